@@ -1,0 +1,100 @@
+#pragma once
+/// Reading YAML configuration into typed structs, with errors that say where and what:
+///   `configs/spidar8.yaml:14: fingers[3].fulcrums[1]: expected 3 numbers, got 2`
+///
+/// A `ConfigNode` is a position in a parsed document: the file name, the key path from the
+/// root and the line it came from. Accessors check the type and throw `ConfigError` with that
+/// location. Parsers of module configs take a `ConfigNode`, so they stay free of file I/O.
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "spidar/core/result.hpp"
+#include "spidar/core/types.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace spidar::core {
+
+/// A configuration error with its location. `what()` is the full one-line message.
+class ConfigError : public SpidarError {
+ public:
+  ConfigError(std::string file, int line, std::string key, std::string expectation);
+  const std::string& file() const { return file_; }
+  int line() const { return line_; }  ///< 1-based; 0 when unknown
+  const std::string& key() const { return key_; }
+  const std::string& expectation() const { return expectation_; }
+
+ private:
+  std::string file_;
+  int line_;
+  std::string key_;
+  std::string expectation_;
+};
+
+class ConfigNode {
+ public:
+  /// Parses a YAML file. Throws ConfigError (with the file name) if it is missing or malformed.
+  static ConfigNode LoadFile(const std::string& path);
+  /// Parses YAML text; `name` stands for the file in messages.
+  static ConfigNode Parse(std::string_view text, const std::string& name);
+
+  const std::string& file() const { return *file_; }
+  const std::string& path() const { return path_; }  ///< e.g. `fingers[3].fulcrums[1]`
+  int line() const;                                   ///< 1-based line of this node
+
+  bool is_map() const;
+  bool is_sequence() const;
+  bool is_null() const;
+
+  bool has(std::string_view key) const;
+  /// A required key of a map. Missing key → ConfigError naming the key.
+  ConfigNode operator[](std::string_view key) const;
+  /// An optional key of a map.
+  std::optional<ConfigNode> find(std::string_view key) const;
+  /// Keys of a map in document order.
+  std::vector<std::string> keys() const;
+  /// Rejects keys not in `allowed` (catches typos such as `fulcrum:`).
+  void expect_keys(std::initializer_list<std::string_view> allowed) const;
+
+  /// Number of entries of a sequence (error if not a sequence).
+  std::size_t size() const;
+  /// Entry i of a sequence.
+  ConfigNode at(std::size_t i) const;
+
+  double as_double() const;  ///< finite number
+  std::int64_t as_int() const;
+  bool as_bool() const;
+  std::string as_string() const;
+  Vec3 as_vec3() const;  ///< a sequence of exactly 3 finite numbers
+  std::vector<double> as_doubles() const;
+
+  /// Convenience for optional scalars.
+  double get_double(std::string_view key, double fallback) const;
+  std::int64_t get_int(std::string_view key, std::int64_t fallback) const;
+
+  /// Throws ConfigError at this node: `file:line: path: expectation`.
+  [[noreturn]] void fail(std::string_view expectation) const;
+
+ private:
+  ConfigNode(std::shared_ptr<const YAML::Node> node, std::shared_ptr<const std::string> file,
+             std::string path);
+  std::string child_path(std::string_view key) const;
+  std::string child_path(std::size_t i) const;
+
+  std::shared_ptr<const YAML::Node> node_;
+  std::shared_ptr<const std::string> file_;
+  std::string path_;
+};
+
+/// Checks a number against [lo, hi] and fails at `node` with the range if outside.
+double require_in_range(const ConfigNode& node, double value, double lo, double hi,
+                        std::string_view unit);
+
+}  // namespace spidar::core

@@ -1,0 +1,45 @@
+#pragma once
+/// A string device's configuration (configs/spidar8.yaml, configs/spidar-g4.yaml): fulcrum
+/// layout per fingertip, encoder channels, motor drive and tension limits, validated on load.
+#include <string>
+#include <vector>
+
+#include "spidar/core/config.hpp"
+#include "spidar/strings/encoder.hpp"
+#include "spidar/strings/motor.hpp"
+#include "spidar/strings/point_geometry.hpp"
+#include "spidar/strings/string_set.hpp"
+
+namespace spidar::strings {
+
+struct FingerConfig {
+  std::string name;                      ///< e.g. "left_index"
+  std::string hand;                      ///< "left", "right" or empty
+  int unit = -1;                         ///< the device's unit number, if documented
+  PointGeometry geometry;                ///< fulcrums [m], world, with closed-form constants
+  std::vector<EncoderChannel> channels;  ///< one per string
+};
+
+struct DeviceConfig {
+  std::string name;
+  std::string source;                     ///< file it was loaded from
+  Vec3 p_W_centre = Vec3::Zero();         ///< frame centre = pole tip [m], world
+  int counter_bits = 24;
+  MotorModel motor;
+  TensionLimits tension;                  ///< as configured
+  std::vector<FingerConfig> fingers;
+
+  int string_count() const;
+  /// Limits the drive can actually deliver: [max(t_min, drive min), min(t_max, drive max)].
+  TensionLimits effective_limits() const;
+};
+
+/// Parses and validates a device config. Throws core::ConfigError naming file:line: key.
+DeviceConfig parse_device_config(const core::ConfigNode& root);
+/// Loads and validates a device config file.
+DeviceConfig load_device_config(const std::string& path);
+
+/// The lengths each string has with the fingertip at p_WF [m].
+StringVec string_lengths(const PointGeometry& geometry, const Vec3& p_WF);
+
+}  // namespace spidar::strings

@@ -1,0 +1,39 @@
+#include "cli_support.hpp"
+
+#include <charconv>
+#include <filesystem>
+
+namespace spidar::app {
+
+std::string resolve_data_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (fs::exists(path)) return path;
+#ifdef SPIDAR_DATA_DIR
+  const fs::path installed = fs::path(SPIDAR_DATA_DIR) / path;
+  if (fs::exists(installed)) return installed.string();
+#endif
+  return path;  // the loader reports it missing
+}
+
+int find_finger(const strings::DeviceConfig& cfg, const std::string& finger) {
+  const int n = static_cast<int>(cfg.fingers.size());
+  int index = -1;
+  const char* end = finger.data() + finger.size();
+  auto [ptr, ec] = std::from_chars(finger.data(), end, index);
+  if (ec == std::errc() && ptr == end) {
+    if (index >= 0 && index < n) return index;
+  } else {
+    for (int i = 0; i < n; ++i)
+      if (cfg.fingers[i].name == finger) return i;
+  }
+  std::string names;
+  for (int i = 0; i < n; ++i) {
+    names += (i ? ", " : "") + std::to_string(i) + " (" + cfg.fingers[i].name + ")";
+  }
+  throw UsageError("--finger " + finger + ": unknown finger in " + cfg.source +
+                   "; expected one of " + names);
+}
+
+nlohmann::json to_json(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace spidar::app

@@ -1,0 +1,16 @@
+#pragma once
+/// The spidar-mr subcommands. Each registers itself on the CLI11 app and runs when chosen.
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace spidar::app {
+
+/// A subcommand's action; returns the process exit code.
+using Action = std::function<int()>;
+
+Action add_check_config(CLI::App& app);
+Action add_position(CLI::App& app);
+Action add_tension(CLI::App& app);
+Action add_demo(CLI::App& app);
+
+}  // namespace spidar::app

@@ -1,0 +1,47 @@
+// spidar-mr: command-line entry point. Bad input exits with code 2 and a message on stderr.
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "spidar/core/config.hpp"
+
+int main(int argc, char** argv) {
+  using namespace spidar::app;
+  CLI::App app{"spidar-mr: SPIDAR-8 string haptics in mixed reality"};
+  app.require_subcommand(1);
+  std::vector<std::pair<CLI::App*, Action>> actions;
+  auto add = [&](Action (*adder)(CLI::App&)) {
+    Action action = adder(app);
+    actions.emplace_back(app.get_subcommands({}).back(), std::move(action));
+  };
+  add(add_check_config);
+  add(add_position);
+  add(add_tension);
+  add(add_demo);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  }
+  try {
+    for (auto& [cmd, action] : actions) {
+      if (cmd->parsed()) return action();
+    }
+  } catch (const spidar::SpidarError& e) {
+    std::cerr << "spidar-mr: error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "spidar-mr: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return kExitBadInput;
+}

@@ -1,0 +1,137 @@
+#include "spidar/strings/device_config.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+namespace spidar::strings {
+namespace {
+
+std::vector<double> per_string(const core::ConfigNode& finger, std::string_view key, int n,
+                               double fallback) {
+  auto node = finger.find(key);
+  if (!node) return std::vector<double>(n, fallback);
+  auto v = node->as_doubles();
+  if (static_cast<int>(v.size()) != n) {
+    node->fail("expected " + std::to_string(n) + " numbers (one per string), got " +
+               std::to_string(v.size()));
+  }
+  return v;
+}
+
+FingerConfig parse_finger(const core::ConfigNode& node, const DeviceConfig& dev,
+                          double default_mpc) {
+  node.expect_keys({"name", "hand", "unit", "fulcrums", "signs", "metres_per_count",
+                    "length_at_zero"});
+  FingerConfig f;
+  f.name = node["name"].as_string();
+  if (auto hand = node.find("hand")) {
+    f.hand = hand->as_string();
+    if (f.hand != "left" && f.hand != "right") hand->fail("expected 'left' or 'right'");
+  }
+  f.unit = static_cast<int>(node.get_int("unit", -1));
+  const auto fulcrums = node["fulcrums"];
+  std::vector<Vec3> p_WA;
+  for (std::size_t i = 0; i < fulcrums.size(); ++i) p_WA.push_back(fulcrums.at(i).as_vec3());
+  auto geometry = make_point_geometry(p_WA, dev.p_W_centre);
+  if (!geometry) fulcrums.fail(geometry.error().message);
+  f.geometry = *geometry;
+  const int n = f.geometry.n;
+
+  const auto signs = per_string(node, "signs", n, 1.0);
+  const auto mpc = per_string(node, "metres_per_count", n, default_mpc);
+  std::vector<double> l0(n);
+  for (int i = 0; i < n; ++i) l0[i] = (p_WA[i] - dev.p_W_centre).norm();
+  if (node.has("length_at_zero")) l0 = per_string(node, "length_at_zero", n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    if (signs[i] != 1.0 && signs[i] != -1.0) {
+      node["signs"].at(i).fail("expected +1 or -1");
+    }
+    if (!(mpc[i] > 0.0 && mpc[i] < 1e-2)) {
+      node["metres_per_count"].at(i).fail("expected metres per count in (0, 0.01)");
+    }
+    f.channels.push_back({static_cast<int>(signs[i]), mpc[i], l0[i]});
+  }
+  return f;
+}
+
+}  // namespace
+
+int DeviceConfig::string_count() const {
+  int n = 0;
+  for (const auto& f : fingers) n += f.geometry.n;
+  return n;
+}
+
+TensionLimits DeviceConfig::effective_limits() const {
+  return {std::max(tension.t_min, min_drive_tension(motor)),
+          std::min(tension.t_max, max_drive_tension(motor))};
+}
+
+DeviceConfig parse_device_config(const core::ConfigNode& root) {
+  root.expect_keys({"name", "frame_centre", "encoder", "motor", "tension", "fingers"});
+  DeviceConfig dev;
+  dev.source = root.file();
+  dev.name = root["name"].as_string();
+  if (auto c = root.find("frame_centre")) dev.p_W_centre = c->as_vec3();
+
+  const auto enc = root["encoder"];
+  enc.expect_keys({"metres_per_count", "counter_bits"});
+  const auto mpc_node = enc["metres_per_count"];
+  const double mpc = core::require_in_range(mpc_node, mpc_node.as_double(), 1e-9, 1e-2, "m");
+  dev.counter_bits = static_cast<int>(enc.get_int("counter_bits", 24));
+  if (dev.counter_bits < 8 || dev.counter_bits > 62) enc["counter_bits"].fail("expected 8..62");
+
+  const auto motor = root["motor"];
+  motor.expect_keys({"pulley_radius", "torque_constant", "amplifier_gain", "dac_bits",
+                     "dac_v_min", "dac_v_max"});
+  auto positive = [&](const char* key) {
+    const auto n = motor[key];
+    const double v = n.as_double();
+    if (!(v > 0.0)) n.fail("expected a positive number, got " + std::to_string(v));
+    return v;
+  };
+  dev.motor.pulley_radius = positive("pulley_radius");
+  dev.motor.torque_constant = positive("torque_constant");
+  dev.motor.amplifier_gain = positive("amplifier_gain");
+  dev.motor.dac_bits = static_cast<int>(motor["dac_bits"].as_int());
+  if (dev.motor.dac_bits < 1 || dev.motor.dac_bits > 24) motor["dac_bits"].fail("expected 1..24");
+  dev.motor.dac_v_min = motor["dac_v_min"].as_double();
+  dev.motor.dac_v_max = motor["dac_v_max"].as_double();
+  if (!(dev.motor.dac_v_max > dev.motor.dac_v_min)) {
+    motor["dac_v_max"].fail("expected dac_v_max > dac_v_min");
+  }
+
+  const auto tension = root["tension"];
+  tension.expect_keys({"min", "max"});
+  dev.tension.t_min = tension["min"].as_double();
+  dev.tension.t_max = tension["max"].as_double();
+  if (dev.tension.t_min < 0.0) tension["min"].fail("expected a tension >= 0 N");
+  if (!(dev.tension.t_max > dev.tension.t_min)) tension["max"].fail("expected max > min");
+  if (dev.effective_limits().t_max <= dev.effective_limits().t_min) {
+    tension.fail("the motor drive cannot produce any tension in [min, max]");
+  }
+
+  const auto fingers = root["fingers"];
+  if (fingers.size() == 0) fingers.fail("expected at least one finger");
+  for (std::size_t i = 0; i < fingers.size(); ++i) {
+    dev.fingers.push_back(parse_finger(fingers.at(i), dev, mpc));
+    for (std::size_t j = 0; j < i; ++j) {
+      if (dev.fingers[j].name == dev.fingers[i].name) {
+        fingers.at(i)["name"].fail("duplicate finger name '" + dev.fingers[i].name + "'");
+      }
+    }
+  }
+  return dev;
+}
+
+DeviceConfig load_device_config(const std::string& path) {
+  return parse_device_config(core::ConfigNode::LoadFile(path));
+}
+
+StringVec string_lengths(const PointGeometry& g, const Vec3& p_WF) {
+  StringVec l(g.n);
+  for (int i = 0; i < g.n; ++i) l[i] = (g.p_WA[i] - p_WF).norm();
+  return l;
+}
+
+}  // namespace spidar::strings
