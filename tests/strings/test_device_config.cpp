@@ -1,0 +1,136 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "spidar/strings/device_config.hpp"
+#include "test_support.hpp"
+
+namespace spidar::strings {
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string parse_error(const std::string& text, const std::string& name = "configs/spidar8.yaml") {
+  try {
+    parse_device_config(core::ConfigNode::Parse(text, name));
+  } catch (const core::ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+/// 1-based line of the first occurrence of `needle` in `text`.
+int line_of(const std::string& text, const std::string& needle) {
+  const auto pos = text.find(needle);
+  return pos == std::string::npos ? -1 : 1 + static_cast<int>(std::count(text.begin(), text.begin() + pos, '\n'));
+}
+
+TEST(DeviceConfig, Spidar8LoadsWithTheMappedFulcrumTable) {
+  const auto& cfg = testing::spidar8();
+  EXPECT_EQ(cfg.name, "SPIDAR-8");
+  ASSERT_EQ(cfg.fingers.size(), 8u);
+  EXPECT_EQ(cfg.string_count(), 24);
+  // Unit 0's A1 (-0.025, +0.230, -0.283) in the source axes is (-0.025, 0.283, 0.230) here.
+  const auto& middle = cfg.fingers[2];
+  EXPECT_EQ(middle.name, "left_middle");
+  EXPECT_EQ(middle.unit, 0);
+  EXPECT_TRUE(middle.geometry.p_WA[0].isApprox(Vec3(-0.025, 0.283, 0.230)));
+  // Right hand mirrors the left in x, finger by finger.
+  for (int k = 0; k < 4; ++k) {
+    const auto& l = cfg.fingers[k];
+    const auto& r = cfg.fingers[k + 4];
+    EXPECT_EQ(l.hand, "left");
+    EXPECT_EQ(r.hand, "right");
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_TRUE(r.geometry.p_WA[i].isApprox(Vec3(-1, 1, 1).asDiagonal() * l.geometry.p_WA[i]));
+    }
+  }
+  // Counters are zeroed at the pole by default: length at count 0 is the pole distance.
+  EXPECT_NEAR(cfg.fingers[0].channels[0].length_at_zero, cfg.fingers[0].geometry.p_WA[0].norm(), 1e-15);
+  EXPECT_NEAR(cfg.effective_limits().t_max, 17.31, 0.01);
+  EXPECT_EQ(cfg.effective_limits().t_min, 0.35);
+}
+
+TEST(DeviceConfig, G4HasFourStringsToOnePoint) {
+  const auto& cfg = testing::spidar_g4();
+  ASSERT_EQ(cfg.fingers.size(), 1u);
+  EXPECT_EQ(cfg.fingers[0].geometry.n, 4);
+}
+
+TEST(DeviceConfig, ShortFulcrumNamesFileLineAndKey) {
+  std::string text = read_file(testing::source_path("configs/spidar8.yaml"));
+  // Drop the last number of fingers[3].fulcrums[1] (left_ring, second fulcrum).
+  const std::string target = "- [-0.316, -0.283, 0.025]";
+  const int line = line_of(text, target);
+  ASSERT_GT(line, 0);
+  text.replace(text.find(target), target.size(), "- [-0.316, -0.283]");
+  EXPECT_EQ(parse_error(text), "configs/spidar8.yaml:" + std::to_string(line) +
+                                   ": fingers[3].fulcrums[1]: expected 3 numbers, got 2");
+}
+
+TEST(DeviceConfig, DegenerateLayoutsAreRejectedWhereTheyAre) {
+  std::string base = read_file(testing::source_path("configs/spidar-g4.yaml"));
+  const int line = line_of(base, "fulcrums:");
+  std::string collinear = base;
+  collinear.replace(collinear.find("fulcrums:"), std::string::npos,
+                    "fulcrums: [[0, 0, 0.3], [0.1, 0, 0.3], [0.2, 0, 0.3], [0.3, 0, 0.3]]\n");
+  EXPECT_EQ(parse_error(collinear, "g4.yaml").rfind("g4.yaml:" + std::to_string(line) +
+                                                        ": fingers[0].fulcrums: fulcrums are collinear",
+                                                    0),
+            0u)
+      << parse_error(collinear, "g4.yaml");
+  std::string coincident = base;
+  coincident.replace(coincident.find("fulcrums:"), std::string::npos,
+                     "fulcrums: [[0, 0, 0.3], [0, 0, 0.3], [0.2, 0, 0.3]]\n");
+  EXPECT_NE(parse_error(coincident).find("fulcrums 0 and 1 coincide"), std::string::npos);
+}
+
+TEST(DeviceConfig, OtherMistakesGiveClearErrors) {
+  const std::string g4 = read_file(testing::source_path("configs/spidar-g4.yaml"));
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = g4;
+    const auto pos = t.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    t.replace(pos, from.size(), to);
+    return parse_error(t, "g4.yaml");
+  };
+  EXPECT_NE(with("min: 0.35", "min: -1").find("tension.min: expected a tension >= 0 N"),
+            std::string::npos);
+  EXPECT_NE(with("max: 30.0", "max: 0.1").find("tension.max: expected max > min"), std::string::npos);
+  EXPECT_NE(with("  - name: grip\n", "  - name: grip\n    signs: [1, 1, 2, 1]\n")
+                .find("fingers[0].signs[2]: expected +1 or -1"),
+            std::string::npos);
+  EXPECT_NE(with("  - name: grip\n", "  - name: grip\n    signs: [1, 1]\n")
+                .find("fingers[0].signs: expected 4 numbers (one per string), got 2"),
+            std::string::npos);
+  EXPECT_NE(with("counter_bits: 24", "counter_bits: 24\n  bogus: 1").find("encoder.bogus: unknown key"),
+            std::string::npos);
+  EXPECT_NE(with("metres_per_count: 2.513e-5", "metres_per_count: abc")
+                .find("encoder.metres_per_count: expected a number, got 'abc'"),
+            std::string::npos);
+  EXPECT_NE(with("torque_constant: 0.0277", "torque_constant: 0")
+                .find("motor.torque_constant: expected a positive number"),
+            std::string::npos);
+  EXPECT_NE(with("name: SPIDAR-G4\n", "").find("missing required key 'name'"), std::string::npos);
+  std::string two = g4 + "  - name: grip\n    fulcrums: [[0, 0, 0.3], [0.2, 0, 0.3], [0, 0.2, 0.3]]\n";
+  EXPECT_NE(parse_error(two).find("duplicate finger name 'grip'"), std::string::npos);
+}
+
+TEST(DeviceConfig, MissingFileIsAClearError) {
+  try {
+    load_device_config("/no/such/spidar.yaml");
+    FAIL();
+  } catch (const core::ConfigError& e) {
+    EXPECT_STREQ(e.what(), "/no/such/spidar.yaml: cannot open file (does it exist and is it readable?)");
+  }
+}
+
+}  // namespace
+}  // namespace spidar::strings
