@@ -20,6 +20,19 @@ int main(int argc, char** argv) {
   add(add_tension);
   add(add_demo);
 
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (auto& [cmd, action] : actions) {
+      known = known || cmd->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + cmd->get_name();
+    }
+    if (!known) {
+      std::cerr << "spidar-mr: unknown subcommand '" << argv[1] << "'; expected one of: " << names
+                << " (see spidar-mr --help)\n";
+      return kExitBadInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

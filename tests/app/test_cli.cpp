@@ -1,0 +1,126 @@
+// Runs the spidar-mr binary as a user would and checks its output and exit codes.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <sys/wait.h>
+
+namespace {
+
+struct Run {
+  int code;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+Run run(const std::string& args) {
+  const std::string err_file = ::testing::TempDir() + "spidar_cli_stderr.txt";
+  const std::string cmd = std::string(SPIDAR_MR) + " " + args + " 2>" + err_file;
+  Run r{-1, "", ""};
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (FILE* e = fopen(err_file.c_str(), "r")) {
+    while (fgets(buf.data(), buf.size(), e)) r.err += buf.data();
+    fclose(e);
+  }
+  return r;
+}
+
+TEST(Cli, CheckConfigSummarisesOrFailsWithCode2) {
+  auto ok = run("check-config configs/spidar8.yaml");
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("ok: SPIDAR-8, 8 fingers, 24 strings"), std::string::npos) << ok.out;
+  auto missing = run("check-config /nonexistent.yaml");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("/nonexistent.yaml: cannot open file"), std::string::npos);
+}
+
+TEST(Cli, PositionPrintsJsonThatRoundTrips) {
+  // Lengths from the fulcrums of left_index (finger 1) to (0.01, 0.02, -0.03).
+  const double A[3][3] = {{-0.025, 0.283, -0.230}, {-0.316, 0.283, -0.080}, {-0.366, 0.025, -0.230}};
+  const double p[3] = {0.01, 0.02, -0.03};
+  std::string lengths;
+  for (const auto& a : A) {
+    const double l = std::sqrt(std::pow(a[0] - p[0], 2) + std::pow(a[1] - p[1], 2) + std::pow(a[2] - p[2], 2));
+    lengths += " " + std::to_string(l);
+  }
+  auto r = run("position --config configs/spidar8.yaml --finger 1 --lengths" + lengths);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["finger"], 1);
+  EXPECT_TRUE(j["consistent"].get<bool>());
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(j["position"][i].get<double>(), p[i], 2e-6);
+  EXPECT_LT(j["residual"].get<double>(), 1e-6);
+  // By name, on the 4-string layout.
+  auto g4 = run("position --config configs/spidar-g4.yaml --finger grip --lengths 0.3 0.4 0.35 0.33");
+  ASSERT_EQ(g4.code, 0) << g4.err;
+  EXPECT_EQ(nlohmann::json::parse(g4.out)["finger"], 0);
+}
+
+TEST(Cli, TensionPrintsDisplayedForce) {
+  auto r = run("tension --config configs/spidar-g4.yaml --finger 0 --position 0 0 0 --force 1 2 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["tensions"].size(), 4u);
+  EXPECT_TRUE(j["reachable"].get<bool>());
+  EXPECT_NEAR(j["force"][2].get<double>(), 3.0, 1e-9);
+  auto out = run("tension --finger 0 --position 0 0 0 --force 0 0 -100");
+  ASSERT_EQ(out.code, 0) << out.err;
+  EXPECT_FALSE(nlohmann::json::parse(out.out)["reachable"].get<bool>());
+}
+
+TEST(Cli, BadArgumentsExitWithCode2AndSayWhat) {
+  struct Case {
+    std::string args, expect;
+  };
+  const Case cases[] = {
+      {"position --finger 9 --lengths 0.3 0.3 0.3", "--finger 9: unknown finger"},
+      {"position --finger thumb --lengths 0.3 0.3 0.3", "expected one of 0 (left_thumb)"},
+      {"position --finger 1 --lengths 0.3 0.3", "has 3 strings; got 2 lengths"},
+      {"position --finger 1 --lengths 0.3 nan 0.3", "string 1: length nan m"},
+      {"position --finger 1 --lengths 0.3 0.3 -0.3", "string 2: length -0.3 m"},
+      {"position --finger 1 --lengths 0.3 inf 0.3", "string 1: length inf m"},
+      {"position --config missing.yaml --finger 1 --lengths 0.3 0.3 0.3", "missing.yaml: cannot open"},
+      {"position --finger 1", "--lengths is required"},
+      {"position --finger 1 --lengths 0.3 abc 0.3", "abc"},
+      {"tension --finger 0 --position 0 0 --force 1 2 3", "--position"},
+      {"tension --finger 0 --position 0 nan 0 --force 1 2 3", "--position: expected finite numbers"},
+      {"tension --finger 0 --position -0.025 -0.283 -0.230 --force 1 2 3", "at its fulcrum"},
+      {"frobnicate", "frobnicate"},
+      {"", "subcommand"},
+  };
+  for (const auto& c : cases) {
+    auto r = run(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\nstderr: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << c.args;
+  }
+}
+
+TEST(Cli, DemoWritesItsReport) {
+  const std::string dir = ::testing::TempDir() + "spidar_demo_test";
+  auto r = run("demo --seconds 0.3 --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("calibration"), std::string::npos);
+  FILE* f = fopen((dir + "/report.json").c_str(), "r");
+  ASSERT_NE(f, nullptr);
+  std::string text;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), f)) text += buf.data();
+  fclose(f);
+  const auto j = nlohmann::json::parse(text);
+  EXPECT_LT(j["calibration"]["jig_position_error_rms_mm"].get<double>(), 1.0);
+  EXPECT_EQ(j["fingers"].size(), 8u);
+  for (const auto& finger : j["fingers"]) {
+    EXPECT_LT(finger["position_error_rms_mm"].get<double>(), 1.5) << finger["name"];
+    EXPECT_GT(finger["force_max_n"].get<double>(), 0.3) << finger["name"];
+  }
+}
+
+}  // namespace
