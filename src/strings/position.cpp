@@ -1,13 +1,72 @@
 #include "spidar/strings/position.hpp"
 
-#include <Eigen/Cholesky>
+#include "sym3.hpp"
+
 #include <cmath>
+#include <array>
 #include <sstream>
+#include <utility>
 
 namespace spidar::strings {
 namespace {
 
-/// Σ (‖P − A_i‖ − l_i)².
+
+/// Distances and unit directions from each fulcrum to p, and the cost Σ (‖P − A_i‖ − l_i)².
+struct Linearisation {
+  std::array<double, kMaxStrings> r{};  ///< residuals ‖P − A_i‖ − l_i [m]
+  std::array<Vec3, kMaxStrings> j{};    ///< unit directions (P − A_i)/‖P − A_i‖
+  double cost = 0.0;
+};
+
+void linearise(const PointGeometry& g, const Vec3& p, std::span<const double> l, Linearisation& L) {
+  L.cost = 0.0;
+  for (int i = 0; i < g.n; ++i) {
+    const Vec3 d = p - g.p_WA[i];
+    const double dist = d.norm();
+    L.j[i] = dist > 1e-12 ? Vec3(d * (1.0 / dist)) : Vec3::Zero();  // at a fulcrum: no gradient
+    L.r[i] = dist - l[i];
+    L.cost += L.r[i] * L.r[i];
+  }
+}
+
+/// Levenberg-Marquardt on Σ (‖P − A_i‖ − l_i)² from `p`, whose linearisation is `cur`. Stops
+/// when the next step would be shorter than the tolerance. Returns iterations used; `cur` ends
+/// as the linearisation at the returned `p`.
+int refine(const PointGeometry& g, std::span<const double> l, const PositionSolverParams& prm,
+           Vec3& p, Linearisation& cur) {
+  Linearisation trial;
+  double lambda = prm.initial_damping;
+  int it = 0;
+  while (it < prm.max_iterations) {
+    ++it;
+    Mat3 A = Mat3::Zero();
+    Vec3 b = Vec3::Zero();
+    for (int i = 0; i < g.n; ++i) {
+      A.noalias() += cur.j[i] * cur.j[i].transpose();
+      b.noalias() += cur.j[i] * cur.r[i];
+    }
+    bool accepted = false;
+    for (int tries = 0; tries < 12 && !accepted; ++tries) {
+      Mat3 Ad = A;
+      Ad.diagonal().array() += lambda * (1.0 + A.diagonal().array());
+      Vec3 step;
+      if (!detail::solve_sym3(Ad, -b, step, 0.0) || !step.allFinite()) return it;
+      if (step.squaredNorm() < prm.step_tolerance * prm.step_tolerance) return it;
+      linearise(g, p + step, l, trial);
+      if (trial.cost <= cur.cost) {
+        p += step;
+        std::swap(cur, trial);
+        lambda = std::max(lambda * 0.1, 1e-15);
+        accepted = true;
+      } else {
+        lambda *= 10.0;
+      }
+    }
+    if (!accepted) break;
+  }
+  return it;
+}
+
 double cost(const PointGeometry& g, const Vec3& p, std::span<const double> l) {
   double c = 0.0;
   for (int i = 0; i < g.n; ++i) {
@@ -15,49 +74,6 @@ double cost(const PointGeometry& g, const Vec3& p, std::span<const double> l) {
     c += r * r;
   }
   return c;
-}
-
-/// Levenberg-Marquardt on Σ (‖P − A_i‖ − l_i)² from `p`. Returns iterations used.
-int refine(const PointGeometry& g, std::span<const double> l, const PositionSolverParams& prm,
-           Vec3& p) {
-  double c = cost(g, p, l);
-  double lambda = prm.initial_damping;
-  int it = 0;
-  for (; it < prm.max_iterations; ++it) {
-    Mat3 A = Mat3::Zero();
-    Vec3 b = Vec3::Zero();
-    for (int i = 0; i < g.n; ++i) {
-      const Vec3 d = p - g.p_WA[i];
-      const double dist = d.norm();
-      if (dist < 1e-12) continue;  // at a fulcrum: no gradient from this string
-      const Vec3 j = d / dist;
-      const double r = dist - l[i];
-      A.noalias() += j * j.transpose();
-      b.noalias() += j * r;
-    }
-    bool accepted = false;
-    Vec3 step = Vec3::Zero();
-    for (int tries = 0; tries < 12 && !accepted; ++tries) {
-      Mat3 Ad = A;
-      Ad.diagonal().array() += lambda * (1.0 + A.diagonal().array());
-      step = -Ad.ldlt().solve(b);
-      if (!step.allFinite()) break;
-      const double c_new = cost(g, p + step, l);
-      if (c_new <= c) {
-        p += step;
-        c = c_new;
-        lambda = std::max(lambda * 0.1, 1e-15);
-        accepted = true;
-      } else {
-        lambda *= 10.0;
-      }
-    }
-    if (!accepted || step.norm() < prm.step_tolerance) {
-      ++it;
-      break;
-    }
-  }
-  return it;
 }
 
 }  // namespace
@@ -108,21 +124,26 @@ Result<PositionEstimate> solve_position(const PointGeometry& g, std::span<const 
   }
 
   Vec3 p = inner.p_WF;
+  Linearisation lin;
+  linearise(g, p, l, lin);
   if (g.n > 3 && inner.discriminant > 0.0) {
     // Extra strings see which mirror root is right.
     const Vec3 outer = closed_form_position(tr, l1, l2, l3, false).p_WF;
-    if (cost(g, outer, l) < cost(g, p, l)) p = outer;
+    Linearisation lin_outer;
+    linearise(g, outer, l, lin_outer);
+    if (lin_outer.cost < lin.cost) p = outer, lin = lin_outer;
   }
-  est.iterations = refine(g, l, prm, p);
+  est.iterations = refine(g, l, prm, p, lin);
   if (inner.discriminant < 0.0) {
     // The in-plane point can be a saddle of the least-squares cost; try once from inside.
     Vec3 q = inner.p_WF + 0.01 * tr.n3_inner;
-    const int it2 = refine(g, l, prm, q);
-    est.iterations += it2;
-    if (cost(g, q, l) < cost(g, p, l)) p = q;
+    Linearisation lin_q;
+    linearise(g, q, l, lin_q);
+    est.iterations += refine(g, l, prm, q, lin_q);
+    if (lin_q.cost < lin.cost) p = q, lin = lin_q;
   }
   est.p_WF = p;
-  est.residual = length_residual_rms(g, p, l);
+  est.residual = std::sqrt(lin.cost / g.n);
   est.consistent = est.residual <= prm.consistency_tolerance;
   return est;
 }

@@ -1,5 +1,7 @@
 #include "spidar/strings/tension.hpp"
 
+#include "sym3.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <array>
@@ -165,6 +167,28 @@ bool satisfies_kkt(const StringMat& U, const Vec3& f, double lo, double hi, cons
   return true;
 }
 
+/// The least-norm solution of U t = f when U has full row rank. If it lies within the bounds it
+/// is the exact optimum (zero residual, least norm), and the active-set search is not needed.
+bool solve_unconstrained(const StringMat& U, const Vec3& f, double lo, double hi, StringVec& t) {
+  const int n = static_cast<int>(U.cols());
+  if (n == 3) {
+    const Mat3 U3 = U;
+    Mat3 inv;
+    double det = 0.0;
+    bool invertible = false;
+    U3.computeInverseAndDetWithCheck(inv, det, invertible, 1e-9);
+    if (!invertible) return false;
+    t = inv * f;
+  } else if (n > 3) {
+    Vec3 y;
+    if (!detail::solve_sym3(U * U.transpose(), f, y, 1e-9)) return false;
+    t = U.transpose() * y;
+  } else {
+    return false;
+  }
+  return t.allFinite() && t.minCoeff() >= lo && t.maxCoeff() <= hi;
+}
+
 }  // namespace
 
 Result<StringMat> string_directions(const PointGeometry& g, const Vec3& p_WF) {
@@ -198,6 +222,11 @@ Result<TensionSolution> solve_tensions(const StringMat& U, const Vec3& f,
   StringVec t_reg(U.cols());
   sol.t.resize(U.cols());
   int iterations = 0;
+  if (solve_unconstrained(U, f, lo, hi, sol.t)) {
+    sol.f_displayed = U * sol.t;
+    sol.reachable = true;
+    return sol;
+  }
   // ε only guides the active-set search; the tensions come from the exact solve on that set.
   for (const double eps : {1e-10, 1e-14, 1e-7}) {
     const ActiveSet as = find_active_set(U, f, lo, hi, eps, t_reg);

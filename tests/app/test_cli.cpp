@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace {
 
@@ -16,7 +17,9 @@ struct Run {
 };
 
 Run run(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + "spidar_cli_stderr.txt";
+  // One file per process: ctest runs the tests of this binary in parallel processes.
+  const std::string err_file =
+      ::testing::TempDir() + "spidar_cli_stderr_" + std::to_string(getpid()) + ".txt";
   const std::string cmd = std::string(SPIDAR_MR) + " " + args + " 2>" + err_file;
   Run r{-1, "", ""};
   FILE* p = popen(cmd.c_str(), "r");
@@ -104,7 +107,7 @@ TEST(Cli, BadArgumentsExitWithCode2AndSayWhat) {
 }
 
 TEST(Cli, DemoWritesItsReport) {
-  const std::string dir = ::testing::TempDir() + "spidar_demo_test";
+  const std::string dir = ::testing::TempDir() + "spidar_demo_test_" + std::to_string(getpid());
   auto r = run("demo --seconds 0.3 --out " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("calibration"), std::string::npos);

@@ -14,7 +14,7 @@ namespace spidar::strings {
 
 struct PositionSolverParams {
   int max_iterations = 30;           ///< Gauss-Newton iterations at most
-  double step_tolerance = 1e-12;     ///< stop when the step is shorter [m]
+  double step_tolerance = 1e-10;     ///< stop when the step is shorter [m] (encoders: ~25 µm)
   double initial_damping = 1e-9;     ///< Levenberg-Marquardt λ added to JᵀJ (dimensionless)
   double consistency_tolerance = 1e-3;  ///< RMS residual above which lengths are inconsistent [m]
 };
