@@ -50,16 +50,24 @@ struct VirtualBox {
 };
 
 /// Scripted fingertip path: open hand → grasp (3 mm into the faces) → slide up 2 cm → release.
+/// (The ring finger on the top face slides out of contact as it rises.)
 Vec3 scripted_fingertip(int finger, double t, double duration) {
   const bool right = finger >= 4;
   const int k = finger % 4;  // thumb, index, middle, ring
   const double sx = right ? 1.0 : -1.0;
   const double h = 0.0285, press = 0.003;
-  // Contact points: thumb on the front face, index/middle/ring on the back face.
-  const double y_face = k == 0 ? -(h - press) : (h - press);
-  const double z_rest = k == 0 ? -0.005 : -0.012 + 0.011 * (k - 1);
-  const Vec3 grasp(sx * (0.012 + 0.004 * k), y_face, z_rest);
-  const Vec3 open = grasp + Vec3(sx * 0.03, (k == 0 ? -1.0 : 1.0) * 0.04, 0.02);
+  // Contact points: thumb on the front face, index and middle on the back face, ring on the top
+  // face (its front-top unit cannot push a finger backwards; see the force-cone table).
+  Vec3 grasp, open;
+  if (k == 3) {
+    grasp = Vec3(sx * 0.018, -0.004, h - press);
+    open = grasp + Vec3(sx * 0.03, 0.0, 0.04);
+  } else {
+    const double y_face = k == 0 ? -(h - press) : (h - press);
+    const double z_rest = k == 0 ? -0.005 : -0.012 + 0.011 * (k - 1);
+    grasp = Vec3(sx * (0.012 + 0.004 * k), y_face, z_rest);
+    open = grasp + Vec3(sx * 0.03, (k == 0 ? -1.0 : 1.0) * 0.04, 0.02);
+  }
   const double s = t / duration;
   auto smooth = [](double x) {
     x = std::clamp(x, 0.0, 1.0);
@@ -191,26 +199,42 @@ int run_demo(const DemoArgs& a) {
             << "  3x3x3 jig, placement sigma 0.5 mm  " << units::m_to_mm(jig_err)
             << " mm   (worst string fit residual " << units::m_to_mm(fit_rms_max) << " mm)\n\n";
 
-  // 4. Force cones at the grasp: which pushes can each finger feel there?
-  std::cout << "force cone at the grasp point (displayable unit pushes of 1 N):\n";
-  const char* dir_names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-  nlohmann::json cones = nlohmann::json::object();
+  // 4. Force cones at the grasp: a 3-string unit only pulls toward its own corner, and t_min on
+  // every string adds a baseline force. Share of directions displayable at 2 N, the baseline,
+  // and whether the contact push the grasp needs is displayable.
+  std::cout << "force cones at the grasp point (share of directions displayable at 2 N; baseline "
+               "force of t_min on all strings; the contact push of the grasp):\n";
+  const VirtualBox box;
+  nlohmann::json cones = nlohmann::json::array();
   for (int f = 0; f < nf; ++f) {
-    const Vec3 p = scripted_fingertip(f, 0.5, 1.0);
-    std::string ok;
-    for (int d = 0; d < 6; ++d) {
-      Vec3 dir = Vec3::Zero();
-      dir[d / 2] = d % 2 ? -1.0 : 1.0;
-      const auto sol = solve_tensions(cfg.fingers[f].geometry, p, dir, limits).value();
-      if (sol.reachable) ok += std::string(ok.empty() ? "" : " ") + dir_names[d];
-      cones[cfg.fingers[f].name].push_back({{"direction", dir_names[d]}, {"reachable", sol.reachable}});
+    const auto& g = cfg.fingers[f].geometry;
+    const Vec3 p = scripted_fingertip(f, 0.32 * a.seconds, a.seconds);  // just grasped
+    const auto U = string_directions(g, p).value();
+    int ok = 0;
+    const int m = 2000;
+    for (int k = 0; k < m; ++k) {  // Fibonacci sphere
+      const double z = 1.0 - (2.0 * k + 1.0) / m, r = std::sqrt(1.0 - z * z);
+      const double phi = k * units::kPi * (3.0 - std::sqrt(5.0));
+      const Vec3 dir(r * std::cos(phi), r * std::sin(phi), z);
+      ok += solve_tensions(U, 2.0 * dir, limits).value().reachable;
     }
+    const Vec3 baseline = U * StringVec::Constant(g.n, limits.t_min);
+    const Vec3 push = box.force(p);
+    const auto sol = solve_tensions(U, push, limits).value();
+    const double along = push.norm() > 0 ? sol.f_displayed.dot(push.normalized()) / push.norm() : 0;
     std::cout << "  " << std::left << std::setw(13) << cfg.fingers[f].name << std::right
-              << (ok.empty() ? "none" : ok) << "\n";
+              << std::setprecision(1) << std::setw(5) << 100.0 * ok / m << " %   baseline "
+              << fmt_vec(baseline, 2) << "   push " << fmt_vec(push, 2) << " -> "
+              << fmt_vec(sol.f_displayed, 2) << (sol.reachable ? "" : " (projected)") << "\n";
+    cones.push_back({{"finger", cfg.fingers[f].name},
+                     {"displayable_share", static_cast<double>(ok) / m},
+                     {"baseline_force_n", to_json(baseline)},
+                     {"grasp_push_n", to_json(push)},
+                     {"grasp_push_displayed_n", to_json(sol.f_displayed)},
+                     {"grasp_push_fidelity", along}});
   }
 
   // 5. The scripted grasp at the servo rate.
-  const VirtualBox box;
   const double dt = 1.0 / a.rate_hz;
   const int steps = static_cast<int>(std::lround(a.seconds * a.rate_hz));
   const int print_every = std::max(1, steps / 12);
@@ -218,7 +242,8 @@ int run_demo(const DemoArgs& a) {
   csv << "t,finger,x_true,y_true,z_true,x_est,y_est,z_est,err_mm,fx_des,fy_des,fz_des,"
          "fx_disp,fy_disp,fz_disp,reachable,t0,t1,t2,dac0,dac1,dac2\n";
   std::vector<double> err_max(nf, 0), err_sum2(nf, 0), force_max(nf, 0), force_gap_max(nf, 0);
-  std::vector<int> unreachable(nf, 0);
+  std::vector<int> contact(nf, 0);
+  std::vector<double> fidelity_sum(nf, 0.0);
   double pos_ns = 0, ten_ns = 0;
   std::cout << "\nscripted grasp, " << a.seconds << " s at " << a.rate_hz
             << " Hz (left index and right thumb shown; all fingers in walkthrough.csv):\n"
@@ -236,7 +261,7 @@ int run_demo(const DemoArgs& a) {
       const auto t0 = std::chrono::steady_clock::now();
       const auto est = solve_position(fc.geometry, std::span<const double>(l.data(), l.size())).value();
       const auto t1 = std::chrono::steady_clock::now();
-      const Vec3 f_des = box.force(est.p_WF);
+      const Vec3 f_des = box.force(est.p_WF);  // felt where the device thinks the finger is
       const auto sol = solve_tensions(fc.geometry, est.p_WF, f_des, limits).value();
       const auto t2 = std::chrono::steady_clock::now();
       pos_ns += std::chrono::duration<double, std::nano>(t1 - t0).count();
@@ -254,8 +279,11 @@ int run_demo(const DemoArgs& a) {
       err_max[f] = std::max(err_max[f], err);
       err_sum2[f] += err * err;
       force_max[f] = std::max(force_max[f], f_out.norm());
-      if (f_des.norm() > 0) force_gap_max[f] = std::max(force_gap_max[f], (sol.f_displayed - f_des).norm());
-      unreachable[f] += sol.reachable ? 0 : 1;
+      if (f_des.norm() > 0.5) {  // in contact: how much of the push the strings display
+        force_gap_max[f] = std::max(force_gap_max[f], (f_out - f_des).norm());
+        fidelity_sum[f] += f_out.dot(f_des) / f_des.squaredNorm();
+        ++contact[f];
+      }
       csv << t << ',' << f << ',' << p_true.x() << ',' << p_true.y() << ',' << p_true.z() << ','
           << est.p_WF.x() << ',' << est.p_WF.y() << ',' << est.p_WF.z() << ',' << err * 1e3 << ','
           << f_des.x() << ',' << f_des.y() << ',' << f_des.z() << ',' << f_out.x() << ','
@@ -276,20 +304,24 @@ int run_demo(const DemoArgs& a) {
     }
   }
   const int samples = (steps + 1);
-  std::cout << "\nper finger over the run:\n  finger        err RMS [mm]  err max [mm]  max |F| [N]"
-               "  cone misses  largest gap to desired F [N]\n";
+  std::cout << "\nper finger over the run (fidelity: displayed force along the desired push / "
+               "desired, in contact):\n  finger        err RMS [mm]  err max [mm]  max |F| [N]"
+               "  contact [ms]  fidelity  largest gap [N]\n";
   nlohmann::json fingers = nlohmann::json::array();
   for (int f = 0; f < nf; ++f) {
     const double rms = std::sqrt(err_sum2[f] / samples);
     std::cout << "  " << std::left << std::setw(13) << cfg.fingers[f].name << std::right
               << std::setprecision(3) << std::setw(12) << rms * 1e3 << std::setw(14)
-              << err_max[f] * 1e3 << std::setw(13) << force_max[f] << std::setw(13)
-              << unreachable[f] << std::setw(16) << force_gap_max[f] << "\n";
+              << err_max[f] * 1e3 << std::setw(13) << force_max[f] << std::setw(14)
+              << std::setprecision(0) << contact[f] * dt * 1e3 << std::setprecision(2)
+              << std::setw(10) << (contact[f] ? fidelity_sum[f] / contact[f] : 0.0)
+              << std::setw(17) << force_gap_max[f] << "\n";
     fingers.push_back({{"name", cfg.fingers[f].name},
                        {"position_error_rms_mm", rms * 1e3},
                        {"position_error_max_mm", err_max[f] * 1e3},
                        {"force_max_n", force_max[f]},
-                       {"unreachable_samples", unreachable[f]},
+                       {"contact_s", contact[f] * dt},
+                       {"force_fidelity_mean", contact[f] ? fidelity_sum[f] / contact[f] : 0.0},
                        {"force_gap_max_n", force_gap_max[f]}});
   }
   const double per = 1.0 / (static_cast<double>(samples) * nf);
