@@ -51,7 +51,8 @@ TEST(Cli, PositionPrintsJsonThatRoundTrips) {
   std::string lengths;
   for (const auto& a : A) {
     const double l = std::sqrt(std::pow(a[0] - p[0], 2) + std::pow(a[1] - p[1], 2) + std::pow(a[2] - p[2], 2));
-    lengths += " " + std::to_string(l);
+    lengths += ' ';
+    lengths += std::to_string(l);
   }
   auto r = run("position --config configs/spidar8.yaml --finger 1 --lengths" + lengths);
   ASSERT_EQ(r.code, 0) << r.err;
