@@ -1,0 +1,58 @@
+#pragma once
+/// Joint ranges of the hand and the parameter box they imply.
+///
+/// Defaults are the common anatomical ranges (FACTS.md): MCP flexion −15…90°, MCP abduction
+/// ±20°, PIP 0…110°, DIP 0…90°, thumb CMC flexion ±60°, CMC abduction 0…70°; thumb MCP 0…60° and
+/// IP 0…80° are our own choice (not in FACTS.md). The coupled distal parameter is limited so
+/// that both coupled joints stay in range: θ1 ∈ [dip.lo, min(dip.hi, θ1 where θ2 = pip.hi)].
+/// With the paper's quadratic the PIP angle dips to −0.018 rad for small θ1, slightly below a
+/// PIP range starting at 0: that is the printed relation and is accepted.
+/// The wrist parameters (position, rotation vector) are unbounded.
+#include <limits>
+
+#include "spidar/core/result.hpp"
+#include "spidar/core/units.hpp"
+#include "spidar/hand/coupling.hpp"
+#include "spidar/hand/parameters.hpp"
+
+namespace spidar::hand {
+
+/// A closed range [lo, hi] [rad].
+struct Interval {
+  double lo = 0.0;
+  double hi = 0.0;
+};
+
+/// Anatomical joint ranges [rad], the same for both hands.
+struct JointRanges {
+  Interval mcp_flexion{units::deg_to_rad(-15.0), units::deg_to_rad(90.0)};
+  Interval mcp_abduction{units::deg_to_rad(-20.0), units::deg_to_rad(20.0)};
+  Interval pip_flexion{0.0, units::deg_to_rad(110.0)};
+  Interval dip_flexion{0.0, units::deg_to_rad(90.0)};
+  Interval thumb_cmc_flexion{units::deg_to_rad(-60.0), units::deg_to_rad(60.0)};
+  Interval thumb_cmc_abduction{0.0, units::deg_to_rad(70.0)};
+  Interval thumb_mcp_flexion{0.0, units::deg_to_rad(60.0)};
+  Interval thumb_ip_flexion{0.0, units::deg_to_rad(80.0)};
+};
+
+/// Checks every range: finite, lo < hi, within ±π, and distal/penultimate ranges starting at
+/// ≥ 0 (the coupling is only defined for non-negative distal flexion). The error names the range.
+Status validate_joint_ranges(const JointRanges& ranges);
+
+/// Lower and upper bound of every parameter (±∞ for the wrist).
+struct ParamLimits {
+  ParamVec lower = ParamVec::Constant(-std::numeric_limits<double>::infinity());
+  ParamVec upper = ParamVec::Constant(std::numeric_limits<double>::infinity());
+};
+
+/// The parameter box implied by the joint ranges under a coupling (see the file comment).
+ParamLimits parameter_limits(const JointRanges& ranges, Coupling coupling);
+
+/// Parameters clamped into the box. NaN parameters become the nearest finite bound's midpoint
+/// (or 0 for unbounded ones), so nothing downstream sees NaN.
+HandParams clamp_to_limits(const HandParams& params, const ParamLimits& limits);
+
+/// True when every parameter is within [lower − tol, upper + tol].
+bool within_limits(const HandParams& params, const ParamLimits& limits, double tol = 0.0);
+
+}  // namespace spidar::hand
