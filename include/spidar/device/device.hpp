@@ -1,0 +1,86 @@
+#pragma once
+/// The hardware boundary: one small interface every string device implements (after CHAI3D's
+/// cGenericHapticDevice). A backend reads raw encoder counts and writes raw motor commands; all
+/// maths (lengths, positions, tensions) stays in `strings` and the servo loop.
+///
+/// Threading: `open`, `close`, `read` and `write` are called from one thread (the servo thread
+/// once it runs). `request_safe_state` and `status` may be called from any thread.
+/// To add a backend, copy src/device/template_device.cpp (docs/adding-a-device.md).
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "spidar/core/result.hpp"
+
+namespace spidar::device {
+
+/// Most strings one device serves (SPIDAR-8: 24).
+inline constexpr int kMaxDeviceStrings = 32;
+
+/// Fault bits, as reported by `DeviceStatus::faults` and the servo loop.
+enum Fault : std::uint32_t {
+  kFaultNone = 0,
+  kFaultDisconnected = 1u << 0,   ///< port gone, cable pulled, device closed itself
+  kFaultReadTimeout = 1u << 1,    ///< no reading within the timeout
+  kFaultProtocol = 1u << 2,       ///< corrupt or unexpected frames beyond tolerance
+  kFaultOverCurrent = 1u << 3,    ///< the device reports a motor over its current limit
+  kFaultEmergencyStop = 1u << 4,  ///< emergency stop pressed (API or hardware button)
+  kFaultWatchdog = 1u << 5,       ///< the device or the loop's watchdog tripped
+  kFaultDeadlineMiss = 1u << 6,   ///< the servo loop missed its deadline by too much
+  kFaultForceStall = 1u << 7,     ///< the force producer stopped delivering
+};
+
+/// Names of the set fault bits, e.g. "disconnected,read_timeout".
+std::string fault_names(std::uint32_t faults);
+
+/// What a device can do; fixed once open.
+struct DeviceInfo {
+  std::string name;                ///< e.g. "simulated SPIDAR-8", "serial /dev/ttyACM0"
+  int string_count = 0;            ///< strings (= encoder channels = motors)
+  int counter_bits = 24;           ///< width of the signed, wrapping encoder counters
+  std::int32_t command_min = 0;    ///< smallest motor command (DAC counts) = minimum tension
+  std::int32_t command_max = 4095; ///< largest motor command (DAC counts)
+};
+
+/// One reading of every encoder.
+struct EncoderReading {
+  std::int64_t host_time_ns = 0;    ///< host monotonic clock when the reading arrived [ns]
+  std::uint32_t device_time_us = 0; ///< device's own clock (wraps) [µs]
+  std::uint32_t status_flags = 0;   ///< device status bits (Fault values)
+  int string_count = 0;
+  std::array<std::int32_t, kMaxDeviceStrings> counts{};  ///< raw signed counter values
+};
+
+struct DeviceStatus {
+  bool open = false;
+  std::uint32_t faults = kFaultNone;  ///< latched fault bits
+};
+
+class Device {
+ public:
+  virtual ~Device() = default;
+
+  /// Opens the device. Errors say what failed and where (port, file).
+  virtual Status open() = 0;
+  /// Puts the motors in the safe state and closes. Idempotent.
+  virtual void close() = 0;
+  virtual const DeviceInfo& info() const = 0;
+
+  /// Reads all encoder counts. Returns an error (and latches a fault) on disconnect or timeout;
+  /// must not block much longer than one servo period on a healthy device.
+  virtual Status read(EncoderReading& out) = 0;
+  /// Writes one command per string (DAC counts). The backend clamps to
+  /// [command_min, command_max] and never drives a motor beyond it.
+  virtual Status write(std::span<const std::int32_t> commands) = 0;
+
+  /// Asks for the safe state (every motor at its minimum command) from any thread. The backend
+  /// applies it at once where it can, and keeps writing minimum commands until `clear_safe_state`.
+  virtual void request_safe_state() = 0;
+  /// Leaves the safe state (the servo loop calls this when it starts).
+  virtual void clear_safe_state() = 0;
+  virtual DeviceStatus status() const = 0;
+};
+
+}  // namespace spidar::device
