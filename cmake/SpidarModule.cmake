@@ -2,8 +2,9 @@
 add_library(spidar_build_flags INTERFACE)
 target_compile_options(spidar_build_flags INTERFACE
   -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
-  # GCC 12 reports false positives inside Eigen for fixed-capacity dynamic matrices.
-  $<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>
+  # GCC 12 false positives: inside Eigen for fixed-capacity dynamic matrices, and -Wrestrict on
+  # `"literal" + std::string` (GCC bug 105651).
+  $<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized -Wno-restrict>
   $<$<BOOL:${SPIDAR_WERROR}>:-Werror>)
 if(SPIDAR_SANITIZE)
   target_compile_options(spidar_build_flags INTERFACE

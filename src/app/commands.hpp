@@ -12,5 +12,6 @@ Action add_check_config(CLI::App& app);
 Action add_position(CLI::App& app);
 Action add_tension(CLI::App& app);
 Action add_demo(CLI::App& app);
+Action add_device_test(CLI::App& app);
 
 }  // namespace spidar::app

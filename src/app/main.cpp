@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   add(add_position);
   add(add_tension);
   add(add_demo);
+  add(add_device_test);
 
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;

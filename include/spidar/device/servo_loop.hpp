@@ -1,0 +1,122 @@
+#pragma once
+/// The haptic servo loop: a dedicated thread at a fixed rate (default 1 kHz) that, each cycle,
+/// reads the encoders, turns counts into lengths and eight fingertip positions, asks the force
+/// source for the forces to display, distributes them into string tensions, and writes motor
+/// commands. It publishes timestamped fingertip samples through a lock-free ring.
+///
+/// Real time: it sleeps to absolute deadlines (clock_nanosleep), asks for SCHED_FIFO and a CPU
+/// when permitted (a warning otherwise), and in the cycle allocates nothing, takes no locks and
+/// logs nothing.
+///
+/// Safety: commands are clamped to the device limits; the safe state (minimum tension on every
+/// motor) is entered within one cycle if the loop wakes more than `deadline_periods` late, if the
+/// force source's data goes stale, on emergency stop, or — from a monitor thread — if the servo
+/// thread itself stops cycling. A device error (disconnect, timeout) puts the device in its safe
+/// state and ends the loop with the fault reported.
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "spidar/core/seqlock.hpp"
+#include "spidar/device/device.hpp"
+#include "spidar/device/force_source.hpp"
+#include "spidar/device/servo_cycle.hpp"
+#include "spidar/device/servo_types.hpp"
+#include "spidar/strings/device_config.hpp"
+
+namespace spidar::device {
+
+struct ServoConfig {
+  double rate_hz = 1000.0;
+  bool realtime = true;           ///< try SCHED_FIFO (priority 80) and CPU pinning
+  int cpu = -1;                   ///< CPU to pin to; -1: the last CPU
+  double deadline_periods = 5.0;  ///< waking this many periods late trips the safe state
+  double force_timeout_s = 0.02;  ///< forces older than this trip the safe state
+  double max_seconds = 0.0;       ///< > 0: stop by itself after this long
+  /// Runs in the servo thread before the first cycle (tests: allocation counters).
+  std::function<void()> on_thread_start;
+};
+
+struct ServoStats {
+  std::uint64_t cycles = 0;
+  double seconds = 0;               ///< from first to last cycle
+  double rate_hz = 0;               ///< achieved cycle rate
+  double jitter_p50_us = 0, jitter_p99_us = 0, jitter_max_us = 0;  ///< |period − nominal|
+  double cycle_us_median = 0, cycle_us_p99 = 0, cycle_us_max = 0;  ///< compute time per cycle
+  std::uint64_t overruns = 0;       ///< cycles that ended after the next deadline
+  std::uint64_t inconsistent = 0;   ///< finger solves flagged inconsistent
+  std::uint32_t faults = 0;         ///< latched Fault bits
+  std::string fault_message;        ///< the error that ended the loop, if any
+  bool realtime_scheduling = false; ///< SCHED_FIFO was granted
+};
+
+class ServoLoop {
+ public:
+  /// The device must already be open. `channels` are the calibrated encoder channels per finger
+  /// (default: the config's).
+  ServoLoop(Device& device, const strings::DeviceConfig& config, ServoConfig servo,
+            std::shared_ptr<ForceSource> force);
+  ~ServoLoop();
+  ServoLoop(const ServoLoop&) = delete;
+  ServoLoop& operator=(const ServoLoop&) = delete;
+
+  /// Starts the servo and monitor threads. Errors if already running or the device is closed.
+  Status start();
+  /// Stops the threads (device left in its safe state). Idempotent.
+  void stop();
+  /// Blocks until the loop ends by itself (max_seconds, a device fault) or `stop()`.
+  void wait();
+  bool running() const { return running_.load(std::memory_order_acquire); }
+
+  /// Safe state now, from any thread; latched until `reset_faults()`.
+  void emergency_stop();
+  /// Clears latched faults (not device faults) and leaves the safe state.
+  void reset_faults();
+
+  /// Newest fingertip samples, newest first (lock-free; any thread).
+  std::size_t newest_samples(FingertipSample* out, std::size_t max) const {
+    return ring_.newest(out, max);
+  }
+  std::uint64_t cycles() const { return cycle_.load(std::memory_order_acquire); }
+  std::uint32_t faults() const { return faults_.load(std::memory_order_acquire); }
+  /// Statistics; complete once the loop has ended, approximate while it runs.
+  ServoStats stats() const;
+
+ private:
+  void run();
+  void monitor();
+  void latch(std::uint32_t fault);
+
+  Device& device_;
+  ServoConfig servo_;
+  std::shared_ptr<ForceSource> force_;
+  std::int64_t period_ns_;
+
+  // Preallocated cycle state.
+  ServoCycle cycle_maths_;
+  std::vector<std::int32_t> commands_;
+  FingertipSample sample_;
+  ForceFrame force_frame_;
+
+  // Statistics (histograms: 1 µs bins, last bin = overflow).
+  static constexpr int kBins = 20000;
+  std::vector<std::uint32_t> jitter_hist_, compute_hist_;
+  double jitter_max_us_ = 0, compute_max_us_ = 0;
+  std::int64_t first_wake_ns_ = 0, last_wake_ns_ = 0;
+  std::uint64_t overruns_ = 0;
+  std::string fault_message_;
+  bool realtime_granted_ = false;
+
+  core::SampleRing<FingertipSample, 1024> ring_;
+  std::atomic<bool> running_{false}, stop_{false}, estop_{false};
+  std::atomic<std::uint64_t> cycle_{0};
+  std::atomic<std::uint32_t> faults_{0};
+  std::thread thread_, monitor_thread_;
+};
+
+}  // namespace spidar::device

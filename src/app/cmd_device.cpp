@@ -1,0 +1,88 @@
+// spidar-mr device-test: run the servo loop on a device with zero desired force and report
+// loop statistics as JSON.
+#include <csignal>
+#include <iostream>
+#include <memory>
+
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "device_backends.hpp"
+#include "spidar/device/servo_loop.hpp"
+
+namespace spidar::app {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+void on_signal(int) { g_interrupted.store(true); }
+
+}  // namespace
+
+Action add_device_test(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "device-test", "Run the servo loop with zero force and print loop statistics (JSON)");
+  auto a = std::make_shared<BackendArgs>();
+  auto seconds = std::make_shared<double>(3.0);
+  auto rate = std::make_shared<double>(1000.0);
+  add_backend_options(*cmd, *a);
+  cmd->add_option("--seconds", *seconds, "how long to run [s]")->capture_default_str();
+  cmd->add_option("--rate", *rate, "servo rate [Hz]")->capture_default_str();
+  return [a, seconds, rate] {
+    if (!(*seconds > 0 && *seconds <= 3600)) throw UsageError("--seconds: expected (0, 3600]");
+    if (!(*rate >= 10 && *rate <= 20000)) throw UsageError("--rate: expected 10 to 20000 Hz");
+    const auto cfg = strings::load_device_config(resolve_data_path(a->config));
+    auto dev = make_backend(*a, cfg);
+    if (auto st = dev->open(); !st.ok()) throw UsageError(st.error().message);
+
+    device::ServoConfig servo;
+    servo.rate_hz = *rate;
+    servo.max_seconds = *seconds;
+    device::ServoLoop loop(*dev, cfg, servo, std::make_shared<device::ZeroForce>());
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    if (auto st = loop.start(); !st.ok()) throw UsageError(st.error().message);
+    while (loop.running() && !g_interrupted.load()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    loop.stop();
+    dev->close();
+
+    const auto s = loop.stats();
+    nlohmann::json faults = nlohmann::json::array();
+    if (s.faults) {
+      std::string names = device::fault_names(s.faults);
+      for (std::size_t pos = 0; pos != std::string::npos;) {
+        const auto comma = names.find(',', pos);
+        faults.push_back(names.substr(pos, comma == std::string::npos ? comma : comma - pos));
+        pos = comma == std::string::npos ? comma : comma + 1;
+      }
+    }
+    nlohmann::json fingers = nlohmann::json::array();
+    device::FingertipSample last;
+    if (loop.newest_samples(&last, 1) == 1) {
+      for (int f = 0; f < last.finger_count; ++f) {
+        fingers.push_back({{"finger", f},
+                           {"name", cfg.fingers[f].name},
+                           {"position", {last.p_W[f][0], last.p_W[f][1], last.p_W[f][2]}},
+                           {"consistent", ((last.consistent >> f) & 1u) != 0}});
+      }
+    }
+    nlohmann::json j = {{"device", dev->info().name},
+                        {"rate_target_hz", *rate},
+                        {"rate_hz", s.rate_hz},
+                        {"cycles", s.cycles},
+                        {"seconds", s.seconds},
+                        {"jitter_p50_us", s.jitter_p50_us},
+                        {"jitter_p99_us", s.jitter_p99_us},
+                        {"jitter_max_us", s.jitter_max_us},
+                        {"overruns", s.overruns},
+                        {"cycle_us_median", s.cycle_us_median},
+                        {"cycle_us_p99", s.cycle_us_p99},
+                        {"realtime_scheduling", s.realtime_scheduling},
+                        {"inconsistent_solves", s.inconsistent},
+                        {"faults", faults},
+                        {"fault_message", s.fault_message},
+                        {"fingertips", fingers}};
+    std::cout << j.dump(2) << "\n";
+    return s.faults ? 1 : 0;
+  };
+}
+
+}  // namespace spidar::app

@@ -1,0 +1,38 @@
+#include "device_backends.hpp"
+
+#include "cli_support.hpp"
+#include "spidar/device/simulated_spidar.hpp"
+
+namespace spidar::app {
+
+void add_backend_options(CLI::App& cmd, BackendArgs& a) {
+  cmd.add_option("--config", a.config, "device config (YAML)")->capture_default_str();
+  cmd.add_option("--backend", a.backend, "sim | serial")
+      ->check(CLI::IsMember({"sim", "serial"}))
+      ->capture_default_str();
+  cmd.add_option("--port", a.port, "serial: device path, e.g. /dev/ttyACM0");
+  cmd.add_option("--baud", a.baud, "serial: baud rate")->capture_default_str();
+  cmd.add_option("--seed", a.seed, "sim: random seed")->capture_default_str();
+}
+
+std::unique_ptr<device::Device> make_simulated(const strings::DeviceConfig& cfg, std::uint64_t seed) {
+  std::vector<Vec3> rest;
+  for (const auto& f : cfg.fingers) {
+    Vec3 mean = Vec3::Zero();
+    for (int i = 0; i < f.geometry.n; ++i) mean += f.geometry.p_WA[i];
+    rest.push_back(cfg.p_W_centre + 0.15 * (mean / f.geometry.n - cfg.p_W_centre));
+  }
+  device::SimulatedSpidarParams params;
+  params.seed = seed;
+  params.scale_error = 0.0;
+  auto source = std::make_shared<device::ScriptedFingertips>(device::hovering_hands(rest));
+  return std::make_unique<device::SimulatedSpidar>(cfg, params, source);
+}
+
+std::unique_ptr<device::Device> make_backend(const BackendArgs& a, const strings::DeviceConfig& cfg) {
+  if (a.backend == "sim") return make_simulated(cfg, a.seed);
+  if (a.port.empty()) throw UsageError("--backend serial needs --port PATH (e.g. /dev/ttyACM0)");
+  throw UsageError("--backend serial: not available in this build yet");
+}
+
+}  // namespace spidar::app

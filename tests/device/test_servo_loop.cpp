@@ -1,0 +1,284 @@
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <new>
+#include <random>
+#include <thread>
+
+#include "device_test_support.hpp"
+#include "spidar/core/clock.hpp"
+#include "spidar/device/servo_loop.hpp"
+
+// Counts heap allocations made by the servo thread while counting is on.
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_servo_allocations{0};
+thread_local bool t_is_servo = false;
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (t_is_servo && g_counting.load(std::memory_order_relaxed)) g_servo_allocations.fetch_add(1);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace spidar::device {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::spidar8;
+
+struct Rig {
+  explicit Rig(SimulatedSpidarParams params = {}) : sim(spidar8(), params, testing::hovering(spidar8())), rec(sim) {
+    EXPECT_TRUE(sim.open().ok());
+  }
+  SimulatedSpidar sim;
+  testing::RecordingDevice rec;
+};
+
+void wait_for_cycles(const ServoLoop& loop, std::uint64_t n) {
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (loop.cycles() < n && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(1ms);
+}
+
+TEST(ServoLoop, RunsAndKeepsOrderedStatistics) {
+  Rig rig;
+  ServoConfig cfg;
+  cfg.rate_hz = 1000;
+  cfg.max_seconds = 0.4;
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  loop.wait();
+  const auto s = loop.stats();
+  EXPECT_EQ(s.faults, 0u) << fault_names(s.faults) << " " << s.fault_message;
+  EXPECT_GT(s.cycles, 100u);
+  EXPECT_LE(s.cycles, 402u);
+  EXPECT_EQ(static_cast<std::uint64_t>(rig.rec.writes()), s.cycles);
+  EXPECT_GT(s.rate_hz, 0.0);
+  EXPECT_LE(s.jitter_p50_us, s.jitter_p99_us);
+  EXPECT_LE(s.jitter_p99_us, s.jitter_max_us + 1.0);
+  EXPECT_LE(s.cycle_us_median, s.cycle_us_p99);
+  EXPECT_LE(s.cycle_us_p99, s.cycle_us_max + 1.0);
+  EXPECT_GT(s.cycle_us_max, 0.0);
+
+  // The ring holds the newest samples, newest first, in cycle and time order.
+  FingertipSample samples[64];
+  const std::size_t n = loop.newest_samples(samples, 64);
+  ASSERT_EQ(n, 64u);
+  for (std::size_t k = 1; k < n; ++k) {
+    EXPECT_EQ(samples[k - 1].cycle, samples[k].cycle + 1);
+    EXPECT_GT(samples[k - 1].t_ns, samples[k].t_ns);
+  }
+  EXPECT_EQ(samples[0].cycle + 1, s.cycles);
+  EXPECT_EQ(samples[0].finger_count, 8);
+  EXPECT_EQ(samples[0].consistent, 0xFFu);
+  // Zero desired force: every motor at its minimum command.
+  EXPECT_EQ(rig.rec.min_command(), rig.sim.info().command_min);
+  EXPECT_EQ(rig.rec.max_command(), rig.sim.info().command_min);
+}
+
+TEST(ServoLoop, PositionsTrackTheSimulatedFingertips) {
+  SimulatedSpidarParams params;
+  params.fixed_step_s = 1e-3;
+  Rig rig(params);
+  ServoConfig cfg;
+  cfg.max_seconds = 0.2;
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  loop.wait();
+  FingertipSample s;
+  ASSERT_EQ(loop.newest_samples(&s, 1), 1u);
+  const auto truth = rig.sim.truth();
+  for (int f = 0; f < 8; ++f) {
+    const Vec3 p(s.p_W[f][0], s.p_W[f][1], s.p_W[f][2]);
+    EXPECT_LT((p - truth.p_W_fingertip[f]).norm(), 3e-4) << f;
+  }
+}
+
+TEST(ServoLoop, CycleBodyDoesNotAllocate) {
+  Rig rig;
+  ServoConfig cfg;
+  cfg.rate_hz = 2000;
+  cfg.on_thread_start = [] { t_is_servo = true; };
+  // A force source that asks for real forces, so tensions and commands vary.
+  struct Pushing final : ForceSource {
+    void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
+      out.t_ns = in.t_ns;
+      for (int f = 0; f < 8; ++f) out.set_force(f, Vec3(1.0 + 0.1 * f, -2.0, 3.0 * static_cast<double>(in.cycle % 7) / 7.0));
+    }
+  };
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<Pushing>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 50);
+  g_servo_allocations = 0;
+  g_counting = true;
+  const auto start = loop.cycles();
+  wait_for_cycles(loop, start + 1000);
+  g_counting = false;
+  loop.stop();
+  EXPECT_GE(loop.cycles(), start + 1000);
+  EXPECT_EQ(g_servo_allocations.load(), 0);
+  EXPECT_GT(rig.rec.max_command(), rig.sim.info().command_min);  // forces were displayed
+}
+
+TEST(ServoLoop, CommandsNeverLeaveTheMotorLimitsWhateverTheForces) {
+  Rig rig;
+  ServoConfig cfg;
+  cfg.rate_hz = 2000;
+  struct Wild final : ForceSource {
+    std::mt19937_64 rng{3};
+    void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
+      std::uniform_real_distribution<double> u(-1e6, 1e6);
+      out.t_ns = in.t_ns;
+      for (int f = 0; f < 8; ++f) {
+        Vec3 v(u(rng), u(rng), u(rng));
+        if (in.cycle % 11 == 0) v.x() = std::numeric_limits<double>::quiet_NaN();
+        if (in.cycle % 13 == 0) v.y() = std::numeric_limits<double>::infinity();
+        out.set_force(f, v * (in.cycle % 3 == 0 ? 1e-6 : 1.0));
+      }
+    }
+  };
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<Wild>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 1500);
+  loop.stop();
+  EXPECT_GE(rig.rec.min_command(), rig.sim.info().command_min);
+  EXPECT_LE(rig.rec.max_command(), rig.sim.info().command_max);
+  EXPECT_EQ(rig.rec.max_command(), rig.sim.info().command_max);  // saturated, not wrapped
+  EXPECT_EQ(loop.faults(), 0u) << fault_names(loop.faults());
+}
+
+TEST(ServoLoop, StalledForceProducerTripsTheSafeStateWithinOneCycle) {
+  Rig rig;
+  ServoConfig cfg;
+  cfg.rate_hz = 1000;
+  cfg.force_timeout_s = 0.005;
+  struct Stalling final : ForceSource {
+    std::int64_t frozen = 0;
+    void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
+      if (in.cycle < 100) frozen = in.t_ns;
+      out.t_ns = frozen;  // stops updating after cycle 100
+      for (int f = 0; f < 8; ++f) out.set_force(f, Vec3(0, 0, 2.0));
+    }
+  };
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<Stalling>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 200);
+  loop.stop();
+  EXPECT_TRUE(loop.faults() & kFaultForceStall);
+  FingertipSample samples[1024];
+  const std::size_t n = loop.newest_samples(samples, 1024);
+  // Find the first cycle that saw the fault: its forces are already zero (commands at minimum).
+  std::uint64_t first_fault = UINT64_MAX;
+  for (std::size_t k = 0; k < n; ++k)
+    if (samples[k].faults & kFaultForceStall) first_fault = std::min(first_fault, samples[k].cycle);
+  ASSERT_NE(first_fault, UINT64_MAX);
+  // Stale by 5 ms at 1 kHz: the fault latches within ~6 cycles of the stall.
+  EXPECT_LE(first_fault, 100u + 8u);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (samples[k].cycle >= first_fault) {
+      for (int f = 0; f < 8; ++f) EXPECT_EQ(samples[k].f_W[f][2], 0.0);
+    }
+  }
+  EXPECT_GE(rig.rec.safe_requests(), 1);
+}
+
+TEST(ServoLoop, MissedDeadlineTripsTheSafeState) {
+  Rig rig;
+  ServoConfig cfg;
+  cfg.rate_hz = 1000;
+  cfg.deadline_periods = 5;
+  struct Slow final : ForceSource {
+    void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
+      if (in.cycle == 50) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      out.t_ns = core::monotonic_ns();
+      for (int f = 0; f < 8; ++f) out.set_force(f, Vec3(0, 0, 1.0));
+    }
+  };
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<Slow>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 80);
+  loop.stop();
+  EXPECT_TRUE(loop.faults() & kFaultDeadlineMiss) << fault_names(loop.faults());
+  const auto s = loop.stats();
+  EXPECT_GE(s.overruns, 1u);
+  EXPECT_GE(s.jitter_max_us, 15000.0);
+  // Latched: cleared only on request.
+  loop.reset_faults();
+  EXPECT_FALSE(loop.faults() & kFaultDeadlineMiss);
+}
+
+TEST(ServoLoop, MonitorCatchesAServoThreadStuckInARead) {
+  SimulatedSpidarParams params;
+  params.hang_after_s = 0.1;
+  params.hang_duration_s = 0.2;
+  Rig rig(params);
+  ServoConfig cfg;
+  cfg.rate_hz = 1000;
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  std::this_thread::sleep_for(250ms);  // the read hangs from 0.1 s to 0.3 s
+  EXPECT_TRUE(loop.faults() & kFaultWatchdog) << fault_names(loop.faults());
+  EXPECT_GE(rig.rec.safe_requests(), 1);
+  loop.stop();
+}
+
+TEST(ServoLoop, DisconnectEndsTheLoopCleanlyWithTheFault) {
+  SimulatedSpidarParams params;
+  params.disconnect_after_s = 0.1;
+  Rig rig(params);
+  ServoLoop loop(rig.rec, spidar8(), ServoConfig{}, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  loop.wait();  // ends by itself
+  EXPECT_FALSE(loop.running());
+  const auto s = loop.stats();
+  EXPECT_TRUE(s.faults & kFaultDisconnected);
+  EXPECT_NE(s.fault_message.find("disconnected"), std::string::npos);
+  EXPECT_GE(rig.rec.safe_requests(), 1);
+  EXPECT_GT(s.cycles, 10u);
+}
+
+TEST(ServoLoop, EmergencyStopHoldsMinimumTensionUntilReset) {
+  Rig rig;
+  struct Pushing final : ForceSource {
+    void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
+      out.t_ns = in.t_ns;
+      for (int f = 0; f < 8; ++f) out.set_force(f, Vec3(0, 0, 3.0));
+    }
+  };
+  ServoLoop loop(rig.rec, spidar8(), ServoConfig{}, std::make_shared<Pushing>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 50);
+  loop.emergency_stop();
+  const auto at_stop = loop.cycles();
+  wait_for_cycles(loop, at_stop + 20);
+  FingertipSample s;
+  ASSERT_EQ(loop.newest_samples(&s, 1), 1u);
+  EXPECT_TRUE(s.faults & kFaultEmergencyStop);
+  for (int f = 0; f < 8; ++f) EXPECT_EQ(s.f_W[f][2], 0.0);
+  loop.reset_faults();
+  wait_for_cycles(loop, loop.cycles() + 20);
+  ASSERT_EQ(loop.newest_samples(&s, 1), 1u);
+  EXPECT_FALSE(s.faults & kFaultEmergencyStop);
+  loop.stop();
+}
+
+TEST(ServoLoop, BadSetupIsAnError) {
+  Rig rig;
+  ServoConfig bad;
+  bad.rate_hz = 0;
+  EXPECT_THROW(ServoLoop(rig.rec, spidar8(), bad, std::make_shared<ZeroForce>()), SpidarError);
+  EXPECT_THROW(ServoLoop(rig.rec, spidar8(), ServoConfig{}, nullptr), SpidarError);
+  rig.sim.close();
+  ServoLoop loop(rig.rec, spidar8(), ServoConfig{}, std::make_shared<ZeroForce>());
+  auto st = loop.start();
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("not open"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace spidar::device
