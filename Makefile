@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc)
 SPIDAR_MR := build/release/src/app/spidar-mr
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps build demo test test-asan bench install clean format
+.PHONY: all deps build demo test test-asan test-tsan bench install clean format
 
 all: build
 
@@ -25,6 +25,12 @@ test-asan: deps
 	cmake --preset asan >/dev/null
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan -j $(JOBS)
+
+# ThreadSanitizer build of the threaded tests (servo loop, lock-free hand-off).
+test-tsan: deps
+	cmake --preset tsan >/dev/null
+	cmake --build --preset tsan -j $(JOBS)
+	ctest --preset tsan -j $(JOBS)
 
 bench: build
 	scripts/run-benchmarks build/release/bench build/bench-results
