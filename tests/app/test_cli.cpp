@@ -128,3 +128,31 @@ TEST(Cli, DemoWritesItsReport) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Cli, DeviceTestOnTheSimulatedDeviceReportsLoopStatistics) {
+  auto r = run("device-test --backend sim --rate 2000 --seconds 0.5");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"rate_hz", "jitter_p50_us", "jitter_p99_us", "jitter_max_us", "overruns",
+                          "cycle_us_median", "faults", "fingertips"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_GT(j["cycles"].get<int>(), 100);
+  EXPECT_LE(j["jitter_p50_us"].get<double>(), j["jitter_p99_us"].get<double>());
+  EXPECT_TRUE(j["faults"].empty());
+  ASSERT_EQ(j["fingertips"].size(), 8u);
+  EXPECT_EQ(j["fingertips"][3]["name"], "left_ring");
+}
+
+TEST(Cli, DeviceTestRejectsBadOptions) {
+  EXPECT_EQ(run("device-test --backend usb").code, 2);
+  auto r = run("device-test --backend serial");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--port"), std::string::npos) << r.err;
+  EXPECT_EQ(run("device-test --rate 0").code, 2);
+  EXPECT_EQ(run("device-test --seconds -1").code, 2);
+}
+
+}  // namespace
