@@ -1,0 +1,114 @@
+#include <gtest/gtest.h>
+
+#include <mujoco/mujoco.h>
+
+#include "spidar/core/units.hpp"
+#include "spidar/physics/rubiks_cube.hpp"
+
+namespace spidar::physics {
+namespace {
+
+std::unique_ptr<World> cube_world() {
+  return World::Load(std::string(SPIDAR_SOURCE_DIR) + "/scenes/rubiks_cube.xml").value();
+}
+
+TEST(RubiksCube, StartsSolvedAndScrambleIsUndone) {
+  auto w = cube_world();
+  auto cube = RubiksCube::Attach(*w).value();
+  EXPECT_TRUE(cube.is_solved());
+  EXPECT_EQ(cube.facelets(), std::string(9, 'U') + std::string(9, 'R') + std::string(9, 'F') +
+                                 std::string(9, 'D') + std::string(9, 'L') + std::string(9, 'B'));
+  ASSERT_TRUE(cube.turn('R', 1).ok());
+  EXPECT_FALSE(cube.is_solved());
+  ASSERT_TRUE(cube.turn('R', 3).ok());  // R R' = identity
+  EXPECT_TRUE(cube.is_solved());
+  const std::string moves = cube.scramble(20, 7);
+  EXPECT_FALSE(cube.is_solved());
+  // Undo in reverse order.
+  std::vector<std::string> list;
+  for (std::size_t p = 0; p < moves.size();) {
+    auto e = moves.find(' ', p);
+    list.push_back(moves.substr(p, e == std::string::npos ? e : e - p));
+    p = e == std::string::npos ? moves.size() : e + 1;
+  }
+  for (auto it = list.rbegin(); it != list.rend(); ++it) {
+    const int q = it->size() == 1 ? 1 : (*it)[1] == '2' ? 2 : 3;
+    ASSERT_TRUE(cube.turn((*it)[0], 4 - q).ok());
+  }
+  EXPECT_TRUE(cube.is_solved());
+  // Every colour appears 9 times whatever the state.
+  const auto s = cube.facelets();
+  for (char c : std::string("URFDLB")) EXPECT_EQ(std::count(s.begin(), s.end(), c), 9);
+  EXPECT_FALSE(cube.turn('X', 1).ok());
+}
+
+TEST(RubiksCube, FourQuarterTurnsOfEveryFaceAreIdentity) {
+  auto w = cube_world();
+  auto cube = RubiksCube::Attach(*w).value();
+  for (char f : std::string("UDFBRL")) {
+    ASSERT_TRUE(cube.turn(f, 1).ok());
+    EXPECT_FALSE(cube.is_solved()) << f;
+    ASSERT_TRUE(cube.turn(f, 3).ok());
+    EXPECT_TRUE(cube.is_solved()) << f;
+  }
+}
+
+TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
+  auto w = cube_world();
+  auto cube = RubiksCube::Attach(*w).value();
+  const mjModel* m = w->model();
+  mjData* d = w->data();
+  std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
+  w->place_proxies(parked);
+  // Like two hands: push the top layer's cubelets around +z, hold the two lower layers back,
+  // until the layer is past the detent's midpoint (55°); then let go.
+  std::vector<int> top, rest;
+  for (int b = 0; b < m->nbody; ++b) {
+    const char* n = mj_id2name(m, mjOBJ_BODY, b);
+    const std::string name = n ? n : "";
+    if (name.rfind("cubelet_", 0) != 0) continue;
+    (name.back() == '2' ? top : rest).push_back(b);
+  }
+  const int core = w->body_id("cube");
+  bool pushing = true;
+  double peak = 0;
+  for (int k = 0; k < 2000; ++k) {
+    if (cube.face_angle('U') > units::deg_to_rad(55)) pushing = false;
+    const Vec3 c = w->body_pose(core).p;
+    auto push = [&](int b, double f) {
+      Vec3 r(d->xpos[3 * b] - c.x(), d->xpos[3 * b + 1] - c.y(), 0);
+      const Vec3 t = r.norm() > 1e-4 ? Vec3(Vec3::UnitZ().cross(r) / r.norm()) : Vec3::Zero();
+      for (int i = 0; i < 3; ++i) d->xfrc_applied[6 * b + i] = pushing ? f * t[i] : 0.0;
+    };
+    for (int b : top) push(b, 0.05);
+    for (int b : rest)
+      if (std::string(mj_id2name(m, mjOBJ_BODY, b)).back() == '0') push(b, -0.05);
+    w->step(parked, v);
+    peak = std::max(peak, cube.face_angle('U'));
+  }
+  // The top layer went past the midpoint and clicked into the next quarter turn; the bottom,
+  // held back by the other hand, clicked into place too (relative to the middle slice).
+  EXPECT_GT(peak, units::deg_to_rad(55));
+  EXPECT_NEAR(cube.face_angle('U'), units::kPi / 2, units::deg_to_rad(2));
+  EXPECT_LT(std::abs(cube.face_misalignment('U')), units::deg_to_rad(2));
+  EXPECT_LT(std::abs(cube.face_misalignment('D')), units::deg_to_rad(2));
+  // The logical state is exactly those quarter turns applied to a solved cube.
+  auto w2 = cube_world();
+  auto reference = RubiksCube::Attach(*w2).value();
+  const int qu = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+  const int qd = static_cast<int>(std::lround(cube.face_angle('D') / (units::kPi / 2)));
+  ASSERT_TRUE(reference.turn('U', ((qu % 4) + 4) % 4).ok());
+  ASSERT_TRUE(reference.turn('D', ((qd % 4) + 4) % 4).ok());
+  EXPECT_EQ(cube.facelets(), reference.facelets());
+  EXPECT_FALSE(cube.is_solved());
+}
+
+TEST(RubiksCube, SceneWithoutACubeIsAClearError) {
+  auto w = World::Load(std::string(SPIDAR_SOURCE_DIR) + "/scenes/blocks.xml").value();
+  auto r = RubiksCube::Attach(*w);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("no body named 'cube'"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace spidar::physics
