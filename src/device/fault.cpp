@@ -14,7 +14,7 @@ std::string fault_names(std::uint32_t faults) {
   std::string out;
   for (const auto& [bit, name] : kNames) {
     if (!(faults & bit)) continue;
-    if (!out.empty()) out += ',';
+    if (!out.empty()) out += ',';  // `+=`, not `"," + std::string`: GCC 12 -Wrestrict false positive
     out += name;
   }
   return out.empty() ? "none" : out;

@@ -1,0 +1,82 @@
+#pragma once
+/// A POSIX termios serial port in raw mode (8 data bits, no parity, one stop bit, no flow
+/// control, no line editing), and pseudo-terminal pairs for running the serial path without
+/// hardware. Reads wait with poll() and a timeout; writes write everything or fail.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "spidar/core/result.hpp"
+
+namespace spidar::device {
+
+/// Outcome of one read or write on a file descriptor.
+enum class IoStatus {
+  kOk,       ///< bytes moved
+  kTimeout,  ///< nothing happened within the timeout
+  kClosed,   ///< the other side is gone: EOF, EIO, hang-up
+  kError,    ///< any other failure; see error_number
+};
+
+struct IoResult {
+  IoStatus status = IoStatus::kOk;
+  std::size_t bytes = 0;  ///< bytes read or written
+  int error_number = 0;   ///< errno for kError (and for kClosed when it came from errno)
+};
+
+/// Waits up to `timeout_s` [s] for input on `fd`, then reads what is available (at most
+/// out.size() bytes). Never allocates.
+IoResult read_some(int fd, std::span<std::uint8_t> out, double timeout_s);
+/// Writes all of `data` to `fd`, waiting up to `timeout_s` [s] in total for room. Never allocates.
+IoResult write_all(int fd, std::span<const std::uint8_t> data, double timeout_s);
+
+/// The termios speed for a baud rate, or 0 if the rate is not one of the standard Linux rates
+/// (9600 … 4000000).
+unsigned baud_to_speed(int baud);
+/// Puts an open tty in raw mode at `baud` (0 keeps the current speed). Errors name `what`.
+Status make_raw(int fd, int baud, const std::string& what);
+
+/// An open serial port. Move-only; closes on destruction.
+class SerialPort {
+ public:
+  SerialPort() = default;
+  ~SerialPort();
+  SerialPort(SerialPort&& other) noexcept;
+  SerialPort& operator=(SerialPort&& other) noexcept;
+  SerialPort(const SerialPort&) = delete;
+  SerialPort& operator=(const SerialPort&) = delete;
+
+  /// Opens `path` (any tty: /dev/ttyACM0, /dev/ttyUSB0, a pty slave) in raw mode at `baud`,
+  /// non-blocking, without making it the controlling terminal, and discards stale input.
+  /// Errors name the path and the errno text; an unsupported baud rate is an error.
+  static Result<SerialPort> open(const std::string& path, int baud);
+
+  IoResult read_some(std::span<std::uint8_t> out, double timeout_s) {
+    return device::read_some(fd_, out, timeout_s);
+  }
+  IoResult write_all(std::span<const std::uint8_t> data, double timeout_s) {
+    return device::write_all(fd_, data, timeout_s);
+  }
+  void close();
+  bool is_open() const { return fd_ >= 0; }
+  int fd() const { return fd_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  int fd_ = -1;
+  std::string path_;
+};
+
+/// A pseudo-terminal pair: the master side (for the device emulator) and the path of the slave
+/// side (what a host opens as its serial port).
+struct PtyPair {
+  int master_fd = -1;      ///< owned by the caller: close() it when done
+  std::string slave_path;  ///< e.g. /dev/pts/3
+};
+
+/// Creates a pty pair with posix_openpt/grantpt/unlockpt, raw mode, master non-blocking.
+/// While no process has the slave open, poll() on the master reports hang-up.
+Result<PtyPair> open_pty();
+
+}  // namespace spidar::device
