@@ -33,7 +33,7 @@ class TemplateDevice final : public Device {
 
   void close() override {
     request_safe_state();
-    apply_commands();
+    (void)apply_commands();  // closing: nothing more to report
     open_ = false;
   }
 
