@@ -1,6 +1,7 @@
 #include "device_backends.hpp"
 
 #include "cli_support.hpp"
+#include "spidar/device/serial_device.hpp"
 #include "spidar/device/simulated_spidar.hpp"
 
 namespace spidar::app {
@@ -32,7 +33,14 @@ std::unique_ptr<device::Device> make_simulated(const strings::DeviceConfig& cfg,
 std::unique_ptr<device::Device> make_backend(const BackendArgs& a, const strings::DeviceConfig& cfg) {
   if (a.backend == "sim") return make_simulated(cfg, a.seed);
   if (a.port.empty()) throw UsageError("--backend serial needs --port PATH (e.g. /dev/ttyACM0)");
-  throw UsageError("--backend serial: not available in this build yet");
+  device::SerialDeviceConfig sc;
+  sc.port = a.port;
+  sc.baud = a.baud;
+  sc.string_count = cfg.string_count();
+  sc.counter_bits = cfg.counter_bits;
+  sc.command_min = cfg.command_range().min;
+  sc.command_max = cfg.command_range().max;
+  return std::make_unique<device::SerialDevice>(sc);
 }
 
 }  // namespace spidar::app

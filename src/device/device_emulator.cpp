@@ -4,7 +4,7 @@
 #include <chrono>
 #include <thread>
 
-#include "monotonic.hpp"
+#include "spidar/core/clock.hpp"
 #include "spidar/device/serial_port.hpp"
 #include "spidar/strings/encoder.hpp"
 
@@ -14,7 +14,7 @@ DeviceEmulator::DeviceEmulator(Device& backend, int fd, DeviceEmulatorOptions op
     : backend_(backend),
       fd_(fd),
       options_(options),
-      start_ns_(monotonic_ns()),
+      start_ns_(core::monotonic_ns()),
       limit_min_(backend.info().command_min),
       limit_max_(backend.info().command_max) {}
 
@@ -126,7 +126,7 @@ void DeviceEmulator::handle(const protocol::Frame& f, std::int64_t now_ns) {
 }
 
 Status DeviceEmulator::poll_once(double timeout_s) {
-  std::int64_t now = monotonic_ns();
+  std::int64_t now = core::monotonic_ns();
   double wait = timeout_s;
   if (armed_ && !tripped_.load(std::memory_order_relaxed)) {
     const double due =
@@ -135,7 +135,7 @@ Status DeviceEmulator::poll_once(double timeout_s) {
   }
   std::array<std::uint8_t, 512> buf{};
   const IoResult r = read_some(fd_, buf, wait);
-  now = monotonic_ns();
+  now = core::monotonic_ns();
   Status status = Ok{};
   if (r.status == IoStatus::kOk) {
     decoder_.feed({buf.data(), r.bytes}, [&](const protocol::Frame& f) { handle(f, now); });
@@ -151,14 +151,14 @@ Status DeviceEmulator::poll_once(double timeout_s) {
     msg += ")";
     status = Error{msg};
   }
-  check_watchdog(monotonic_ns());
+  check_watchdog(core::monotonic_ns());
   publish_counters();
   return status;
 }
 
 void DeviceEmulator::run(const std::atomic<bool>& stop) {
   while (!stop.load(std::memory_order_acquire)) {
-    if (!poll_once(0.01)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (!poll_once(0.01)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 }
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <utility>
 
-#include "monotonic.hpp"
+#include "spidar/core/clock.hpp"
 
 namespace spidar::device {
 namespace {
@@ -194,12 +194,12 @@ Status SerialDevice::read(EncoderReading& out) {
     outstanding_ = true;
   }
   const std::int64_t deadline =
-      monotonic_ns() + static_cast<std::int64_t>(config_.read_timeout_s * 1e9);
+      core::monotonic_ns() + static_cast<std::int64_t>(config_.read_timeout_s * 1e9);
   bool got = false;
   int bad_count = -1;
   protocol::Counts counts;
   for (;;) {
-    const double remaining = static_cast<double>(deadline - monotonic_ns()) * 1e-9;
+    const double remaining = static_cast<double>(deadline - core::monotonic_ns()) * 1e-9;
     const IoResult r = port_.read_some(rx_, remaining > 0.0 ? remaining : 0.0);
     if (r.status == IoStatus::kTimeout) {
       ++stats_.timeouts;
@@ -240,7 +240,7 @@ Status SerialDevice::read(EncoderReading& out) {
   }
   outstanding_ = false;
   ++stats_.counts_in;
-  out.host_time_ns = monotonic_ns();
+  out.host_time_ns = core::monotonic_ns();
   out.device_time_us = counts.device_time_us;
   out.status_flags = counts.status_flags;
   out.string_count = counts.count;

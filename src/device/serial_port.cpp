@@ -12,7 +12,7 @@
 #include <ctime>
 #include <utility>
 
-#include "monotonic.hpp"
+#include "spidar/core/clock.hpp"
 
 namespace spidar::device {
 namespace {
@@ -29,7 +29,7 @@ constexpr BaudEntry kBauds[] = {
     {3500000, B3500000}, {4000000, B4000000},
 };
 
-std::int64_t now_ns() { return monotonic_ns(); }
+std::int64_t now_ns() { return core::monotonic_ns(); }
 
 timespec to_timespec(std::int64_t ns) {
   if (ns < 0) ns = 0;

@@ -156,6 +156,7 @@ void ServoLoop::run() {
       jitter_max_us_ = std::max(jitter_max_us_, jitter_us);
     } else {
       first_wake_ns_ = wake;
+      first_timed_cycle_ = cycle_.load(std::memory_order_relaxed);
     }
     prev_wake = wake;
     last_wake_ns_ = wake;
@@ -182,7 +183,7 @@ void ServoLoop::run() {
     cycle_maths_.command(force_frame_, safe, sample_, commands_);
     // A cycle that ran far past its deadline (a stall in the read or the force source) must not
     // send the commands it computed from old data.
-    if (core::monotonic_ns() - deadline > late_limit) {
+    if (cycle_.load(std::memory_order_relaxed) > 0 && core::monotonic_ns() - deadline > late_limit) {
       device_.request_safe_state();
       latch(kFaultDeadlineMiss);
       std::fill(commands_.begin(), commands_.end(), device_.info().command_min);
@@ -196,6 +197,12 @@ void ServoLoop::run() {
     ring_.push(sample_);
 
     const std::int64_t end = core::monotonic_ns();
+    if (prev_wake == wake && cycle_.load(std::memory_order_relaxed) == 0) {
+      // The first cycle is untimed: a freshly opened device may answer its first read late
+      // (handshake). Deadlines and statistics start from here.
+      deadline = end;
+      prev_wake = 0;
+    }
     const double compute_us = static_cast<double>(end - wake) * 1e-3;
     add_to_hist(compute_hist_, compute_us);
     compute_max_us_ = std::max(compute_max_us_, compute_us);
@@ -218,7 +225,8 @@ ServoStats ServoLoop::stats() const {
   s.faults = faults_.load(std::memory_order_acquire);
   if (running_.load(std::memory_order_acquire)) return s;  // histograms belong to the servo thread
   s.seconds = core::ns_to_s(last_wake_ns_ - first_wake_ns_);
-  s.rate_hz = s.seconds > 0 ? static_cast<double>(s.cycles > 0 ? s.cycles - 1 : 0) / s.seconds : 0;
+  const std::uint64_t periods = s.cycles > first_timed_cycle_ + 1 ? s.cycles - 1 - first_timed_cycle_ : 0;
+  s.rate_hz = s.seconds > 0 ? static_cast<double>(periods) / s.seconds : 0;
   s.jitter_p50_us = percentile(jitter_hist_, 0.5);
   s.jitter_p99_us = percentile(jitter_hist_, 0.99);
   s.jitter_max_us = jitter_max_us_;

@@ -20,9 +20,8 @@ SimulatedSpidar::SimulatedSpidar(const strings::DeviceConfig& config, SimulatedS
                       " strings; at most " + std::to_string(kMaxDeviceStrings) + " supported");
   }
   info_.counter_bits = config.counter_bits;
-  const auto lim = config.effective_limits();
-  info_.command_min = strings::tension_to_command(config.motor, lim.t_min).dac;
-  info_.command_max = strings::tension_to_command(config.motor, lim.t_max).dac;
+  info_.command_min = config.command_range().min;
+  info_.command_max = config.command_range().max;
   std::normal_distribution<double> scale(0.0, params.scale_error);
   const int nf = static_cast<int>(config.fingers.size());
   for (int f = 0; f < nf; ++f) {

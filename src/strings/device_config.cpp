@@ -67,6 +67,11 @@ TensionLimits DeviceConfig::effective_limits() const {
           std::min(tension.t_max, max_drive_tension(motor))};
 }
 
+DeviceConfig::CommandRange DeviceConfig::command_range() const {
+  const auto lim = effective_limits();
+  return {tension_to_command(motor, lim.t_min).dac, tension_to_command(motor, lim.t_max).dac};
+}
+
 DeviceConfig parse_device_config(const core::ConfigNode& root) {
   root.expect_keys({"name", "frame_centre", "encoder", "motor", "tension", "fingers"});
   DeviceConfig dev;

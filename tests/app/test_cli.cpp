@@ -8,6 +8,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdlib>
+#include <thread>
+
 namespace {
 
 struct Run {
@@ -153,6 +157,39 @@ TEST(Cli, DeviceTestRejectsBadOptions) {
   EXPECT_NE(r.err.find("--port"), std::string::npos) << r.err;
   EXPECT_EQ(run("device-test --rate 0").code, 2);
   EXPECT_EQ(run("device-test --seconds -1").code, 2);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Cli, DeviceTestOverAPtyServedByEmulateDevice) {
+  // emulate-device prints its pty path first; device-test drives the serial backend through it.
+  const std::string out = ::testing::TempDir() + "spidar_emulator_" + std::to_string(getpid());
+  const std::string cmd = std::string(SPIDAR_MR) + " emulate-device --pty --seconds 6 >" + out +
+                          ".path 2>" + out + ".log &";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  std::string path;
+  for (int i = 0; i < 100 && path.empty(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (FILE* f = fopen((out + ".path").c_str(), "r")) {
+      std::array<char, 256> buf{};
+      if (fgets(buf.data(), buf.size(), f)) path = buf.data();
+      fclose(f);
+    }
+  }
+  while (!path.empty() && (path.back() == '\n' || path.back() == '\r')) path.pop_back();
+  ASSERT_EQ(path.rfind("/dev/pts/", 0), 0u) << path;
+  auto r = run("device-test --backend serial --port " + path + " --rate 1000 --seconds 1.5");
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["device"], "serial " + path);
+  EXPECT_GT(j["cycles"].get<int>(), 500);
+  // Transport faults never; a loaded CI machine may still cause a late cycle (deadline faults).
+  for (const auto& f : j["faults"]) {
+    EXPECT_TRUE(f == "deadline_miss" || f == "watchdog") << f << "\n" << r.out;
+  }
+  ASSERT_EQ(j["fingertips"].size(), 8u);
+  for (const auto& f : j["fingertips"]) EXPECT_TRUE(f["consistent"].get<bool>());
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ class DeviceEmulator {
   /// Waits up to `timeout_s` [s] for host bytes (less if the watchdog is due), handles every
   /// complete frame, then runs the watchdog. Errors: the host side hung up or the fd failed.
   Status poll_once(double timeout_s);
-  /// Calls poll_once until `stop` is set; after an error waits 10 ms and goes on (a host may
+  /// Calls poll_once until `stop` is set; after an error waits 1 ms and goes on (a host may
   /// reopen the port).
   void run(const std::atomic<bool>& stop);
 

@@ -108,6 +108,7 @@ class ServoLoop {
   std::vector<std::uint32_t> jitter_hist_, compute_hist_;
   double jitter_max_us_ = 0, compute_max_us_ = 0;
   std::int64_t first_wake_ns_ = 0, last_wake_ns_ = 0;
+  std::uint64_t first_timed_cycle_ = 0;  ///< the first cycle is untimed (device handshake)
   std::uint64_t overruns_ = 0;
   std::string fault_message_;
   bool realtime_granted_ = false;

@@ -32,6 +32,11 @@ struct DeviceConfig {
   int string_count() const;
   /// Limits the drive can actually deliver: [max(t_min, drive min), min(t_max, drive max)].
   TensionLimits effective_limits() const;
+  /// Motor commands [DAC counts] for the effective minimum and maximum tension.
+  struct CommandRange {
+    std::int32_t min = 0, max = 0;
+  };
+  CommandRange command_range() const;
 };
 
 /// Parses and validates a device config. Throws core::ConfigError naming file:line: key.
