@@ -12,6 +12,7 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "demo.hpp"
 #include "spidar/core/units.hpp"
 #include "spidar/strings/calibration.hpp"
 #include "spidar/strings/position.hpp"
@@ -21,14 +22,6 @@ namespace spidar::app {
 namespace {
 
 using namespace spidar::strings;
-
-struct DemoArgs {
-  std::string config = "configs/spidar8.yaml";
-  std::string out = "out/demo";
-  double seconds = 3.0;
-  double rate_hz = 1000.0;
-  std::uint64_t seed = 1;
-};
 
 /// A virtual box felt through a penalty spring (the grasped object until physics lands).
 struct VirtualBox {
@@ -123,10 +116,14 @@ double workspace_error_rms(const DeviceConfig& cfg, const SimulatedStrings& dev,
   return std::sqrt(sum2 / n);
 }
 
-int run_demo(const DemoArgs& a) {
+}  // namespace
+
+int run_strings_demo(const DemoOptions& a) {
+  using namespace spidar::strings;
+  const double seconds = seconds > 0 ? seconds : 3.0;
   namespace fs = std::filesystem;
   const auto cfg = load_device_config(resolve_data_path(a.config));
-  if (!(a.seconds > 0 && a.seconds <= 600)) throw UsageError("--seconds: expected (0, 600]");
+  if (!(seconds > 0 && seconds <= 600)) throw UsageError("--seconds: expected (0, 600]");
   if (!(a.rate_hz >= 10 && a.rate_hz <= 20000)) throw UsageError("--rate: expected 10..20000 Hz");
   fs::create_directories(a.out);
   std::mt19937_64 rng(a.seed);
@@ -208,7 +205,7 @@ int run_demo(const DemoArgs& a) {
   nlohmann::json cones = nlohmann::json::array();
   for (int f = 0; f < nf; ++f) {
     const auto& g = cfg.fingers[f].geometry;
-    const Vec3 p = scripted_fingertip(f, 0.32 * a.seconds, a.seconds);  // just grasped
+    const Vec3 p = scripted_fingertip(f, 0.32 * seconds, seconds);  // just grasped
     const auto U = string_directions(g, p).value();
     int ok = 0;
     const int m = 2000;
@@ -236,7 +233,7 @@ int run_demo(const DemoArgs& a) {
 
   // 5. The scripted grasp at the servo rate.
   const double dt = 1.0 / a.rate_hz;
-  const int steps = static_cast<int>(std::lround(a.seconds * a.rate_hz));
+  const int steps = static_cast<int>(std::lround(seconds * a.rate_hz));
   const int print_every = std::max(1, steps / 12);
   std::ofstream csv(fs::path(a.out) / "walkthrough.csv");
   csv << "t,finger,x_true,y_true,z_true,x_est,y_est,z_est,err_mm,fx_des,fy_des,fz_des,"
@@ -245,7 +242,7 @@ int run_demo(const DemoArgs& a) {
   std::vector<int> contact(nf, 0);
   std::vector<double> fidelity_sum(nf, 0.0);
   double pos_ns = 0, ten_ns = 0;
-  std::cout << "\nscripted grasp, " << a.seconds << " s at " << a.rate_hz
+  std::cout << "\nscripted grasp, " << seconds << " s at " << a.rate_hz
             << " Hz (left index and right thumb shown; all fingers in walkthrough.csv):\n"
             << "     t  finger        position est [m]          err[mm]  desired F [N]"
                "            displayed F [N]          tensions [N]\n";
@@ -253,7 +250,7 @@ int run_demo(const DemoArgs& a) {
     const double t = k * dt;
     for (int f = 0; f < nf; ++f) {
       const auto& fc = cfg.fingers[f];
-      const Vec3 p_true = scripted_fingertip(f, t, a.seconds);
+      const Vec3 p_true = scripted_fingertip(f, t, seconds);
       const auto raw = dev.read_raw(fc.geometry, f, p_true, rng);
       StringVec l(fc.geometry.n);
       for (int i = 0; i < fc.geometry.n; ++i)
@@ -330,7 +327,7 @@ int run_demo(const DemoArgs& a) {
             << " ns (make bench gives the careful figures)\n";
   nlohmann::json report = {
       {"config", cfg.source},
-      {"seconds", a.seconds},
+      {"seconds", seconds},
       {"rate_hz", a.rate_hz},
       {"seed", a.seed},
       {"calibration",
@@ -344,19 +341,6 @@ int run_demo(const DemoArgs& a) {
   std::cout << "wrote " << (fs::path(a.out) / "walkthrough.csv").string() << " and "
             << (fs::path(a.out) / "report.json").string() << "\n";
   return 0;
-}
-
-}  // namespace
-
-Action add_demo(CLI::App& app) {
-  auto* cmd = app.add_subcommand("demo", "Walk through the SPIDAR-8 device maths on a scripted grasp");
-  auto a = std::make_shared<DemoArgs>();
-  cmd->add_option("--config", a->config, "device config (YAML)")->capture_default_str();
-  cmd->add_option("--out", a->out, "output directory")->capture_default_str();
-  cmd->add_option("--seconds", a->seconds, "scripted session length [s]")->capture_default_str();
-  cmd->add_option("--rate", a->rate_hz, "servo rate [Hz]")->capture_default_str();
-  cmd->add_option("--seed", a->seed, "random seed")->capture_default_str();
-  return [a] { return run_demo(*a); };
 }
 
 }  // namespace spidar::app

@@ -113,7 +113,7 @@ TEST(Cli, BadArgumentsExitWithCode2AndSayWhat) {
 
 TEST(Cli, DemoWritesItsReport) {
   const std::string dir = ::testing::TempDir() + "spidar_demo_test_" + std::to_string(getpid());
-  auto r = run("demo --seconds 0.3 --out " + dir);
+  auto r = run("demo --scenario strings --seconds 0.3 --out " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("calibration"), std::string::npos);
   FILE* f = fopen((dir + "/report.json").c_str(), "r");
