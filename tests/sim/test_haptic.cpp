@@ -8,6 +8,7 @@
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
 #include "spidar/sim/scripted_grasp.hpp"
+#include "spidar/strings/tension.hpp"
 
 namespace spidar::sim {
 namespace {
@@ -119,6 +120,34 @@ SweepResult press(double stiffness, bool control) {
   r.min_energy = port.stats().min_energy;
   r.ripple = r.finite ? fmax - fmin : 1e9;
   return r;
+}
+
+TEST(Haptic, PressingAFixedBlockDisplaysTheCouplingForceWithinTensionLimits) {
+  // The right middle finger (its unit pulls toward the back-top corner, so it can push a
+  // fingertip up) presses 6 mm into the fixed block; the servo side renders k·depth upward and
+  // the strings display it within their limits.
+  const auto cfg = strings::load_device_config(source("configs/spidar8.yaml"));
+  physics::WorldParams wp;
+  wp.proxy.count = 1;
+  auto w = physics::World::Load(source("scenes/blocks.xml"), wp).value();
+  const Vec3 top(0.12, 0.08, 0.01);
+  std::vector<Vec3> p{top + Vec3(0, 0, 0.02)}, v{Vec3::Zero()};
+  w->place_proxies(p);
+  p[0] = top + Vec3(0, 0, wp.proxy.radius - 0.006);
+  for (int k = 0; k < 500; ++k) w->step(p, v);
+  physics::ProxyState ps = w->proxies()[0];
+  const Vec3 f_user = -physics::coupling_force(wp.coupling, p[0], Vec3::Zero(),
+                                               physics::local_proxy_position(ps, 0.0), ps.v_W);
+  EXPECT_NEAR(f_user.z(), wp.coupling.stiffness * 0.006, 0.3);
+  const auto& finger = cfg.fingers[6];  // right_middle
+  const auto lim = cfg.effective_limits();
+  const auto sol = strings::solve_tensions(finger.geometry, p[0], f_user, lim).value();
+  for (int i = 0; i < sol.t.size(); ++i) {
+    EXPECT_GE(sol.t[i], lim.t_min);
+    EXPECT_LE(sol.t[i], lim.t_max);
+  }
+  // The displayed force is the nearest the strings can show: pushing up along the desired force.
+  EXPECT_GT(sol.f_displayed.dot(f_user.normalized()), 0.0);
 }
 
 TEST(Haptic, DISABLED_PrintSweep) {
