@@ -120,7 +120,7 @@ double workspace_error_rms(const DeviceConfig& cfg, const SimulatedStrings& dev,
 
 int run_strings_demo(const DemoOptions& a) {
   using namespace spidar::strings;
-  const double seconds = seconds > 0 ? seconds : 3.0;
+  const double seconds = a.seconds > 0 ? a.seconds : 3.0;
   namespace fs = std::filesystem;
   const auto cfg = load_device_config(resolve_data_path(a.config));
   if (!(seconds > 0 && seconds <= 600)) throw UsageError("--seconds: expected (0, 600]");
