@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <limits>
 
 #include "spidar/strings/position.hpp"
@@ -26,7 +28,11 @@ void round_trip(const DeviceConfig& cfg, int points_per_finger, double half) {
       ASSERT_LT((est->p_WF - p).norm(), 1e-9) << f.name << " at " << p.transpose();
     }
   }
-  ::testing::Test::RecordProperty("worst_error_m", std::to_string(worst));
+  {
+    std::ostringstream os;
+    os << std::scientific << worst;
+    ::testing::Test::RecordProperty("worst_error_m", os.str());
+  }
 }
 
 TEST(Position, ClosedFormRoundTripSpidar8) { round_trip(testing::spidar8(), 2000, 0.2); }

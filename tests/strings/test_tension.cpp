@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "reference_tension.hpp"
 #include "spidar/strings/tension.hpp"
 #include "test_support.hpp"
@@ -57,7 +59,11 @@ void compare_with_brute_force(const DeviceConfig& cfg, int problems_per_finger,
   // The random problems must exercise both reachable and unreachable forces.
   EXPECT_GT(reachable, total / 20);
   EXPECT_LT(reachable, total - total / 20);
-  ::testing::Test::RecordProperty("worst_relative_difference", std::to_string(worst_rel));
+  {
+    std::ostringstream os;
+    os << std::scientific << worst_rel;
+    ::testing::Test::RecordProperty("worst_relative_difference", os.str());
+  }
 }
 
 TEST(Tension, ThreeStringsMatchActiveSetEnumeration) {
