@@ -13,5 +13,6 @@ Action add_position(CLI::App& app);
 Action add_tension(CLI::App& app);
 Action add_demo(CLI::App& app);
 Action add_device_test(CLI::App& app);
+Action add_calibrate_camera(CLI::App& app);
 
 }  // namespace spidar::app

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   add(add_tension);
   add(add_demo);
   add(add_device_test);
+  add(add_calibrate_camera);
 
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;
