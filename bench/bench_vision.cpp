@@ -19,23 +19,24 @@ const cv::Mat& frame() {
   return f;
 }
 
-// Argument: the distance transform's margin around the silhouette [px]; 0 = whole image.
+// Arguments: the distance transform's margin around the silhouette [px] (0 = whole image) and
+// its downsampling (1 = full resolution, 2 = half).
 void VisionFrame(benchmark::State& state) {
   const auto keyer = ChromaKeyer::create(ChromaKeyParams{}).value();
   const BraceletParams bp;
   ChromaKeyResult matte;
   BraceletWorkspace ws;
   SilhouetteDistance dist;
-  const int margin = static_cast<int>(state.range(0));
+  const SilhouetteDistanceOptions dt{static_cast<int>(state.range(0)), static_cast<int>(state.range(1))};
   for (auto _ : state) {
     if (!keyer.apply(frame(), &matte).ok()) state.SkipWithError("chroma key failed");
     auto wrists = detect_bracelets(frame(), bp, nullptr, &ws);
     if (!wrists.ok() || !(*wrists)[0].found) state.SkipWithError("bracelet not found");
-    if (!silhouette_distance(matte.silhouette, &dist, margin).ok()) state.SkipWithError("dt failed");
+    if (!silhouette_distance(matte.silhouette, &dist, dt).ok()) state.SkipWithError("dt failed");
     benchmark::DoNotOptimize(dist.label_pixel.data());
   }
 }
-BENCHMARK(VisionFrame)->Arg(0)->Arg(48)->Unit(benchmark::kMillisecond);
+BENCHMARK(VisionFrame)->Args({0, 1})->Args({48, 1})->Args({48, 2})->Unit(benchmark::kMillisecond);
 
 void ChromaKeyOnly(benchmark::State& state) {
   const auto keyer = ChromaKeyer::create(ChromaKeyParams{}).value();
@@ -59,10 +60,11 @@ void DistanceTransformOnly(benchmark::State& state) {
   (void)chroma_key(frame(), ChromaKeyParams{}, &matte);
   SilhouetteDistance dist;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(silhouette_distance(matte.silhouette, &dist, static_cast<int>(state.range(0))).ok());
+    const SilhouetteDistanceOptions dt{static_cast<int>(state.range(0)), static_cast<int>(state.range(1))};
+    benchmark::DoNotOptimize(silhouette_distance(matte.silhouette, &dist, dt).ok());
   }
 }
-BENCHMARK(DistanceTransformOnly)->Arg(0)->Arg(48)->Unit(benchmark::kMillisecond);
+BENCHMARK(DistanceTransformOnly)->Args({0, 1})->Args({48, 1})->Args({48, 2})->Unit(benchmark::kMillisecond);
 
 void RedMaskOnly(benchmark::State& state) {
   cv::Mat mask;

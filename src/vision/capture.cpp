@@ -120,7 +120,11 @@ Result<Capture> Capture::open(const std::string& source, const CaptureOptions& o
     }
     if (!fs::exists(source, ec)) return Error{"video file " + source + ": no such file"};
     if (!fs::is_regular_file(source, ec)) return Error{"video file " + source + ": not a file"};
-    if (!cap->open(source, cv::CAP_ANY) || !cap->isOpened()) {
+    // FFmpeg, then OpenCV's own MJPEG/AVI reader. Not CAP_ANY: probing every backend (GStreamer,
+    // camera SDKs) on a file is slow, noisy, and leaks inside those libraries.
+    bool opened = cap->open(source, cv::CAP_FFMPEG) && cap->isOpened();
+    if (!opened) opened = cap->open(source, cv::CAP_OPENCV_MJPEG) && cap->isOpened();
+    if (!opened) {
       return Error{"video file " + source +
                    ": cannot decode it (unsupported format or codec, or not a video)"};
     }

@@ -103,24 +103,22 @@ Status ChromaKeyer::apply(const cv::Mat& bgr, ChromaKeyResult* out) const {
   if (p.despill) {
     bgr.copyTo(out->foreground);
     const float limit = static_cast<float>(p.spill_limit);
-    // Edge band: soft pixels and their 8 neighbours. Rows are processed with a one-row look
-    // around instead of a separate dilation pass.
+    // Edge band: soft pixels (0 < alpha < 1) and their 8 neighbours that are not screen.
+    // Soft pixels are few, so visit them and cap their neighbourhoods (capping is idempotent).
     for (int y = 0; y < rows; ++y) {
-      const float* a_prev = out->alpha.ptr<float>(std::max(y - 1, 0));
-      const float* a_cur = out->alpha.ptr<float>(y);
-      const float* a_next = out->alpha.ptr<float>(std::min(y + 1, rows - 1));
-      std::uint8_t* px = out->foreground.ptr<std::uint8_t>(y);
+      const float* a = out->alpha.ptr<float>(y);
       for (int x = 0; x < cols; ++x) {
-        if (a_cur[x] <= 0.0f) continue;  // screen pixels are not part of the foreground
-        bool band = false;
-        const int x0 = std::max(x - 1, 0), x1 = std::min(x + 1, cols - 1);
-        for (int xx = x0; xx <= x1 && !band; ++xx) {
-          band = a_prev[xx] < 1.0f || a_cur[xx] < 1.0f || a_next[xx] < 1.0f;
+        if (!(a[x] > 0.0f && a[x] < 1.0f)) continue;
+        for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, rows - 1); ++yy) {
+          const float* an = out->alpha.ptr<float>(yy);
+          std::uint8_t* px = out->foreground.ptr<std::uint8_t>(yy);
+          for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, cols - 1); ++xx) {
+            if (an[xx] <= 0.0f) continue;  // screen pixels are not part of the foreground
+            const float rg = std::max<float>(px[3 * xx + 1], px[3 * xx + 2]);
+            const float cap = std::min(255.0f, limit * rg);
+            if (px[3 * xx] > cap) px[3 * xx] = static_cast<std::uint8_t>(cap);
+          }
         }
-        if (!band) continue;
-        const float rg = std::max<float>(px[3 * x + 1], px[3 * x + 2]);
-        const float cap = std::min(255.0f, limit * rg);
-        if (px[3 * x] > cap) px[3 * x] = static_cast<std::uint8_t>(cap);
       }
     }
   }

@@ -53,7 +53,7 @@ TEST(Silhouette, MarginRoiAgreesNearTheSilhouette) {
   cv::rectangle(sil, cv::Rect(95, 40, 20, 30), cv::Scalar(255), -1);
   SilhouetteDistance full, near;
   ASSERT_TRUE(silhouette_distance(sil, &full).ok());
-  ASSERT_TRUE(silhouette_distance(sil, &near, 10).ok());
+  ASSERT_TRUE(silhouette_distance(sil, &near, {.max_distance_px = 10}).ok());
   EXPECT_EQ(near.roi, cv::Rect(35, 30, 90, 66));
   for (int y = near.roi.y; y < near.roi.y + near.roi.height; ++y)
     for (int x = near.roi.x; x < near.roi.x + near.roi.width; ++x) {
@@ -65,6 +65,34 @@ TEST(Silhouette, MarginRoiAgreesNearTheSilhouette) {
   ASSERT_TRUE(far.has_value());
   EXPECT_NE(sil.at<uchar>(static_cast<int>(far->y()), static_cast<int>(far->x())), 0);
   EXPECT_FALSE(near.nearest(0, 0).has_value());
+}
+
+TEST(Silhouette, HalfResolutionLabelsStayClose) {
+  std::mt19937 rng(33);
+  double worst_excess = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    cv::Mat sil(41 + trial, 57 - trial, CV_8UC1, cv::Scalar(0));
+    std::uniform_int_distribution<int> ux(0, sil.cols - 1), uy(0, sil.rows - 1), ur(1, 6);
+    for (int b = 0; b < 1 + trial % 3; ++b) cv::circle(sil, {ux(rng), uy(rng)}, ur(rng), cv::Scalar(255), -1);
+    sil.at<uchar>(uy(rng), ux(rng)) = 255;
+    std::vector<cv::Point> on;
+    cv::findNonZero(sil, on);
+    SilhouetteDistance d;
+    ASSERT_TRUE(silhouette_distance(sil, &d, {.max_distance_px = 0, .downsample = 2}).ok());
+    for (int y = 0; y < sil.rows; ++y)
+      for (int x = 0; x < sil.cols; ++x) {
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& p : on) best = std::min(best, std::hypot(p.x - x, p.y - y));
+        const auto n = d.nearest(x, y);
+        ASSERT_TRUE(n.has_value());
+        ASSERT_NE(sil.at<uchar>(n->y, n->x), 0);
+        const double got = std::hypot(n->x - x, n->y - y);
+        worst_excess = std::max(worst_excess, got - best);
+        ASSERT_LE(got, best * 1.05 + 2.5) << "at " << x << "," << y;
+      }
+  }
+  std::printf("half-resolution distance transform: nearest-label excess at most %.3f px\n", worst_excess);
+  RecordProperty("half_res_label_excess_max_px", std::to_string(worst_excess));
 }
 
 TEST(Silhouette, SubPixelQueriesAndEmptySilhouettes) {

@@ -21,11 +21,24 @@ namespace spidar::vision {
 /// bounding box grown by that margin (registration only pulls model pixels that lie near the
 /// hands; this saves most of the cost). Queries outside the roi are clamped into it first, so
 /// they still get a silhouette pixel, though not necessarily the nearest one.
+///
+/// With downsample = 2 the transform runs on a half-resolution silhouette (a 2×2 block is
+/// silhouette if any of its pixels is) and a query picks, in the nearest block, the silhouette
+/// pixel nearest to it: about 4× cheaper, and the returned pixel is at most ~2 px farther than
+/// the true nearest one. `nearest` and `distance_at` always answer in full-resolution pixels.
+struct SilhouetteDistanceOptions {
+  int max_distance_px = 0;  ///< margin around the silhouette's bounding box [px]; 0 = whole image
+  int downsample = 1;       ///< 1 (exact labels up to OpenCV's mask) or 2 (half resolution)
+};
+
 struct SilhouetteDistance {
-  cv::Rect roi;      ///< region the maps below cover, in image pixels
-  cv::Mat distance;  ///< CV_32FC1 over roi [px], 0 on the silhouette (5×5 mask approximation)
-  cv::Mat labels;    ///< CV_32SC1 over roi, OpenCV's label of the nearest silhouette pixel
-  std::vector<cv::Point> label_pixel;  ///< label → that pixel's image (x, y); entry 0 unused
+  cv::Rect roi;      ///< region covered, in full-resolution image pixels
+  int scale = 1;     ///< 1 or 2: pixels of the maps below per image pixel side
+  cv::Mat distance;  ///< CV_32FC1 over roi/scale [map px], 0 on the silhouette (5×5 mask approx.)
+  cv::Mat labels;    ///< CV_32SC1 over roi/scale, OpenCV's label of the nearest silhouette pixel
+  std::vector<cv::Point> label_pixel;  ///< label → its map pixel as image (x, y) of the block's
+                                       ///< top-left; entry 0 unused
+  cv::Mat silhouette_roi;  ///< full-resolution silhouette over roi (scale 2 only)
   bool empty = true;  ///< no silhouette pixel at all
 
   /// The silhouette pixel nearest to image pixel (x, y) (inside the roi), or nullopt if empty
@@ -40,9 +53,8 @@ struct SilhouetteDistance {
 };
 
 /// Computes `out` from a CV_8UC1 silhouette (non-zero = silhouette). Reuses out's buffers.
-/// max_distance_px: 0 = whole image, else the margin around the silhouette's bounding box.
 Status silhouette_distance(const cv::Mat& silhouette, SilhouetteDistance* out,
-                           int max_distance_px = 0);
+                           const SilhouetteDistanceOptions& options = {});
 
 /// Bilinear sample of a CV_32FC1 matte at a sub-pixel point [px]; pixels outside the image
 /// count as 0 (screen), so the value fades to 0 across the border.
