@@ -1,0 +1,101 @@
+// spidar-mr calibrate-camera: intrinsics from a folder of chessboard images, extrinsics from a
+// markers file (PnP or the paper's three markers), written as a camera file.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "spidar/vision/camera_config.hpp"
+#include "spidar/vision/chessboard.hpp"
+#include "spidar/vision/markers.hpp"
+
+namespace spidar::app {
+
+Action add_calibrate_camera(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "calibrate-camera",
+      "Camera intrinsics from chessboard images, extrinsics from markers; writes a camera file");
+  struct Args {
+    std::string images;
+    std::string pattern = "9x6";
+    double square = 0.025;
+    std::string markers;
+    std::string base;
+    std::string out = "configs/camera.yaml";
+    bool k3 = false;
+  };
+  auto a = std::make_shared<Args>();
+  cmd->add_option("--images", a->images, "folder of chessboard images")->required();
+  cmd->add_option("--pattern", a->pattern, "inner corners COLSxROWS")->capture_default_str();
+  cmd->add_option("--square", a->square, "side of one square [m]")->capture_default_str();
+  cmd->add_option("--markers", a->markers,
+                  "markers file (YAML): world + pixel (PnP, >= 4) or world + camera (3, the "
+                  "paper's method)");
+  cmd->add_option("--base", a->base,
+                  "camera file whose extrinsics are kept when --markers is not given (default: "
+                  "--out if it exists, else the default rig camera)");
+  cmd->add_option("--out", a->out, "camera file to write")->capture_default_str();
+  cmd->add_flag("--k3", a->k3, "also estimate the k3 distortion coefficient (default: k3 = 0)");
+  return [a] {
+    auto pattern = vision::parse_pattern(a->pattern, a->square);
+    if (!pattern) throw UsageError("--pattern/--square: " + pattern.error().message);
+    vision::IntrinsicsOptions options;
+    options.fix_k3 = !a->k3;
+    auto folder = vision::calibrate_chessboard_folder(a->images, *pattern, options);
+    if (!folder) throw UsageError("--images " + folder.error().message);
+    const auto& cal = folder->calibration;
+
+    vision::CalibrationNotes notes;
+    notes.intrinsics_rms_px = cal.rms_px;
+    nlohmann::json extr;
+    Pose X_CW;
+    if (!a->markers.empty()) {
+      const auto set = vision::load_markers(a->markers);
+      auto r = vision::calibrate_extrinsics(cal.intrinsics, set);
+      if (!r) throw UsageError("--markers " + r.error().message);
+      X_CW = r->X_CW;
+      notes.method = "chessboard + " + r->method;
+      notes.extrinsics_rms_px = r->rms_px;
+      notes.extrinsics_rms_m = r->rms_m;
+      extr = {{"method", r->method}, {"markers", set.markers.size()}};
+      if (r->rms_px) extr["rms_px"] = *r->rms_px;
+      if (r->max_px) extr["max_px"] = *r->max_px;
+      if (r->rms_m) extr["rms_m"] = *r->rms_m;
+    } else {
+      std::string base = a->base;
+      if (base.empty() && std::filesystem::exists(a->out)) base = a->out;
+      if (base.empty()) {
+        X_CW = vision::default_rig_camera().X_CW();
+        extr = {{"method", "default rig pose (no --markers)"}};
+      } else {
+        X_CW = vision::load_camera_file(base).camera.X_CW();
+        extr = {{"method", "kept from " + base + " (no --markers)"}};
+      }
+      notes.method = "chessboard";
+    }
+    const vision::Camera camera(cal.intrinsics, X_CW);
+    if (auto s = vision::save_camera_file(a->out, camera, notes); !s.ok()) {
+      throw UsageError("--out " + s.error().message);
+    }
+    const auto& in = cal.intrinsics;
+    const auto& d = in.distortion;
+    const Vec3 p_WC = camera.X_WC().p;
+    nlohmann::json j = {
+        {"out", a->out},
+        {"images", folder->used.size() + folder->rejected.size()},
+        {"boards_found", folder->used.size()},
+        {"rejected", folder->rejected},
+        {"intrinsics",
+         {{"fx", in.fx}, {"fy", in.fy}, {"cx", in.cx}, {"cy", in.cy},
+          {"distortion", {d.k1, d.k2, d.p1, d.p2, d.k3}},
+          {"image_size", {in.width, in.height}},
+          {"rms_px", cal.rms_px}}},
+        {"extrinsics", extr},
+        {"camera_position", to_json(p_WC)}};
+    std::cout << j.dump() << "\n";
+    return 0;
+  };
+}
+
+}  // namespace spidar::app

@@ -1,0 +1,207 @@
+// Red bracelets on drawn hands: wrist position, hand assignment, partly hidden or missing bands.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "spidar/vision/bracelet.hpp"
+#include "synthetic_scene.hpp"
+
+namespace spidar::vision {
+namespace {
+
+using test::DrawnHand;
+using test::SceneOptions;
+
+std::array<BraceletObservation, 2> detect(const cv::Mat& bgr, const BraceletPrediction* pred = nullptr) {
+  BraceletWorkspace ws;
+  auto r = detect_bracelets(bgr, BraceletParams{}, pred, &ws);
+  EXPECT_TRUE(r.ok());
+  return r.ok() ? *r : std::array<BraceletObservation, 2>{};
+}
+
+TEST(Bracelet, RedMaskMatchesOpenCvHsvRanges) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> c(0, 255);
+  cv::Mat img(200, 200, CV_8UC3);
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x) {
+      // Bias toward reddish pixels so that the boundaries are exercised.
+      const int r = c(rng);
+      img.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uchar>(c(rng) * r / 255), static_cast<uchar>(c(rng) * r / 255),
+                                           static_cast<uchar>(r));
+    }
+  const BraceletParams p;
+  cv::Mat ours;
+  ASSERT_TRUE(red_mask(img, p, &ours).ok());
+  cv::Mat hsv, lo, hi, ref;
+  cv::cvtColor(img, hsv, cv::COLOR_BGR2HSV);
+  cv::inRange(hsv, cv::Scalar(0, p.saturation_min, p.value_min), cv::Scalar(p.hue_low_max, 255, 255), lo);
+  cv::inRange(hsv, cv::Scalar(p.hue_high_min, p.saturation_min, p.value_min), cv::Scalar(179, 255, 255), hi);
+  ref = lo | hi;
+  ASSERT_GT(cv::countNonZero(ref), 1000);
+  const int mismatches = cv::countNonZero(ours != ref);
+  EXPECT_LE(mismatches, 40) << "of " << img.total() << " (rounding ties only)";
+}
+
+TEST(Bracelet, BothHandsByImageSideWithSubPixelWrists) {
+  const std::vector<DrawnHand> hands = {{{190, 400}, -1.75, 170}, {{450, 390}, -1.35, 170}};
+  const auto scene = test::draw_scene(hands);
+  const auto obs = detect(scene.bgr);
+  double worst = 0;
+  for (int h = 0; h < 2; ++h) {
+    ASSERT_TRUE(obs[h].found) << h;
+    const double err = (obs[h].wrist_px - *scene.wrist[h]).norm();
+    worst = std::max(worst, err);
+    EXPECT_LT(err, 0.5) << "hand " << h;
+    EXPECT_GT(obs[h].confidence, 0.7) << "hand " << h;
+    EXPECT_EQ(obs[h].pieces, 1);
+  }
+  std::printf("bracelet wrist error, whole bands: %.3f px (worst of two); confidence %.2f, %.2f\n", worst,
+              obs[0].confidence, obs[1].confidence);
+  RecordProperty("wrist_error_px", std::to_string(worst));
+}
+
+TEST(Bracelet, WristErrorOverManyPosesAndLights) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> ang(-0.5, 0.5), dx(-40, 40), len(130, 200), light(0.3, 0.9);
+  double sum = 0, worst = 0;
+  int n = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    const std::vector<DrawnHand> hands = {{{180 + dx(rng), 380 + dx(rng) / 2}, -M_PI / 2 + ang(rng), len(rng)},
+                                          {{460 + dx(rng), 380 + dx(rng) / 2}, -M_PI / 2 + ang(rng), len(rng)}};
+    SceneOptions o;
+    o.seed = 100 + static_cast<unsigned>(trial);
+    o.light_min = light(rng);
+    const auto scene = test::draw_scene(hands, o);
+    const auto obs = detect(scene.bgr);
+    for (int h = 0; h < 2; ++h) {
+      ASSERT_TRUE(obs[h].found) << "trial " << trial << " hand " << h;
+      const double e = (obs[h].wrist_px - *scene.wrist[h]).norm();
+      sum += e;
+      worst = std::max(worst, e);
+      ++n;
+    }
+  }
+  std::printf("bracelet wrist error over %d bands: mean %.3f px, worst %.3f px\n", n, sum / n, worst);
+  RecordProperty("wrist_error_mean_px", std::to_string(sum / n));
+  RecordProperty("wrist_error_max_px", std::to_string(worst));
+  EXPECT_LT(worst, 0.5);
+}
+
+TEST(Bracelet, PredictionsAssignCrossedHands) {
+  // The left hand crossed over to the image's right side and vice versa.
+  const std::vector<DrawnHand> hands = {{{430, 390}, -1.9, 170}, {{220, 400}, -1.2, 170}};
+  const auto scene = test::draw_scene(hands);
+  BraceletPrediction pred;
+  pred.wrist_px = {Vec2(440, 380), Vec2(205, 410)};  // off by ~15 px
+  const auto obs = detect(scene.bgr, &pred);
+  for (int h = 0; h < 2; ++h) {
+    ASSERT_TRUE(obs[h].found);
+    EXPECT_LT((obs[h].wrist_px - *scene.wrist[h]).norm(), 1.0);
+  }
+}
+
+TEST(Bracelet, MissingBraceletIsNotTakenFromTheOtherHand) {
+  std::vector<DrawnHand> hands = {{{190, 400}, -1.75, 170}, {{450, 390}, -1.35, 170}};
+  hands[0].bracelet = false;
+  const auto scene = test::draw_scene(hands);
+  // By image side.
+  auto obs = detect(scene.bgr);
+  EXPECT_FALSE(obs[0].found);
+  EXPECT_EQ(obs[0].confidence, 0.0);
+  ASSERT_TRUE(obs[1].found);
+  EXPECT_LT((obs[1].wrist_px - *scene.wrist[1]).norm(), 1.0);
+  // With predictions for both: the left prediction must not grab the right band, even when
+  // the left prediction is (badly) placed between the two wrists.
+  BraceletPrediction pred;
+  pred.wrist_px = {Vec2(380, 395), Vec2(455, 385)};
+  obs = detect(scene.bgr, &pred);
+  EXPECT_FALSE(obs[0].found);
+  EXPECT_TRUE(obs[1].found);
+  // A single band equally near both predictions is ambiguous: no hand gets it.
+  pred.wrist_px = {Vec2(420, 390), Vec2(480, 390)};
+  obs = detect(scene.bgr, &pred);
+  EXPECT_FALSE(obs[0].found);
+  EXPECT_FALSE(obs[1].found);
+  // Only one hand predicted: the other hand does not take a band claimed by the prediction.
+  pred.wrist_px = {std::nullopt, Vec2(455, 385)};
+  obs = detect(scene.bgr, &pred);
+  EXPECT_FALSE(obs[0].found);
+  EXPECT_TRUE(obs[1].found);
+}
+
+TEST(Bracelet, LoneBandNearTheMidlineIsAmbiguousWithoutPredictions) {
+  const std::vector<DrawnHand> hands = {{{322, 400}, -1.57, 170}};
+  const auto scene = test::draw_scene(hands);
+  const auto obs = detect(scene.bgr);
+  EXPECT_FALSE(obs[0].found);
+  EXPECT_FALSE(obs[1].found);
+}
+
+TEST(Bracelet, PartlyHiddenBandHasLowConfidence) {
+  std::vector<DrawnHand> hands = {{{190, 400}, -1.75, 170}, {{450, 390}, -1.35, 170}};
+  hands[1].hidden_fraction = 0.5;
+  const auto scene = test::draw_scene(hands);
+  const auto obs = detect(scene.bgr);
+  ASSERT_TRUE(obs[0].found);
+  EXPECT_GT(obs[0].confidence, 0.7);
+  ASSERT_TRUE(obs[1].found);
+  const double err = (obs[1].wrist_px - *scene.wrist[1]).norm();
+  std::printf("half-hidden band: confidence %.3f, wrist error %.1f px (whole band: %.3f)\n", obs[1].confidence,
+              err, obs[0].confidence);
+  RecordProperty("half_hidden_confidence", std::to_string(obs[1].confidence));
+  EXPECT_LT(obs[1].confidence, 0.3);
+  // Mostly hidden: lower still.
+  hands[1].hidden_fraction = 0.8;
+  const auto obs2 = detect(test::draw_scene(hands).bgr);
+  EXPECT_LT(obs2[1].confidence, 0.1);
+  EXPECT_GT(obs2[0].confidence, 0.7);
+}
+
+TEST(Bracelet, PredictedLengthJudgesCompleteness) {
+  std::vector<DrawnHand> hands = {{{190, 400}, -1.75, 170}, {{450, 390}, -1.35, 170}};
+  hands[1].hidden_fraction = 0.3;
+  const auto scene = test::draw_scene(hands);
+  BraceletPrediction pred;
+  pred.wrist_px = {Vec2(190, 400), Vec2(450, 390)};
+  pred.length_px = {0.44 * 170, 0.44 * 170};
+  const auto obs = detect(scene.bgr, &pred);
+  EXPECT_GT(obs[0].confidence, 0.8);
+  EXPECT_LT(obs[1].confidence, 0.55);
+}
+
+TEST(Bracelet, FingerAcrossTheBandKeepsItsEnds) {
+  std::vector<DrawnHand> hands = {{{190, 400}, -1.75, 170}, {{450, 390}, -1.35, 170}};
+  hands[0].finger_across = true;
+  const auto scene = test::draw_scene(hands);
+  const auto obs = detect(scene.bgr);
+  ASSERT_TRUE(obs[0].found);
+  EXPECT_EQ(obs[0].pieces, 2);
+  EXPECT_LT((obs[0].wrist_px - *scene.wrist[0]).norm(), 1.5);
+  EXPECT_GT(obs[0].confidence, 0.5);
+}
+
+TEST(Bracelet, RedNoiseSpecklesAreIgnored) {
+  const std::vector<DrawnHand> hands = {{{190, 400}, -1.75, 170}, {{450, 390}, -1.35, 170}};
+  auto scene = test::draw_scene(hands);
+  std::mt19937 rng(8);
+  std::uniform_int_distribution<int> ux(0, 639), uy(0, 479);
+  for (int i = 0; i < 300; ++i) scene.bgr.at<cv::Vec3b>(uy(rng), ux(rng)) = cv::Vec3b(30, 20, 220);
+  const auto obs = detect(scene.bgr);
+  for (int h = 0; h < 2; ++h) {
+    ASSERT_TRUE(obs[h].found);
+    EXPECT_LT((obs[h].wrist_px - *scene.wrist[h]).norm(), 1.0);
+  }
+}
+
+TEST(Bracelet, BadInputIsAnError) {
+  BraceletWorkspace ws;
+  EXPECT_FALSE(detect_bracelets(cv::Mat(), BraceletParams{}, nullptr, &ws).ok());
+  BraceletParams p;
+  p.ambiguity_ratio = 1.5;
+  EXPECT_FALSE(detect_bracelets(cv::Mat(10, 10, CV_8UC3), p, nullptr, &ws).ok());
+}
+
+}  // namespace
+}  // namespace spidar::vision
