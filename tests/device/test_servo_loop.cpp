@@ -7,24 +7,10 @@
 #include <random>
 #include <thread>
 
+#include "allocation_counter.hpp"
 #include "device_test_support.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/device/servo_loop.hpp"
-
-// Counts heap allocations made by the servo thread while counting is on.
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_servo_allocations{0};
-thread_local bool t_is_servo = false;
-}  // namespace
-
-void* operator new(std::size_t n) {
-  if (t_is_servo && g_counting.load(std::memory_order_relaxed)) g_servo_allocations.fetch_add(1);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace spidar::device {
 namespace {
@@ -100,10 +86,12 @@ TEST(ServoLoop, PositionsTrackTheSimulatedFingertips) {
 }
 
 TEST(ServoLoop, CycleBodyDoesNotAllocate) {
+  namespace alloc = spidar::testing::allocations;
+  if (!alloc::available()) GTEST_SKIP() << "allocation counting is off under ASan";
   Rig rig;
   ServoConfig cfg;
   cfg.rate_hz = 2000;
-  cfg.on_thread_start = [] { t_is_servo = true; };
+  cfg.on_thread_start = [] { alloc::mark_this_thread(); };
   // A force source that asks for real forces, so tensions and commands vary.
   struct Pushing final : ForceSource {
     void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
@@ -114,14 +102,13 @@ TEST(ServoLoop, CycleBodyDoesNotAllocate) {
   ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<Pushing>());
   ASSERT_TRUE(loop.start().ok());
   wait_for_cycles(loop, 50);
-  g_servo_allocations = 0;
-  g_counting = true;
+  alloc::start();
   const auto start = loop.cycles();
   wait_for_cycles(loop, start + 1000);
-  g_counting = false;
+  alloc::stop();
   loop.stop();
   EXPECT_GE(loop.cycles(), start + 1000);
-  EXPECT_EQ(g_servo_allocations.load(), 0);
+  EXPECT_EQ(alloc::count(), 0);
   EXPECT_GT(rig.rec.max_command(), rig.sim.info().command_min);  // forces were displayed
 }
 
