@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   add(add_demo);
   add(add_device_test);
   add(add_calibrate_camera);
+  add(add_render_test);
 
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;
