@@ -69,7 +69,16 @@ TEST(VideoOutput, MjpgFallbackAlwaysWorks) {
 TEST(RenderCli, RenderTestWritesCompositedPngs) {
   const auto dir = scratch("cli");
   const std::string src = SPIDAR_SOURCE_DIR;
-  const std::string cmd = std::string(SPIDAR_MR) + " render-test --out " + dir.string() +
+#ifdef __SANITIZE_ADDRESS__
+  // Sanitizer builds: LeakSanitizer's stop-the-world tracer intermittently dies with SIGSEGV at
+  // the exit of spidar-mr when the test binary starts it (Mesa and FFmpeg threads still winding
+  // down; never seen when spidar-mr is run by hand). The child keeps ASan/UBSan; the leak check
+  // of the same render code runs in this test binary's own process.
+  const std::string env = "ASAN_OPTIONS=${ASAN_OPTIONS}:detect_leaks=0 ";
+#else
+  const std::string env;
+#endif
+  const std::string cmd = env + std::string(SPIDAR_MR) + " render-test --out " + dir.string() +
                           " --scene " + src + "/scenes/rubiks_cube.xml --camera " + src +
                           "/configs/camera.yaml --device " + src +
                           "/configs/spidar8.yaml --frames 3 > " + (dir.string() + ".log") + " 2>&1";
