@@ -15,5 +15,6 @@ Action add_demo(CLI::App& app);
 Action add_device_test(CLI::App& app);
 Action add_emulate_device(CLI::App& app);
 Action add_calibrate_camera(CLI::App& app);
+Action add_render_test(CLI::App& app);
 
 }  // namespace spidar::app

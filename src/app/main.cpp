@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   add(add_device_test);
   add(add_emulate_device);
   add(add_calibrate_camera);
+  add(add_render_test);
 
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;

@@ -1,0 +1,140 @@
+// Rendering on this machine's GL (Mesa llvmpipe when headless). Goals (issue 6) at 640×480:
+// scene + hands render (with read-back of all targets) ≤ 8 ms median; compositor ≤ 3 ms;
+// synthetic camera frame ≤ 10 ms. Argument: image width (640 → 640×480, 1280 → 1280×720).
+#include <benchmark/benchmark.h>
+
+#include <iostream>
+
+#include "../tests/render/synthetic_hands.hpp"
+#include "spidar/hand/render_geometry.hpp"
+#include "spidar/physics/world.hpp"
+#include "spidar/render/compositor.hpp"
+#include "spidar/render/context.hpp"
+#include "spidar/render/hand_shapes.hpp"
+#include "spidar/render/renderer.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/vision/chroma_key.hpp"
+
+namespace {
+
+using namespace spidar;
+
+render::Context* context() {
+  static std::unique_ptr<render::Context> ctx = [] {
+    auto r = render::Context::create_headless();
+    if (!r) {
+      std::cerr << "bench_render: " << r.error().message << "\n";
+      return std::unique_ptr<render::Context>();
+    }
+    std::cerr << "bench_render: GL_RENDERER " << (*r)->gl_renderer() << "\n";
+    return std::move(r).value();
+  }();
+  return ctx.get();
+}
+
+vision::Camera camera(int width) {
+  vision::Camera cam = vision::default_rig_camera();
+  if (width == 640) return cam;
+  vision::Intrinsics K = cam.intrinsics();
+  const double s = width / 640.0;
+  K.width = width;
+  K.height = width * 9 / 16;
+  K.fx *= s;
+  K.fy *= s;
+  K.cx = (K.width - 1) / 2.0;
+  K.cy = (K.height - 1) / 2.0;
+  cam.set_intrinsics(K);
+  return cam;
+}
+
+/// The cube scene (physics snapshot) with both model hands.
+SceneSnapshot cube_scene_with_hands() {
+  auto world = physics::World::Load(std::string(SPIDAR_SOURCE_DIR) + "/scenes/rubiks_cube.xml");
+  SceneSnapshot s;
+  if (!world) {
+    std::cerr << "bench_render: " << world.error().message << "\n";
+    return s;
+  }
+  (*world)->snapshot(s);
+  const auto q = render::test::reaching_hands();
+  for (int h = 0; h < 2; ++h)
+    render::append_hand_shapes(
+        hand::hand_render_shapes(hand::default_hand_model(static_cast<hand::Side>(h)), q[h]), &s);
+  return s;
+}
+
+void RenderSceneAndHands(benchmark::State& state) {
+  if (!context()) return state.SkipWithError("no headless GL");
+  const vision::Camera cam = camera(static_cast<int>(state.range(0)));
+  const SceneSnapshot scene = cube_scene_with_hands();
+  auto renderer = render::Renderer::create(*context(), cam.width(), cam.height()).value();
+  render::RenderTargets t;
+  for (auto _ : state) {
+    if (!renderer->render(scene, cam).ok() || !renderer->read(&t).ok())
+      state.SkipWithError("render failed");
+    benchmark::DoNotOptimize(t.colour.data);
+  }
+  state.counters["shapes"] = static_cast<double>(scene.shapes.size());
+}
+BENCHMARK(RenderSceneAndHands)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
+
+struct CompositeFixture {
+  render::RenderTargets targets;
+  vision::ChromaKeyResult key;
+  sim::SyntheticFrame frame;
+};
+
+CompositeFixture make_composite_inputs(int width) {
+  CompositeFixture f;
+  const vision::Camera cam = camera(width);
+  const SceneSnapshot scene = cube_scene_with_hands();
+  auto renderer = render::Renderer::create(*context(), cam.width(), cam.height()).value();
+  (void)renderer->render(scene, cam);
+  (void)renderer->read(&f.targets);
+  auto camera_sim = sim::SyntheticCamera::create(*context(), cam, render::test::truth_models()).value();
+  const auto q = render::test::reaching_hands(0.003);  // the model is 3 mm off
+  (void)camera_sim->film({&q[0], &q[1]}, &f.frame);
+  (void)vision::chroma_key(f.frame.bgr, vision::ChromaKeyParams{}, &f.key);
+  return f;
+}
+
+void Composite(benchmark::State& state) {
+  if (!context()) return state.SkipWithError("no headless GL");
+  const CompositeFixture f = make_composite_inputs(static_cast<int>(state.range(0)));
+  render::CompositorParams p;
+  p.mode = state.range(1) == 0 ? render::CompositeMode::kDepth : render::CompositeMode::kPaper;
+  render::Compositor compositor(p);
+  cv::Mat out;
+  const render::CompositeInputs in{&f.targets,
+                                   p.mode == render::CompositeMode::kDepth ? f.key.foreground
+                                                                           : f.frame.bgr,
+                                   f.key.alpha};
+  for (auto _ : state) {
+    if (!compositor.compose(in, &out).ok()) state.SkipWithError("compose failed");
+    benchmark::DoNotOptimize(out.data);
+  }
+  state.SetLabel(render::composite_mode_name(p.mode));
+}
+BENCHMARK(Composite)->Args({640, 0})->Args({640, 1})->Args({1280, 0})->Unit(benchmark::kMillisecond);
+
+void SyntheticCameraFrame(benchmark::State& state) {
+  if (!context()) return state.SkipWithError("no headless GL");
+  const vision::Camera cam = camera(static_cast<int>(state.range(0)));
+  sim::SyntheticCameraParams p;
+  p.motion_blur_samples = static_cast<int>(state.range(1));
+  auto camera_sim = sim::SyntheticCamera::create(*context(), cam, render::test::truth_models(), p).value();
+  const auto q = render::test::reaching_hands(), prev = render::test::reaching_hands(-0.01);
+  const sim::HandPoses before = {&prev[0], &prev[1]};
+  sim::SyntheticFrame frame;
+  for (auto _ : state) {
+    if (!camera_sim->film({&q[0], &q[1]}, &frame, p.motion_blur_samples > 1 ? &before : nullptr).ok())
+      state.SkipWithError("film failed");
+    benchmark::DoNotOptimize(frame.bgr.data);
+  }
+}
+BENCHMARK(SyntheticCameraFrame)->Args({640, 1})->Args({1280, 1})->Args({640, 4})
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,82 @@
+#pragma once
+/// The simulated rig's camera: films the ground-truth ("real") hands against a blue screen, as
+/// the lab camera would, so that chroma key, bracelet detection and registration run on images
+/// they did not draw themselves.
+///
+/// The hands are deliberately *not* the model's capsules: each bone is a tapered sphere-swept
+/// cone (thicker at its proximal end), the palm a fuller rounded box (superellipsoid), the wrist
+/// continues into a short forearm, with a red bracelet around the wrist. Skin colour with
+/// Lambert shading over a uniformly lit blue screen; then an optical blur (Gaussian PSF), sensor
+/// noise (Gaussian, in 8-bit levels) and, optionally, motion blur (the mean of sub-frames
+/// between the previous and the current pose). Ground truth comes with every frame: the mask of
+/// everything in front of the screen (skin, bracelet, forearm), which hand, and depth.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core/mat.hpp>
+
+#include "spidar/core/result.hpp"
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/render/context.hpp"
+#include "spidar/vision/camera.hpp"
+
+namespace spidar::sim {
+
+struct SyntheticCameraParams {
+  std::array<float, 3> screen_rgb{0.15f, 0.35f, 0.78f};   ///< blue screen, as lit
+  std::array<float, 3> skin_rgb{0.88f, 0.66f, 0.54f};     ///< skin albedo
+  std::array<float, 3> bracelet_rgb{0.85f, 0.07f, 0.07f}; ///< red bracelet albedo
+  double bracelet_width_m = 0.018;    ///< along the forearm [m]
+  double bracelet_offset_m = 0.012;   ///< bracelet centre, from the wrist toward the elbow [m]
+  double forearm_length_m = 0.10;     ///< visible forearm beyond the wrist [m]; 0 = none
+  double taper = 0.12;                ///< bone radius: (1 + taper)·r proximal, (1 − taper)·r distal
+  double palm_fullness = 1.2;         ///< palm thickness and width × this (vs the model's box)
+  float ambient = 0.45f;              ///< share of light that is not directional
+  Vec3 light_dir_C{0.2, -0.6, -0.75}; ///< toward the light, camera frame
+  double psf_sigma_px = 0.5;          ///< optical blur [px]; 0 = off
+  double noise_sigma = 2.0;           ///< sensor noise [8-bit levels], i.i.d. per pixel and
+                                      ///< channel within a frame; 0 = off
+  int motion_blur_samples = 1;        ///< sub-frames per frame when a previous pose is given; 1 = off
+  std::uint64_t seed = 1;             ///< noise seed (frames are reproducible)
+};
+
+/// Error naming the bad field.
+Status validate(const SyntheticCameraParams& params);
+
+struct SyntheticFrame {
+  cv::Mat bgr;         ///< CV_8UC3, what the camera sees
+  cv::Mat mask;        ///< CV_8UC1, 255 where a hand, bracelet or forearm is in front of the screen
+  cv::Mat hand_index;  ///< CV_8UC1, 0 screen, 1 left hand, 2 right hand (incl. its bracelet/arm)
+  cv::Mat depth;       ///< CV_32FC1 z_C [m] of the ground-truth surface; +inf on the screen
+};
+
+/// The poses to film: entry 0 left, 1 right; nullptr = that hand is out of view.
+using HandPoses = std::array<const hand::HandParams*, 2>;
+
+class SyntheticCamera {
+ public:
+  /// `truth` gives the two hands' shapes (left, right: the user's true proportions, not
+  /// necessarily the registration's). The context must stay alive and current on this thread.
+  static Result<std::unique_ptr<SyntheticCamera>> create(render::Context& context,
+                                                         const vision::Camera& camera,
+                                                         const std::array<hand::HandModel, 2>& truth,
+                                                         const SyntheticCameraParams& params = {});
+  ~SyntheticCamera();
+  SyntheticCamera(const SyntheticCamera&) = delete;
+  SyntheticCamera& operator=(const SyntheticCamera&) = delete;
+
+  /// Films one frame at `poses`. With `previous` and motion_blur_samples > 1 the image is the
+  /// mean of sub-frames from previous to poses (ground truth: at `poses`). Reuses out's buffers.
+  Status film(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous = nullptr);
+
+  const vision::Camera& camera() const;
+  void set_camera(const vision::Camera& camera);
+  const SyntheticCameraParams& params() const;
+
+ private:
+  struct Impl;
+  explicit SyntheticCamera(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spidar::sim

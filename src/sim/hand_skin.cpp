@@ -1,0 +1,147 @@
+#include "hand_skin.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "spidar/hand/render_geometry.hpp"
+#include "spidar/hand/rotation_vector.hpp"
+
+namespace spidar::sim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+void push(MeshData& m, const Vec3& p) {
+  for (int k = 0; k < 3; ++k) m.vertices.push_back(static_cast<float>(p[k]));
+}
+
+/// Triangles of a (rows × cols) vertex grid wrapped in the second index; outward when the rows
+/// run from −z to +z and the columns counter-clockwise about z.
+void grid_faces(MeshData& m, int rows, int cols) {
+  for (int i = 0; i + 1 < rows; ++i) {
+    for (int j = 0; j < cols; ++j) {
+      const int a = i * cols + j, b = i * cols + (j + 1) % cols;
+      const int c = a + cols, d = b + cols;
+      m.faces.insert(m.faces.end(), {a, b, d, a, d, c});
+    }
+  }
+}
+
+Pose along(const Vec3& p_W_origin, const Vec3& dir_W) {
+  Pose X;
+  X.p = p_W_origin;
+  const double n = dir_W.norm();
+  X.R = n > 1e-12 ? Quat::FromTwoVectors(Vec3::UnitZ(), dir_W / n) : Quat::Identity();
+  return X;
+}
+
+std::array<float, 4> rgba(const std::array<float, 3>& c) { return {c[0], c[1], c[2], 1.f}; }
+
+}  // namespace
+
+MeshData tapered_segment(double r_a, double r_b, double length, int slices, int rings) {
+  MeshData m;
+  m.name = "tapered_segment";
+  // Elevation of the tangent circle: sin α = (r_a − r_b) / length.
+  const double s = length > 1e-9 ? std::clamp((r_a - r_b) / length, -0.99, 0.99) : 0.0;
+  const double alpha = std::asin(s);
+  std::vector<std::pair<double, double>> profile;  // (radius, z)
+  for (int i = 0; i <= rings; ++i) {  // lower cap: −π/2 … α
+    const double t = -kPi / 2 + (alpha + kPi / 2) * i / rings;
+    profile.emplace_back(r_a * std::cos(t), r_a * std::sin(t));
+  }
+  for (int i = 0; i <= rings; ++i) {  // upper cap: α … π/2
+    const double t = alpha + (kPi / 2 - alpha) * i / rings;
+    profile.emplace_back(r_b * std::cos(t), length + r_b * std::sin(t));
+  }
+  const int rows = static_cast<int>(profile.size());
+  for (const auto& [r, z] : profile)
+    for (int j = 0; j < slices; ++j) {
+      const double phi = 2 * kPi * j / slices;
+      push(m, Vec3(r * std::cos(phi), r * std::sin(phi), z));
+    }
+  grid_faces(m, rows, slices);
+  return m;
+}
+
+MeshData rounded_box(const Vec3& half, double e, int slices, int stacks) {
+  MeshData m;
+  m.name = "rounded_box";
+  auto spow = [e](double v) { return std::copysign(std::pow(std::abs(v), e), v); };
+  for (int i = 0; i <= stacks; ++i) {
+    const double theta = -kPi / 2 + kPi * i / stacks;  // −z … +z
+    for (int j = 0; j < slices; ++j) {
+      const double phi = 2 * kPi * j / slices;
+      const double ct = spow(std::cos(theta)), st = spow(std::sin(theta));
+      push(m, Vec3(half.x() * ct * spow(std::cos(phi)), half.y() * ct * spow(std::sin(phi)),
+                   half.z() * st));
+    }
+  }
+  grid_faces(m, stacks + 1, slices);
+  return m;
+}
+
+HandSkin build_hand_skin(const hand::HandModel& model, const SyntheticCameraParams& p,
+                         std::vector<MeshData>* meshes) {
+  HandSkin skin;
+  // Bone lengths are fixed by the shape: measure them at the zero pose.
+  const hand::HandRenderShapes rest = hand::hand_render_shapes(model, hand::HandParams{});
+  for (const hand::Capsule& c : rest.capsules) {
+    const double len = (c.p_W_b - c.p_W_a).norm();
+    meshes->push_back(tapered_segment((1 + p.taper) * c.radius, (1 - p.taper) * c.radius, len));
+    skin.bones.push_back({static_cast<int>(meshes->size()) - 1, c.finger});
+  }
+  const Vec3 h = rest.boxes.at(0).half_extents;
+  meshes->push_back(rounded_box(Vec3(1.05 * h.x(), h.y() * 1.02, p.palm_fullness * h.z())));
+  skin.palm_mesh = static_cast<int>(meshes->size()) - 1;
+  skin.wrist_radius = 0.62 * h.x();
+  if (p.forearm_length_m > 0) {
+    meshes->push_back(
+        tapered_segment(skin.wrist_radius, 1.15 * skin.wrist_radius, p.forearm_length_m));
+    skin.forearm_mesh = static_cast<int>(meshes->size()) - 1;
+  }
+  return skin;
+}
+
+void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const hand::HandParams& q,
+                    const SyntheticCameraParams& p, SceneSnapshot* scene) {
+  const hand::HandRenderShapes shapes = hand::hand_render_shapes(model, q);
+  const int hand = static_cast<int>(model.side);
+  auto add = [&](Shape s, int finger, const std::array<float, 3>& colour) {
+    s.hand = hand;
+    s.finger = finger;
+    s.rgba = rgba(colour);
+    scene->shapes.push_back(s);
+  };
+  for (std::size_t i = 0; i < shapes.capsules.size() && i < skin.bones.size(); ++i) {
+    const hand::Capsule& c = shapes.capsules[i];
+    Shape s;
+    s.type = Shape::Type::kMesh;
+    s.mesh = skin.bones[i].mesh;
+    s.X_WS = along(c.p_W_a, c.p_W_b - c.p_W_a);
+    add(s, c.finger, p.skin_rgb);
+  }
+  Shape palm;
+  palm.type = Shape::Type::kMesh;
+  palm.mesh = skin.palm_mesh;
+  palm.X_WS = shapes.boxes.at(0).X_WB;
+  add(palm, kPalmPart, p.skin_rgb);
+
+  const Mat3 R_WH = hand::rotation_from_vector(q.r_W_hand());
+  const Vec3 toward_elbow = -R_WH.col(1);
+  if (skin.forearm_mesh >= 0) {
+    Shape arm;
+    arm.type = Shape::Type::kMesh;
+    arm.mesh = skin.forearm_mesh;
+    arm.X_WS = along(q.p_W_wrist(), toward_elbow);
+    add(arm, kForearmPart, p.skin_rgb);
+  }
+  Shape bracelet;
+  bracelet.type = Shape::Type::kCylinder;
+  bracelet.X_WS = along(q.p_W_wrist() + p.bracelet_offset_m * toward_elbow, toward_elbow);
+  const double grow = p.forearm_length_m > 0 ? 0.15 * p.bracelet_offset_m / p.forearm_length_m : 0;
+  bracelet.size = Vec3(skin.wrist_radius * (1 + grow) + 0.002, 0.5 * p.bracelet_width_m, 0);
+  add(bracelet, kBraceletPart, p.bracelet_rgb);
+}
+
+}  // namespace spidar::sim

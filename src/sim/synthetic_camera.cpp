@@ -1,0 +1,150 @@
+#include "spidar/sim/synthetic_camera.hpp"
+
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "hand_skin.hpp"
+#include "spidar/render/renderer.hpp"
+
+namespace spidar::sim {
+
+Status validate(const SyntheticCameraParams& p) {
+  auto bad = [](const std::string& what) { return Status(Error{"synthetic camera: " + what}); };
+  for (const auto* c : {&p.screen_rgb, &p.skin_rgb, &p.bracelet_rgb})
+    for (float v : *c)
+      if (!(v >= 0.f && v <= 1.f)) return bad("colours must be in [0, 1]");
+  if (!(p.bracelet_width_m > 0 && p.bracelet_width_m < 0.1))
+    return bad("bracelet_width_m must be in (0, 0.1) m, got " + std::to_string(p.bracelet_width_m));
+  if (!(p.bracelet_offset_m >= 0 && p.bracelet_offset_m < 0.1))
+    return bad("bracelet_offset_m must be in [0, 0.1) m");
+  if (!(p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
+    return bad("forearm_length_m must be in [0, 0.5] m");
+  if (!(p.taper >= 0 && p.taper < 0.5)) return bad("taper must be in [0, 0.5)");
+  if (!(p.palm_fullness >= 0.5 && p.palm_fullness <= 2)) return bad("palm_fullness must be in [0.5, 2]");
+  if (!(p.ambient >= 0.f && p.ambient <= 1.f)) return bad("ambient must be in [0, 1]");
+  if (!p.light_dir_C.allFinite() || p.light_dir_C.norm() < 1e-9) return bad("light_dir_C must be a direction");
+  if (!(p.psf_sigma_px >= 0 && p.psf_sigma_px <= 5)) return bad("psf_sigma_px must be in [0, 5]");
+  if (!(p.noise_sigma >= 0 && p.noise_sigma <= 64)) return bad("noise_sigma must be in [0, 64]");
+  if (p.motion_blur_samples < 1 || p.motion_blur_samples > 32)
+    return bad("motion_blur_samples must be in 1..32, got " + std::to_string(p.motion_blur_samples));
+  return Ok{};
+}
+
+struct SyntheticCamera::Impl {
+  vision::Camera camera;
+  SyntheticCameraParams params;
+  std::array<hand::HandModel, 2> models;
+  std::array<HandSkin, 2> skins;
+  std::shared_ptr<const std::vector<MeshData>> meshes;
+  std::unique_ptr<render::Renderer> renderer;
+  render::RenderParams render_params;
+  SceneSnapshot scene;
+  render::RenderTargets targets;
+  cv::Mat accumulator, noise;
+  cv::RNG rng;
+
+  void build_scene(const HandPoses& poses) {
+    scene.shapes.clear();
+    scene.meshes = meshes;
+    for (int h = 0; h < 2; ++h)
+      if (poses[h]) pose_hand_skin(models[h], skins[h], *poses[h], params, &scene);
+  }
+};
+
+SyntheticCamera::SyntheticCamera(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SyntheticCamera::~SyntheticCamera() = default;
+
+Result<std::unique_ptr<SyntheticCamera>> SyntheticCamera::create(
+    render::Context& context, const vision::Camera& camera,
+    const std::array<hand::HandModel, 2>& truth, const SyntheticCameraParams& params) {
+  if (auto s = validate(params); !s) return s.error();
+  if (truth[0].side != hand::Side::kLeft || truth[1].side != hand::Side::kRight)
+    return Error{"synthetic camera: truth models must be {left, right}"};
+  auto impl = std::make_unique<Impl>();
+  impl->camera = camera;
+  impl->params = params;
+  impl->models = truth;
+  auto meshes = std::make_shared<std::vector<MeshData>>();
+  for (int h = 0; h < 2; ++h) impl->skins[h] = build_hand_skin(truth[h], params, meshes.get());
+  impl->meshes = meshes;
+  auto renderer = render::Renderer::create(context, camera.width(), camera.height());
+  if (!renderer) return renderer.error();
+  impl->renderer = std::move(renderer).value();
+  render::RenderParams& rp = impl->render_params;
+  rp.background_rgb = params.screen_rgb;
+  rp.hands = render::HandDrawMode::kVisible;  // hands in colour with their own skin/bracelet colours
+  rp.hands_keep_colour = true;
+  rp.light_dir_C = params.light_dir_C;
+  rp.ambient = params.ambient;
+  rp.depth_range = {0.02, 10.0};
+  impl->rng = cv::RNG(params.seed);
+  return std::unique_ptr<SyntheticCamera>(new SyntheticCamera(std::move(impl)));
+}
+
+const vision::Camera& SyntheticCamera::camera() const { return impl_->camera; }
+void SyntheticCamera::set_camera(const vision::Camera& camera) { impl_->camera = camera; }
+const SyntheticCameraParams& SyntheticCamera::params() const { return impl_->params; }
+
+Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous) {
+  if (out == nullptr) return Error{"synthetic camera: no output frame given"};
+  Impl& s = *impl_;
+  const SyntheticCameraParams& p = s.params;
+  const int samples = previous ? p.motion_blur_samples : 1;
+  // Motion blur: sub-frames from the previous pose (exclusive) to the current one (last, so the
+  // targets left in the renderer are the ground truth at `poses`).
+  std::array<hand::HandParams, 2> blended;
+  for (int k = 1; k <= samples; ++k) {
+    HandPoses at = poses;
+    if (k < samples) {
+      const double t = static_cast<double>(k) / samples;
+      for (int h = 0; h < 2; ++h) {
+        if (!poses[h] || !(*previous)[h]) continue;
+        blended[h].q = (1 - t) * (*previous)[h]->q + t * poses[h]->q;
+        at[h] = &blended[h];
+      }
+    }
+    s.build_scene(at);
+    if (auto st = s.renderer->render(s.scene, s.camera, s.render_params); !st) return st;
+    const bool last = k == samples;
+    if (auto st = s.renderer->read(&s.targets, last ? render::kAllTargets : render::kColour); !st)
+      return st;
+    if (samples > 1) {
+      if (k == 1) s.targets.colour.convertTo(s.accumulator, CV_32FC3);
+      else cv::accumulate(s.targets.colour, s.accumulator);
+    }
+  }
+  if (samples > 1) s.accumulator.convertTo(out->bgr, CV_8UC3, 1.0 / samples);
+  else s.targets.colour.copyTo(out->bgr);
+
+  // Ground truth at `poses`.
+  cv::compare(s.targets.hand_id, 0, out->mask, cv::CMP_GT);
+  out->hand_index.create(out->mask.size(), CV_8UC1);
+  for (int y = 0; y < out->mask.rows; ++y) {
+    const std::uint8_t* id = s.targets.hand_id.ptr<std::uint8_t>(y);
+    std::uint8_t* hi = out->hand_index.ptr<std::uint8_t>(y);
+    for (int x = 0; x < out->mask.cols; ++x)
+      hi[x] = id[x] == 0 ? 0 : static_cast<std::uint8_t>(render::decode_hand_id(id[x]).hand + 1);
+  }
+  s.targets.hand_depth.copyTo(out->depth);
+
+  // Optics and sensor.
+  if (p.psf_sigma_px > 0) cv::GaussianBlur(out->bgr, out->bgr, cv::Size(0, 0), p.psf_sigma_px);
+  if (p.noise_sigma > 0) {
+    // Gaussian noise from a bank a little larger than the frame, drawn once; each frame takes it
+    // at a random offset (kNoisePad² different fields). Drawing 3·W·H normals per frame would
+    // cost more than the rendering.
+    constexpr int kNoisePad = 128;
+    const cv::Size bank(out->bgr.cols + kNoisePad, out->bgr.rows + kNoisePad);
+    if (s.noise.size() != bank) {
+      s.noise.create(bank, CV_16SC3);
+      s.rng.fill(s.noise, cv::RNG::NORMAL, 0.0, p.noise_sigma);
+    }
+    const cv::Rect at(s.rng.uniform(0, kNoisePad), s.rng.uniform(0, kNoisePad), out->bgr.cols,
+                      out->bgr.rows);
+    cv::add(out->bgr, s.noise(at), out->bgr, cv::noArray(), CV_8U);  // saturates to 0..255
+  }
+  return Ok{};
+}
+
+}  // namespace spidar::sim
