@@ -84,8 +84,10 @@ Status Compositor::compose_depth(const CompositeInputs& in, cv::Mat* out) {
 
   // Virtual-hand pixels, and for every pixel near them the nearest one.
   cv::compare(v.hand_depth, FLT_MAX, hand_mask_, cv::CMP_LT);
-  if (auto s = vision::silhouette_distance(hand_mask_, &distance_, params_.max_carry_px); !s)
-    return s;
+  vision::SilhouetteDistanceOptions dt_options;
+  dt_options.max_distance_px = params_.max_carry_px;  // only pixels the carry can reach
+  dt_options.downsample = 1;                           // exact labels at full resolution
+  if (auto s = vision::silhouette_distance(hand_mask_, &distance_, dt_options); !s) return s;
   const float unmatched = params_.show_unmatched ? 1.f : 0.f;
   const auto margin = static_cast<float>(params_.depth_margin_m);
   const auto max_d = static_cast<float>(params_.max_carry_px);

@@ -16,9 +16,11 @@ namespace {
 std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
 
 /// Largest allowed change of a displayed force between two servo cycles [N]. Contact onset is
-/// the worst case: the fingertip meets a surface the local model learnt of one physics step
-/// late, so the force can rise by k·(depth reached in that step) ≈ 1000 N/m × 3 mm.
-constexpr double kForceJumpBound = 5.0;
+/// the worst case: the fingertip meets a surface the local model learns of only after the next
+/// physics step, so the force can rise by k × (depth reached meanwhile). Measured: 3.2 N on a
+/// quiet machine, 5.5 N with the physics thread a few ms late on a loaded one; bound
+/// 1000 N/m × 8 mm.
+constexpr double kForceJumpBound = 8.0;
 
 TEST(Haptic, ScriptedTwoHandScenarioLiftsTurnsAndFeelsContinuous) {
   const auto cfg = strings::load_device_config(source("configs/spidar8.yaml"));
