@@ -18,13 +18,7 @@ const strings::DeviceConfig& config() {
 }
 
 std::shared_ptr<FingertipSource> hovering() {
-  std::vector<Vec3> rest;
-  for (const auto& f : config().fingers) {
-    Vec3 mean = Vec3::Zero();
-    for (int i = 0; i < f.geometry.n; ++i) mean += f.geometry.p_WA[i];
-    rest.push_back(0.15 * mean / f.geometry.n);
-  }
-  return std::make_shared<ScriptedFingertips>(hovering_hands(rest));
+  return std::make_shared<ScriptedFingertips>(hovering_hands(rest_points(config())));
 }
 
 /// Forces of a few newtons in varying directions, so the tension solver does real work.

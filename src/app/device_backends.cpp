@@ -17,16 +17,10 @@ void add_backend_options(CLI::App& cmd, BackendArgs& a) {
 }
 
 std::unique_ptr<device::Device> make_simulated(const strings::DeviceConfig& cfg, std::uint64_t seed) {
-  std::vector<Vec3> rest;
-  for (const auto& f : cfg.fingers) {
-    Vec3 mean = Vec3::Zero();
-    for (int i = 0; i < f.geometry.n; ++i) mean += f.geometry.p_WA[i];
-    rest.push_back(cfg.p_W_centre + 0.15 * (mean / f.geometry.n - cfg.p_W_centre));
-  }
   device::SimulatedSpidarParams params;
   params.seed = seed;
   params.scale_error = 0.0;
-  auto source = std::make_shared<device::ScriptedFingertips>(device::hovering_hands(rest));
+  auto source = std::make_shared<device::ScriptedFingertips>(device::hovering_hands(device::rest_points(cfg)));
   return std::make_unique<device::SimulatedSpidar>(cfg, params, source);
 }
 

@@ -7,6 +7,17 @@
 
 namespace spidar::device {
 
+std::vector<Vec3> rest_points(const strings::DeviceConfig& config) {
+  std::vector<Vec3> rest;
+  for (const auto& f : config.fingers) {
+    Vec3 mean = Vec3::Zero();
+    for (int i = 0; i < f.geometry.n; ++i) mean += f.geometry.p_WA[i];
+    mean /= f.geometry.n;
+    rest.push_back(config.p_W_centre + 0.15 * (mean - config.p_W_centre));
+  }
+  return rest;
+}
+
 ScriptedFingertips::Script hovering_hands(std::span<const Vec3> p_W_rest) {
   std::vector<Vec3> rest(p_W_rest.begin(), p_W_rest.end());
   return [rest](double t, std::span<Vec3> goal) {

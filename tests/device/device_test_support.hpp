@@ -16,18 +16,6 @@ inline const strings::DeviceConfig& spidar8() {
   return cfg;
 }
 
-/// Rest points a few centimetres from the centre, on each finger's own side.
-inline std::vector<Vec3> rest_points(const strings::DeviceConfig& cfg) {
-  std::vector<Vec3> rest;
-  for (const auto& f : cfg.fingers) {
-    Vec3 mean = Vec3::Zero();
-    for (int i = 0; i < f.geometry.n; ++i) mean += f.geometry.p_WA[i];
-    mean /= f.geometry.n;
-    rest.push_back(cfg.p_W_centre + 0.15 * (mean - cfg.p_W_centre));
-  }
-  return rest;
-}
-
 inline std::shared_ptr<FingertipSource> hovering(const strings::DeviceConfig& cfg) {
   return std::make_shared<ScriptedFingertips>(hovering_hands(rest_points(cfg)));
 }

@@ -5,7 +5,10 @@
 #include <functional>
 #include <span>
 
+#include <vector>
+
 #include "spidar/core/types.hpp"
+#include "spidar/strings/device_config.hpp"
 
 namespace spidar::device {
 
@@ -27,6 +30,10 @@ class ScriptedFingertips final : public FingertipSource {
  private:
   Script script_;
 };
+
+/// A rest point per finger of a device config: 15 % of the way from the frame centre toward the
+/// mean of its fulcrums (each finger's own side of the workspace) [m], world.
+std::vector<Vec3> rest_points(const strings::DeviceConfig& config);
 
 /// Every fingertip circles slowly (radius 1 cm, 0.5 Hz, phase per finger) around a rest point
 /// `offset` from the frame centre toward its own fulcrums' side: a hand hovering in the frame.
