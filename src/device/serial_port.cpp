@@ -117,6 +117,21 @@ unsigned baud_to_speed(int baud) {
   return 0;
 }
 
+namespace {
+
+/// The error for a baud rate termios cannot set, naming the port and the rates it can.
+Error unsupported_baud(const std::string& what, int baud) {
+  std::string msg = what;
+  msg += ": unsupported baud rate ";
+  msg += std::to_string(baud);
+  msg += " (expected a standard rate: 9600, 19200, 38400, 57600, 115200, 230400, 460800, "
+         "500000, 576000, 921600, 1000000, 1152000, 1500000, 2000000, 2500000, 3000000, "
+         "3500000 or 4000000)";
+  return Error{msg};
+}
+
+}  // namespace
+
 Status make_raw(int fd, int baud, const std::string& what) {
   termios t{};
   if (tcgetattr(fd, &t) != 0) {
@@ -134,15 +149,7 @@ Status make_raw(int fd, int baud, const std::string& what) {
   t.c_cc[VTIME] = 0;
   if (baud != 0) {
     const unsigned speed = baud_to_speed(baud);
-    if (speed == 0) {
-      std::string msg = what;
-      msg += ": unsupported baud rate ";
-      msg += std::to_string(baud);
-      msg += " (expected a standard rate: 9600, 19200, 38400, 57600, 115200, 230400, 460800, "
-             "500000, 576000, 921600, 1000000, 1152000, 1500000, 2000000, 2500000, 3000000, "
-             "3500000 or 4000000)";
-      return Error{msg};
-    }
+    if (speed == 0) return unsupported_baud(what, baud);
     cfsetispeed(&t, static_cast<speed_t>(speed));
     cfsetospeed(&t, static_cast<speed_t>(speed));
   }
@@ -180,16 +187,7 @@ void SerialPort::close() {
 Result<SerialPort> SerialPort::open(const std::string& path, int baud) {
   std::string what = "serial port ";
   what += path;
-  if (baud_to_speed(baud) == 0) {
-    // Same message as make_raw gives, before touching the device.
-    std::string msg = what;
-    msg += ": unsupported baud rate ";
-    msg += std::to_string(baud);
-    msg += " (expected a standard rate: 9600, 19200, 38400, 57600, 115200, 230400, 460800, "
-           "500000, 576000, 921600, 1000000, 1152000, 1500000, 2000000, 2500000, 3000000, "
-           "3500000 or 4000000)";
-    return Error{msg};
-  }
+  if (baud_to_speed(baud) == 0) return unsupported_baud(what, baud);  // before touching the device
   const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
     std::string msg = what;
