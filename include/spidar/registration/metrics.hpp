@@ -1,0 +1,23 @@
+#pragma once
+/// Registration metrics against ground truth: silhouette IoU, projected joint error [px],
+/// fingertip error [mm].
+#include <array>
+#include <opencv2/core/mat.hpp>
+
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/vision/camera.hpp"
+
+namespace spidar::registration {
+
+/// |A ∩ B| / |A ∪ B| of two CV_8UC1 masks (non-zero = inside); 1 when both are empty.
+double mask_iou(const cv::Mat& a, const cv::Mat& b);
+
+/// Mean image distance [px] between the projected joints of a fitted and a true hand (all 21
+/// joints; joints behind the camera are skipped).
+double joint_px_error(const hand::HandPoints& fitted, const hand::HandPoints& truth,
+                      const vision::Camera& camera);
+
+/// Mean 3D distance [m] between the four fingertip caps of a fitted and a true hand.
+double fingertip_error_m(const hand::HandPoints& fitted, const hand::HandPoints& truth);
+
+}  // namespace spidar::registration

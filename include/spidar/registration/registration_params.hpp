@@ -1,0 +1,45 @@
+#pragma once
+/// Settings of the successive adjustment (registration/successive_adjustment.hpp).
+///
+/// Units on one scale: every residual is divided by its standard deviation σ, so the cost
+///   J = Σ (fingertip error / σ_tip)² + conf · (wrist error / σ_wrist)² + Σ (joint-ball error / σ_ball)²
+///       [+ Σ (silhouette error / σ_sil)²] + Σ ((θ − θ_prev) / σ_prior)²
+/// is dimensionless. The paper's J = ‖ΔQ‖² + c‖ΔP‖² (eq. 22) is the special case
+/// c = σ_tip² / σ_ball² with ΔQ's wrist entry weighted by σ_tip / σ_wrist [m/px].
+///
+/// configs/registration.yaml holds the same values with their units; every key is optional.
+#include "spidar/core/config.hpp"
+#include "spidar/core/result.hpp"
+
+namespace spidar::registration {
+
+struct RegistrationParams {
+  // --- terms ---
+  double fingertip_sigma_m = 0.0015;  ///< σ of a string-measured fingertip [m]
+  double wrist_sigma_px = 4.0;        ///< σ of the bracelet's projected wrist [px]
+  double joint_ball_sigma_px = 4.0;   ///< σ of a joint-ball target [px]
+  double joint_ball_alpha = 0.5;      ///< α of eq. 21 (dimensionless, 0..1)
+  double ball_radius_scale = 1.0;     ///< ball radius = scale × the bone's projected radius
+  double matte_threshold = 0.5;       ///< a neighbour is "on the silhouette" if alpha ≥ this
+  bool silhouette_term = false;       ///< the distance-transform term (off: the paper's method)
+  double silhouette_sigma_px = 3.0;   ///< σ of a silhouette sample's distance [px]
+  int silhouette_samples_per_bone = 3;  ///< samples along each bone (each gives 3 points)
+  // --- temporal prior (toward the previous frame's parameters) ---
+  double prior_sigma_wrist_m = 0.02;     ///< [m]
+  double prior_sigma_rotation_rad = 0.2; ///< [rad]
+  double prior_sigma_joint_rad = 0.3;    ///< [rad]
+  // --- solver ---
+  double lambda_initial = 1e-3;  ///< Levenberg-Marquardt damping, relative to diag(A)
+  int max_iterations = 10;
+  double cost_epsilon = 1e-3;    ///< stop when J < ε (dimensionless)
+  double step_epsilon = 1e-6;    ///< stop when ‖Δθ‖ < this (mixed m/rad)
+};
+
+/// Error naming the bad field and what was expected (all σ > 0, α in [0, 1], ...).
+Status validate(const RegistrationParams& params);
+
+/// Reads a `registration:` map (every key optional, defaults above). Throws core::ConfigError
+/// naming file:line: key.
+RegistrationParams parse_registration_params(const core::ConfigNode& node);
+
+}  // namespace spidar::registration

@@ -1,0 +1,72 @@
+#pragma once
+/// Successive adjustment of the 17-parameter hand (paper, eqs 22–39) with the improvements a
+/// real-time tracker needs: Levenberg-Marquardt damping, joint limits, a temporal prior and an
+/// optional silhouette (distance-transform) term.
+///
+/// Each iteration linearises every residual r(θ + Δθ) ≈ r(θ) + J Δθ (fingertips from the strings
+/// in 3D, the projected wrist from the bracelet, the joint-ball targets of eq. 21 recomputed at
+/// the current pose, silhouette samples, the prior) and solves
+///   (A + λ diag(A)) Δθ = b,   A = Σ JᵀJ,  b = −Σ Jᵀ r    (eq. 39's Δθ = A⁺ b when λ = 0)
+/// with the residuals divided by their σ (registration_params.hpp), then clamps θ + Δθ into the
+/// joint limits. A step that does not lower the cost is rejected and λ grows ×10; an accepted step
+/// shrinks it ÷10. It stops when J < cost_epsilon, ‖Δθ‖ < step_epsilon or after max_iterations.
+/// Nothing here allocates per frame.
+#include <array>
+#include <opencv2/core/mat.hpp>
+#include <optional>
+
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/registration/joint_balls.hpp"
+#include "spidar/registration/registration_params.hpp"
+#include "spidar/vision/camera.hpp"
+#include "spidar/vision/silhouette.hpp"
+
+namespace spidar::registration {
+
+/// What is measured of one hand in one frame.
+struct HandObservation {
+  std::array<Vec3, hand::kFingertipCount> p_W_fingertip{};  ///< from the strings, world [m]
+  std::array<bool, hand::kFingertipCount> fingertip_valid{};
+  std::optional<Vec2> wrist_px;  ///< projected wrist from the bracelet [px]
+  double wrist_confidence = 1.0; ///< 0..1, multiplies the wrist term's weight
+};
+
+/// The image evidence shared by both hands. Without a camera only the 3D terms and the prior act.
+struct ImageEvidence {
+  const vision::Camera* camera = nullptr;
+  cv::Mat alpha;  ///< CV_32FC1 chroma-key matte, 1 = hand (joint-balls); empty = no joint-balls
+  const vision::SilhouetteDistance* distance = nullptr;  ///< silhouette term; null = off
+};
+
+/// Cost of each term at the final pose (dimensionless, see registration_params.hpp).
+struct TermCosts {
+  double fingertip = 0, wrist = 0, joint_ball = 0, silhouette = 0, prior = 0;
+  double total() const { return fingertip + wrist + joint_ball + silhouette + prior; }
+};
+
+struct FitReport {
+  int iterations = 0;
+  double cost_initial = 0;
+  double cost_final = 0;
+  TermCosts terms;
+  bool converged = false;  ///< stopped by ε (cost or step), not by max_iterations
+};
+
+class SuccessiveAdjustment {
+ public:
+  explicit SuccessiveAdjustment(const RegistrationParams& params = {});
+  const RegistrationParams& params() const { return params_; }
+
+  /// Fits one hand. `params` holds the start (the previous frame's result: warm start) on entry
+  /// and the fit on return; `prior` is the temporal prior's mean (usually the same previous
+  /// result; null = no prior). Never produces NaN: non-finite observations are ignored.
+  FitReport fit(const hand::HandModel& model, const HandObservation& observation,
+                const ImageEvidence& image, const hand::HandParams* prior,
+                hand::HandParams* params) const;
+
+ private:
+  RegistrationParams params_;
+};
+
+}  // namespace spidar::registration
