@@ -131,6 +131,14 @@ Status SimulatedSpidar::read(EncoderReading& out) {
     if (params_.count_noise > 0) count += std::llround(params_.count_noise * noise_(rng_));
     out.counts[k] = static_cast<std::int32_t>(strings::wrap_counter(count, info_.counter_bits));
   }
+  truth_sample_.t_ns = last_ns_;
+  truth_sample_.cycle = reads_++;
+  truth_sample_.finger_count = static_cast<int>(std::min<std::size_t>(x_.size(), kMaxFingers));
+  for (int f = 0; f < truth_sample_.finger_count; ++f) {
+    truth_sample_.p_W[f] = {x_[f].x(), x_[f].y(), x_[f].z()};
+    truth_sample_.f_W[f] = {force_[f].x(), force_[f].y(), force_[f].z()};
+  }
+  truth_ring_.push(truth_sample_);
   return Ok{};
 }
 

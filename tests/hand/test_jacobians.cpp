@@ -243,3 +243,38 @@ TEST(RotationVector, ExpAndLeftJacobian) {
 
 }  // namespace
 }  // namespace spidar::hand
+
+namespace spidar::hand {
+namespace {
+
+// A ground-truth hand's own little finger: its joints follow `little`, not the ring's parameters,
+// and the Jacobians (which have no column for it) still match central differences.
+TEST(JacobianStructure, IndependentLittleFingerMatchesCentralDifferences) {
+  std::mt19937 rng(7);
+  for (auto side : {Side::kLeft, Side::kRight}) {
+    const HandModel m = default_hand_model(side);
+    for (int trial = 0; trial < 5; ++trial) {
+      HandParams q = testing::random_params(m, rng);
+      q.little_independent = true;
+      q.little = Vec3(0.9, -0.1, 0.4);
+      check_3d(m, q);
+      HandParams copy = q;
+      copy.little_independent = false;
+      const HandPoints a = forward_kinematics(m, q);
+      const HandPoints b = forward_kinematics(m, copy);
+      double little_moved = 0;
+      for (int j = 0; j < kJointCount; ++j) {
+        const double d = (a.p_W_joint[j] - b.p_W_joint[j]).norm();
+        if (j >= joint_index(kLittle, 1)) {
+          little_moved = std::max(little_moved, d);
+        } else {
+          EXPECT_EQ(d, 0.0) << joint_name(j);
+        }
+      }
+      EXPECT_GT(little_moved, 1e-3);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace spidar::hand

@@ -17,8 +17,10 @@
 #include <random>
 #include <vector>
 
+#include "spidar/core/seqlock.hpp"
 #include "spidar/device/device.hpp"
 #include "spidar/device/fingertip_source.hpp"
+#include "spidar/device/servo_types.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::device {
@@ -70,8 +72,15 @@ class SimulatedSpidar final : public Device {
 
   /// Advances the simulation by dt [s] (used by read(); public for tests).
   void advance(double dt_s);
-  /// A copy of the ground truth (not for the servo path: allocates).
+  /// A copy of the ground truth (not for the servo path: allocates; not thread-safe while the
+  /// servo thread reads: use truth_samples() then).
   SimulatedTruth truth() const;
+  /// Ground truth as seen at each read(), for other threads (lock-free): up to `max` newest
+  /// samples, newest first, into `out`; returns how many. t_ns is the host time of the read,
+  /// p_W the true cap positions [m], f_W the force the strings apply to each cap [N].
+  std::size_t truth_samples(FingertipSample* out, std::size_t max) const {
+    return truth_ring_.newest(out, max);
+  }
   /// The commands in effect (after clamping and the safe state).
   std::span<const std::int32_t> applied_commands() const { return applied_; }
   /// Sets the over-current flag reported in status_flags (fault injection).
@@ -100,6 +109,9 @@ class SimulatedSpidar final : public Device {
   bool open_ = false, hung_ = false;
   std::atomic<bool> safe_{true}, over_current_{false};
   std::atomic<std::uint32_t> faults_{kFaultNone};
+  FingertipSample truth_sample_;
+  std::uint64_t reads_ = 0;
+  core::SampleRing<FingertipSample, 1024> truth_ring_;
 };
 
 }  // namespace spidar::device

@@ -86,6 +86,12 @@ std::string_view joint_name(int joint);
 /// The 17 parameters of one hand with named access. A plain value type; no invariants.
 struct HandParams {
   ParamVec q = ParamVec::Zero();
+  /// The model's little finger copies the ring finger's parameters. A real hand's does not: with
+  /// `little_independent` the little finger takes `little` = (MCP flexion, MCP abduction, DIP)
+  /// [rad] instead (ground-truth users of the simulated rig). Not a fitted parameter: Jacobians
+  /// have no column for it.
+  bool little_independent = false;
+  Vec3 little = Vec3::Zero();
 
   Vec3 p_W_wrist() const { return q.segment<3>(kWristX); }
   Vec3 r_W_hand() const { return q.segment<3>(kWristRotX); }
