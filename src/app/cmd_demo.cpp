@@ -11,12 +11,27 @@ Action add_demo(CLI::App& app) {
   auto* cmd = app.add_subcommand("demo", "Run a demonstration on the simulated SPIDAR-8");
   auto o = std::make_shared<DemoOptions>();
   cmd->add_option("--scenario", o->scenario,
-                  "haptic: two hands lift the Rubik's cube and turn a layer; strings: the device "
-                  "maths walkthrough")
-      ->check(CLI::IsMember({"haptic", "strings"}))
+                  "rubiks: the mixed-reality demo (device, physics, camera, registration, "
+                  "compositing); haptic: the haptic part alone; strings: the device maths "
+                  "walkthrough")
+      ->check(CLI::IsMember({"rubiks", "haptic", "strings"}))
       ->capture_default_str();
   cmd->add_option("--config", o->config, "device config (YAML)")->capture_default_str();
-  cmd->add_option("--scene", o->scene, "MJCF scene (haptic)")->capture_default_str();
+  cmd->add_option("--scene", o->scene, "MJCF scene (rubiks, haptic)")->capture_default_str();
+  cmd->add_option("--user-hand", o->user_hand,
+                  "hands YAML of the simulated user (profile 'user', else the first)")
+      ->capture_default_str();
+  cmd->add_option("--camera", o->camera, "camera YAML (rubiks)")->capture_default_str();
+  cmd->add_option("--width", o->width, "camera image width [px]")->capture_default_str();
+  cmd->add_option("--height", o->height, "camera image height [px]")->capture_default_str();
+  cmd->add_option("--fps", o->fps, "camera rate [Hz]")->capture_default_str();
+  cmd->add_flag("--window", o->window, "show the mixed-reality view in a window");
+  cmd->add_option("--compositor", o->compositor, "paper: the paper's cut-outs; depth: matte + model depth")
+      ->check(CLI::IsMember({"paper", "depth"}))
+      ->capture_default_str();
+  cmd->add_flag("--silhouette", o->silhouette,
+                "register with the silhouette term too (default: the paper's joint-balls)");
+  cmd->add_flag("!--no-video", o->video, "do not write mixed_reality.mp4");
   cmd->add_option("--out", o->out, "output directory")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "length [s] (0: the scenario's own)");
   cmd->add_option("--rate", o->rate_hz, "servo rate [Hz]")->capture_default_str();
@@ -24,7 +39,12 @@ Action add_demo(CLI::App& app) {
   return [o] {
     if (o->seconds < 0 || o->seconds > 600) throw UsageError("--seconds: expected 0 to 600");
     if (!(o->rate_hz >= 10 && o->rate_hz <= 20000)) throw UsageError("--rate: expected 10 to 20000 Hz");
-    return o->scenario == "strings" ? run_strings_demo(*o) : run_haptic_demo(*o);
+    if (o->width < 64 || o->width > 3840 || o->height < 48 || o->height > 2160)
+      throw UsageError("--width/--height: expected 64..3840 x 48..2160 px");
+    if (!(o->fps >= 1 && o->fps <= 240)) throw UsageError("--fps: expected 1 to 240 Hz");
+    if (o->scenario == "strings") return run_strings_demo(*o);
+    if (o->scenario == "haptic") return run_haptic_demo(*o);
+    return run_mr_demo(*o);
   };
 }
 

@@ -6,18 +6,31 @@
 namespace spidar::app {
 
 struct DemoOptions {
-  std::string scenario = "haptic";  ///< haptic | strings
+  std::string scenario = "rubiks";  ///< rubiks | haptic | strings
   std::string config = "configs/spidar8.yaml";
   std::string scene = "scenes/rubiks_cube.xml";
   std::string out = "out/demo";
   double seconds = 0;               ///< 0: the scenario's own length
   double rate_hz = 1000.0;
   std::uint64_t seed = 1;
+  // rubiks (the mixed-reality demo)
+  std::string user_hand = "configs/hands.yaml";  ///< the simulated user's hands (profile "user")
+  std::string user_profile = "user";
+  std::string camera = "configs/camera.yaml";
+  int width = 640, height = 480;   ///< camera image [px]
+  double fps = 30.0;               ///< camera rate [Hz]
+  bool window = false;
+  std::string compositor = "depth";
+  bool silhouette = false;         ///< the silhouette term in the main registration
+  bool video = true;
 };
 
 /// The left hand lifts the Rubik's cube, the right hand turns its top layer (simulated device,
 /// servo loop, physics thread).
 int run_haptic_demo(const DemoOptions& o);
+/// The mixed-reality demo (`make demo`): the scripted user turns the cube's layers with both
+/// hands; simulated device, physics, synthetic camera, registration, rendering, compositing.
+int run_mr_demo(const DemoOptions& o);
 /// The device maths walkthrough: calibration, force cones, a scripted grasp of a virtual box.
 int run_strings_demo(const DemoOptions& o);
 

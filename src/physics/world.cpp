@@ -1,5 +1,7 @@
 #include "spidar/physics/world.hpp"
 
+#include <algorithm>
+
 #include <mujoco/mujoco.h>
 
 #include <cmath>
@@ -194,12 +196,14 @@ void World::update_proxy_states() {
   }
 }
 
-void World::snapshot(SceneSnapshot& out) const {
+void World::snapshot(SceneSnapshot& out, bool include_proxies) const {
   out.t_s = data_->time;
   out.meshes = meshes_;
   out.shapes.clear();
   for (int g = 0; g < model_->ngeom; ++g) {
     if (model_->geom_rgba[4 * g + 3] <= 0.0f) continue;
+    if (!include_proxies &&
+        std::find(proxy_geom_.begin(), proxy_geom_.end(), g) != proxy_geom_.end()) continue;
     Shape s;
     const double* size = model_->geom_size + 3 * g;
     s.size = Vec3(size[0], size[1], size[2]);

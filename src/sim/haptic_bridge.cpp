@@ -130,7 +130,7 @@ void PhysicsThread::run() {
     }
     if (placed) bridge_.proxies().publish(frame);
     if (step % snapshot_every_ == 0) {
-      world_.snapshot(snapshots_.back());
+      world_.snapshot(snapshots_.back(), snapshot_proxies_);
       snapshots_.publish();
     }
     deadline += period;

@@ -120,11 +120,16 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
   // Ground truth at `poses`.
   cv::compare(s.targets.hand_id, 0, out->mask, cv::CMP_GT);
   out->hand_index.create(out->mask.size(), CV_8UC1);
+  out->hand_only.create(out->mask.size(), CV_8UC1);
   for (int y = 0; y < out->mask.rows; ++y) {
     const std::uint8_t* id = s.targets.hand_id.ptr<std::uint8_t>(y);
     std::uint8_t* hi = out->hand_index.ptr<std::uint8_t>(y);
-    for (int x = 0; x < out->mask.cols; ++x)
-      hi[x] = id[x] == 0 ? 0 : static_cast<std::uint8_t>(render::decode_hand_id(id[x]).hand + 1);
+    std::uint8_t* ho = out->hand_only.ptr<std::uint8_t>(y);
+    for (int x = 0; x < out->mask.cols; ++x) {
+      const render::HandId d = render::decode_hand_id(id[x]);
+      hi[x] = id[x] == 0 ? 0 : static_cast<std::uint8_t>(d.hand + 1);
+      ho[x] = id[x] != 0 && d.finger != kBraceletPart && d.finger != kForearmPart ? 255 : 0;
+    }
   }
   s.targets.hand_depth.copyTo(out->depth);
 

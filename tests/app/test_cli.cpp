@@ -195,3 +195,83 @@ TEST(Cli, DeviceTestOverAPtyServedByEmulateDevice) {
 }
 
 }  // namespace
+
+namespace {
+
+nlohmann::json read_json(const std::string& path) {
+  FILE* f = fopen(path.c_str(), "r");
+  if (f == nullptr) return {};
+  std::string text;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), f)) text += buf.data();
+  fclose(f);
+  return nlohmann::json::parse(text, nullptr, false);
+}
+
+bool exists(const std::string& path) {
+  FILE* f = fopen(path.c_str(), "r");
+  if (f) fclose(f);
+  return f != nullptr;
+}
+
+// The mixed-reality demo end to end, short and small: the hands approach, grasp and lift the
+// cube (the turns come later in the script). Everything runs: simulated device, servo loop,
+// physics, synthetic camera, registration of both hands, rendering, both composites, video.
+TEST(Cli, MixedRealityDemoRunsEndToEnd) {
+  const std::string dir = ::testing::TempDir() + "spidar_mr_demo_" + std::to_string(getpid());
+  auto r = run("demo --seconds 3 --width 320 --height 240 --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("registration"), std::string::npos);
+  const auto j = read_json(dir + "/report.json");
+  ASSERT_TRUE(j.is_object()) << "no report.json";
+  EXPECT_GE(j["frames"].get<int>(), 20);  // 30 fps for ~3 s, some may be dropped on a loaded VM
+  EXPECT_DOUBLE_EQ(j["seconds"].get<double>(), 3.0);
+  EXPECT_GT(j["haptic"]["rate_hz"].get<double>(), 900.0);
+  EXPECT_GT(j["physics"]["step_ms_median"].get<double>(), 0.0);
+  const auto& reg = j["registration"];
+  EXPECT_GT(reg["iou_mean"].get<double>(), 0.75);
+  EXPECT_LT(reg["fingertip_mm_mean"].get<double>(), 5.0);
+  EXPECT_LT(reg["joint_px_mean"].get<double>(), 8.0);
+  EXPECT_GT(reg["iterations_mean"].get<double>(), 0.0);
+  EXPECT_TRUE(reg["comparison"].is_object());
+  const auto& c = j["composite"];
+  EXPECT_LT(c["occlusion_error_pct"].get<double>(), c["occlusion_error_pct_paper"].get<double>());
+  EXPECT_GT(j["pipeline"]["fps"].get<double>(), 5.0);
+  EXPECT_TRUE(j["cube"]["present"].get<bool>());
+  EXPECT_EQ(j["cube"]["turns_completed"].get<int>(), 0);  // no turn within 3 s
+  EXPECT_TRUE(exists(dir + "/registration_error.png"));
+  EXPECT_TRUE(exists(dir + "/fingertip_forces.png"));
+  EXPECT_TRUE(exists(dir + "/loop_timing.png"));
+  EXPECT_TRUE(exists(j["video"]["path"].get<std::string>()));
+  EXPECT_TRUE(exists(dir + "/keyframes/keyframe_1_t01.9s.png") ||
+              exists(dir + "/keyframes/keyframe_1_t02.0s.png"));
+}
+
+TEST(Cli, MixedRealityDemoRejectsBadSceneAndHandFiles) {
+  const std::string dir = ::testing::TempDir() + "spidar_mr_bad_" + std::to_string(getpid());
+  // A scene that is not MJCF.
+  const std::string bad_scene = dir + "_scene.xml";
+  FILE* f = fopen(bad_scene.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fputs("<mujoco><worldbody><geom type=\"box\" size=\"1\"/></mujoco>\n", f);
+  fclose(f);
+  auto r = run("demo --seconds 1 --no-video --scene " + bad_scene + " --out " + dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--scene"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(bad_scene), std::string::npos) << r.err;
+  // A hands file with a hand far too short: file:line: key and what was expected.
+  const std::string bad_hand = dir + "_hands.yaml";
+  f = fopen(bad_hand.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fputs("hands:\n  - name: user\n    length: 0.05\n    width: 0.08\n", f);
+  fclose(f);
+  r = run("demo --seconds 1 --no-video --user-hand " + bad_hand + " --out " + dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(bad_hand), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("length"), std::string::npos) << r.err;
+  r = run("demo --seconds 1 --no-video --user-hand /nonexistent/hands.yaml --out " + dir);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("/nonexistent/hands.yaml"), std::string::npos) << r.err;
+}
+
+}  // namespace

@@ -63,7 +63,9 @@ class World {
   const std::string& scene_path() const { return scene_path_; }
 
   /// Fills a snapshot (reusing its storage): every visible geom with its pose and colour.
-  void snapshot(SceneSnapshot& out) const;
+  /// Without `include_proxies` the fingertip proxies are left out (a mixed-reality view shows the
+  /// real fingers instead).
+  void snapshot(SceneSnapshot& out, bool include_proxies = true) const;
 
   /// Body/joint lookup for scene-specific code (−1 if absent).
   int body_id(const std::string& name) const;

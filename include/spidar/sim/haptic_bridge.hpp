@@ -93,6 +93,8 @@ class PhysicsThread {
   void start();
   void stop();
   void set_before_step(std::function<void(physics::World&)> fn) { before_step_ = std::move(fn); }
+  /// Whether snapshots show the fingertip proxies (default yes; set before start()).
+  void set_snapshot_proxies(bool on) { snapshot_proxies_ = on; }
   /// Renderer side: true and the newest snapshot in `snapshots().front()` if there is a new one.
   core::TripleBuffer<SceneSnapshot>& snapshots() { return snapshots_; }
   /// Complete once stopped.
@@ -105,6 +107,7 @@ class PhysicsThread {
   double rate_hz_;
   int snapshot_every_;
   std::function<void(physics::World&)> before_step_;
+  bool snapshot_proxies_ = true;
   core::TripleBuffer<SceneSnapshot> snapshots_;
   std::vector<double> step_ms_;
   std::int64_t t0_ = 0, t1_ = 0;

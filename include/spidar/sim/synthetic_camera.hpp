@@ -47,6 +47,8 @@ struct SyntheticFrame {
   cv::Mat bgr;         ///< CV_8UC3, what the camera sees
   cv::Mat mask;        ///< CV_8UC1, 255 where a hand, bracelet or forearm is in front of the screen
   cv::Mat hand_index;  ///< CV_8UC1, 0 screen, 1 left hand, 2 right hand (incl. its bracelet/arm)
+  cv::Mat hand_only;   ///< CV_8UC1, 255 where the hand itself (palm, digits) is in front: no
+                       ///< bracelet, no forearm (what a hand model should cover)
   cv::Mat depth;       ///< CV_32FC1 z_C [m] of the ground-truth surface; +inf on the screen
 };
 

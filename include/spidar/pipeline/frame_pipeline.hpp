@@ -1,0 +1,92 @@
+#pragma once
+/// The frame thread's work for one camera frame (DESIGN.md, "The flow of one session"):
+///
+///   camera frame ─► chroma key (matte, silhouette) ─► bracelets (projected wrists)
+///                                  │                       │
+///   fingertip sample at the frame's exposure time ─► successive adjustment of both hands
+///                                                          │
+///   scene snapshot + fitted hands ─► render (colour, depth, hand depth) ─► compositor ─► output
+///
+/// The same code runs on the simulated rig (synthetic camera) and on a real camera. It keeps the
+/// previous frame's hands (warm start, temporal prior, bracelet prediction). Not thread-safe: one
+/// pipeline per frame thread, whose GL context must be current.
+#include <array>
+#include <memory>
+#include <opencv2/core/mat.hpp>
+
+#include "spidar/core/result.hpp"
+#include "spidar/core/scene_snapshot.hpp"
+#include "spidar/device/servo_types.hpp"
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/registration/successive_adjustment.hpp"
+#include "spidar/render/compositor.hpp"
+#include "spidar/render/context.hpp"
+#include "spidar/render/renderer.hpp"
+#include "spidar/vision/bracelet.hpp"
+#include "spidar/vision/camera.hpp"
+#include "spidar/vision/chroma_key.hpp"
+
+namespace spidar::pipeline {
+
+struct FramePipelineParams {
+  vision::ChromaKeyParams chroma_key;
+  vision::BraceletParams bracelet;
+  registration::RegistrationParams registration;
+  render::CompositorParams compositor;  ///< its mode makes `composite`
+  bool other_composite = true;          ///< also compose in the other mode (for comparison)
+  int silhouette_margin_px = 40;        ///< distance-transform margin (silhouette term only)
+  int first_frame_rounds = 6;           ///< registration rounds on the first frame (cold start)
+  /// Hand rotations to start from on the first frame (rotation vectors, world) [rad].
+  std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};
+  /// Device finger index of each hand's thumb, index, middle, ring (the config's order).
+  std::array<std::array<int, 4>, 2> fingers{{{0, 1, 2, 3}, {4, 5, 6, 7}}};
+};
+
+/// Wall-clock cost of each stage [ms].
+struct FrameTimings {
+  double key_ms = 0, bracelet_ms = 0, distance_ms = 0, registration_ms = 0, render_ms = 0,
+         composite_ms = 0, total_ms = 0;
+};
+
+struct FrameResult {
+  std::array<hand::HandParams, 2> hands;                ///< fitted (left, right)
+  std::array<registration::FitReport, 2> fits;
+  std::array<vision::BraceletObservation, 2> bracelets;
+  vision::ChromaKeyResult key;
+  render::RenderTargets virt;   ///< the virtual scene with the fitted hands (hidden)
+  cv::Mat composite;            ///< in params.compositor.mode
+  cv::Mat composite_alpha;      ///< CV_32FC1, share of the real image in `composite`
+  cv::Mat other;                ///< the other mode (if other_composite)
+  cv::Mat other_alpha;
+  FrameTimings timings;
+};
+
+class FramePipeline {
+ public:
+  /// `models`: the registration's hand models (left, right). Error on invalid params.
+  static Result<std::unique_ptr<FramePipeline>> create(render::Context& context,
+                                                       const vision::Camera& camera,
+                                                       const std::array<hand::HandModel, 2>& models,
+                                                       const FramePipelineParams& params);
+  ~FramePipeline();
+  FramePipeline(const FramePipeline&) = delete;
+  FramePipeline& operator=(const FramePipeline&) = delete;
+
+  /// Processes one frame: `bgr` the camera image (camera's size), `fingertips` the servo sample
+  /// at its exposure time, `scene` the virtual world. Error on a bad frame (naming what).
+  Status process(const cv::Mat& bgr, const device::FingertipSample& fingertips,
+                 const SceneSnapshot& scene, FrameResult* out);
+  /// Shows an image (e.g. the composite) in the window of `context` (error when headless).
+  Status present(render::Context& context, const cv::Mat& bgr);
+  /// Forgets the previous frame (the next one is a cold start).
+  void reset();
+  const FramePipelineParams& params() const;
+  const std::array<hand::HandModel, 2>& models() const;
+
+ private:
+  struct Impl;
+  explicit FramePipeline(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spidar::pipeline

@@ -1,0 +1,47 @@
+#pragma once
+/// Ground-truth measures of one processed frame of the simulated rig: how well the fitted hands
+/// cover the real ones (silhouette IoU), where their joints and fingertips are, and how often each
+/// composite shows or hides the real hands where the truth would not.
+#include <array>
+#include <opencv2/core/mat.hpp>
+
+#include "spidar/core/result.hpp"
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/vision/camera.hpp"
+
+namespace spidar::sim {
+
+struct FrameTruthMetrics {
+  double iou = 0;                     ///< fitted hands' pixels vs the real hands' (no bracelet/arm)
+  std::array<double, 2> fingertip_mm{};  ///< mean fingertip cap error per hand [mm]
+  std::array<double, 2> joint_px{};      ///< mean projected joint error per hand [px]
+  double occlusion_pct = 0;        ///< depth-mode composite vs the truth [% of the hand region]
+  double occlusion_pct_paper = 0;  ///< paper-mode composite vs the truth [%]
+};
+
+/// Reusable buffers.
+struct FrameTruthWorkspace {
+  cv::Mat model_mask, truth_alpha, region, tmp;
+};
+
+/// Measures `result` (which must hold both composites: FramePipelineParams::other_composite)
+/// against the frame's ground truth. `models`: the registration's hands; `truth_models` and
+/// `truth`: the user's. Error if a composite is missing.
+Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
+                                        const pipeline::FrameResult& result,
+                                        render::CompositeMode main_mode,
+                                        const std::array<hand::HandModel, 2>& models,
+                                        const std::array<hand::HandModel, 2>& truth_models,
+                                        const std::array<hand::HandParams, 2>& truth,
+                                        const vision::Camera& camera, FrameTruthWorkspace* ws);
+
+/// A 2×2 keyframe for the report: the camera frame | the matte with the fitted hands' wireframe
+/// and bracelet wrists, the depth composite | the paper composite, each labelled, with `caption`.
+cv::Mat keyframe_montage(const cv::Mat& camera_bgr, const pipeline::FrameResult& result,
+                         render::CompositeMode main_mode,
+                         const std::array<hand::HandModel, 2>& models,
+                         const vision::Camera& camera, const std::string& caption);
+
+}  // namespace spidar::sim

@@ -1,0 +1,64 @@
+#pragma once
+/// The scripted user of the mixed-reality demo: both hands perform the Rubik's cube task.
+///
+///   0.0 – 1.0  hands approach           1.0 – 2.0  both hands close on the cube
+///   2.0 – 3.0  lift: the left hand holds the two lower layers, the right hand the top layer
+///   3.0 – 5.0  turn 1: the right hand turns the top layer by +turn about +z (past 90°, clicks)
+///   5.0 – 5.7  the right hand lets go    5.7 – 6.5  it goes back    6.5 – 7.2  it grasps again
+///   7.2 – 9.2  turn 2: the top layer by −turn (back past 0°: the cube is solved again)
+///   9.2 – 9.9  the right hand lets go    9.9 – 10.6 the left hand sets the cube down
+///  10.6 – 11.3 both hands open          11.3 – 12.0 both hands withdraw
+///
+/// It gives the eight fingertip goals (left thumb, index, middle, ring, then right; the simulated
+/// device's FingertipSource) and, per hand, a nominal hand pose that goes with them (wrist pose
+/// and a relaxed grip), which sim::UserHands uses as the prior of the user's hand posture.
+/// Goals lie `squeeze` inside the faces, so the fingertips' impedance sets the grip force.
+/// In a scene without a cube, p_W_cube and half describe the object to reach for (any box-like
+/// object): the same motions then grasp, push and turn it.
+#include <span>
+
+#include "spidar/core/types.hpp"
+#include "spidar/device/fingertip_source.hpp"
+#include "spidar/hand/parameters.hpp"
+
+namespace spidar::sim {
+
+struct RubiksTaskParams {
+  Vec3 p_W_cube = Vec3::Zero();  ///< cube centre at the start [m]
+  double half = 0.0285;          ///< half the cube's size [m]
+  double pitch = 0.019;          ///< layer pitch [m]
+  double proxy_radius = 0.008;   ///< [m]
+  double squeeze = 0.012;        ///< goal depth inside the faces [m]
+  double lift = 0.02;            ///< [m]
+  double withdraw = 0.06;        ///< how far the hands start and end away from the grasp [m]
+  double turn = 1.75;            ///< [rad] per turn, past 90° so that the detent finishes the click
+  double duration = 12.0;        ///< [s]
+};
+
+class RubiksTask final : public device::FingertipSource {
+ public:
+  explicit RubiksTask(RubiksTaskParams p) : p_(p) {}
+  /// Goals of the eight fingertips at time t [s] (world, m).
+  void goals(double t_s, std::span<Vec3> p_W_goal) override;
+  /// The nominal pose of one hand at time t (wrist in world, relaxed finger angles).
+  hand::HandParams nominal(double t_s, hand::Side side) const;
+  /// Name of the phase at time t (progress output).
+  static const char* phase(double t_s);
+  /// Layer turns the script performs (completed when the detent clicks).
+  static constexpr int kTurns = 2;
+  const RubiksTaskParams& params() const { return p_; }
+
+ private:
+  struct HandState {
+    Vec3 offset = Vec3::Zero();  ///< fingertip displacement from the grasp, cube frame [m]
+    double yaw = 0;              ///< rotation of the hand about the cube's vertical axis [rad]
+    double lift = 0;             ///< [m]
+  };
+  HandState state(double t_s, hand::Side side, int finger) const;
+  /// 0 = hand open, 1 = closed on the grasp.
+  static double closeness(double t_s, hand::Side side);
+  void goals_at(double t_s, std::span<Vec3> p_W_goal) const;
+  RubiksTaskParams p_;
+};
+
+}  // namespace spidar::sim

@@ -1,0 +1,399 @@
+// spidar-mr demo (rubiks scenario, `make demo`): the whole mixed-reality system on the simulated
+// rig. A scripted user with their own hands turns the Rubik's cube's top layer twice with the
+// right hand while the left hand holds the cube; the simulated SPIDAR-8 measures the fingertips
+// and displays the contact forces (servo thread ↔ physics thread); a synthetic camera films the
+// real hands over the blue screen; the frame loop fits both model hands to the strings and the
+// image, renders the virtual world, composites the real hands into it, and measures everything
+// against the ground truth.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "cli_support.hpp"
+#include "demo.hpp"
+#include "demo_mr_report.hpp"
+#include "progress.hpp"
+#include "spidar/core/clock.hpp"
+#include "spidar/device/sample_interpolation.hpp"
+#include "spidar/device/servo_loop.hpp"
+#include "spidar/device/simulated_spidar.hpp"
+#include "spidar/hand/hand_config.hpp"
+#include "spidar/hand/render_geometry.hpp"
+#include "spidar/physics/rubiks_cube.hpp"
+#include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/render/video_output.hpp"
+#include "spidar/sim/frame_truth.hpp"
+#include "spidar/sim/haptic_bridge.hpp"
+#include "spidar/sim/rubiks_task.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/sim/user_hands.hpp"
+#include "spidar/vision/camera_config.hpp"
+#include "spidar/vision/vision_config.hpp"
+
+namespace spidar::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The cube (or, in another scene, the object the user reaches for) as the physics thread sees it.
+struct CubeStatus {
+  double t_s = 0;
+  double lift = 0;
+  double u_angle = 0;
+  int turns = 0;
+  bool solved = true;
+  int contacts = 0;
+};
+
+/// Counts completed quarter turns of any face: a layer that settles (within 3°) at another
+/// quarter than before.
+class TurnCounter {
+ public:
+  void update(const physics::RubiksCube& cube) {
+    static constexpr char kFaces[6] = {'U', 'D', 'F', 'B', 'R', 'L'};
+    for (int f = 0; f < 6; ++f) {
+      const double a = cube.face_angle(kFaces[f]);
+      if (std::abs(cube.face_misalignment(kFaces[f])) > 0.05) continue;
+      const int q = static_cast<int>(std::lround(a / (M_PI / 2)));
+      if (q != quarter_[f]) {
+        turns_ += std::abs(q - quarter_[f]);
+        quarter_[f] = q;
+      }
+    }
+  }
+  int turns() const { return turns_; }
+
+ private:
+  std::array<int, 6> quarter_{};
+  int turns_ = 0;
+};
+
+vision::Camera scaled_camera(const vision::Camera& c, int w, int h) {
+  vision::Intrinsics k = c.intrinsics();
+  const double sx = static_cast<double>(w) / k.width, sy = static_cast<double>(h) / k.height;
+  k.fx *= sx;
+  k.fy *= sy;
+  k.cx = (k.cx + 0.5) * sx - 0.5;
+  k.cy = (k.cy + 0.5) * sy - 0.5;
+  k.width = w;
+  k.height = h;
+  return vision::Camera(k, c.X_CW());
+}
+
+std::array<hand::HandModel, 2> user_models(const std::string& path, const std::string& profile) {
+  const hand::HandProfiles profiles = hand::load_hand_profiles(path);  // throws ConfigError
+  const hand::HandProfile* p = profiles.find(profile);
+  if (p == nullptr) {
+    if (profiles.profiles.empty()) throw UsageError("--user-hand " + path + ": no hand profiles");
+    p = &profiles.profiles.front();
+  }
+  return {p->model(hand::Side::kLeft), p->model(hand::Side::kRight)};
+}
+
+/// Where the scripted user reaches in a scene without a cube: the non-static object nearest the
+/// frame centre (its centre and half size), else the centre itself.
+void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
+  double best = 1e9;
+  for (const Shape& s : scene.shapes) {
+    if (s.body <= 0 || s.hand >= 0) continue;
+    const double d = s.X_WS.p.norm();
+    if (d < best) {
+      best = d;
+      tp->p_W_cube = s.X_WS.p;
+      tp->half = std::clamp(s.size.maxCoeff(), 0.01, 0.05);
+      tp->pitch = tp->half * 2.0 / 3.0;
+    }
+  }
+}
+
+std::array<Vec3, 8> caps_of(const device::FingertipSample& s) {
+  std::array<Vec3, 8> c;
+  for (int f = 0; f < 8; ++f) c[f] = Vec3(s.p_W[f][0], s.p_W[f][1], s.p_W[f][2]);
+  return c;
+}
+
+}  // namespace
+
+int run_mr_demo(const DemoOptions& o) {
+  // --- inputs (all checked before anything starts) ---
+  const auto cfg = strings::load_device_config(resolve_data_path(o.config));
+  if (cfg.fingers.size() != 8) throw UsageError("--config: the rubiks demo needs 8 fingers");
+  const std::string scene_path = resolve_data_path(o.scene);
+  const std::string hand_path = resolve_data_path(o.user_hand);
+  const auto truth_models = user_models(hand_path, o.user_profile);
+  const std::array<hand::HandModel, 2> models{hand::default_hand_model(hand::Side::kLeft),
+                                              hand::default_hand_model(hand::Side::kRight)};
+  const vision::Camera camera = scaled_camera(
+      vision::load_camera_file(resolve_data_path(o.camera)).camera, o.width, o.height);
+  const auto vision_cfg = vision::load_vision_config(resolve_data_path("configs/vision.yaml"));
+  const auto reg_root = core::ConfigNode::LoadFile(resolve_data_path("configs/registration.yaml"));
+  const auto reg_params = registration::parse_registration_params(reg_root["registration"]);
+  auto mode = render::parse_composite_mode(o.compositor);
+  if (!mode) throw UsageError("--compositor: " + mode.error().message);
+
+  physics::WorldParams wp;
+  auto world_r = physics::World::Load(scene_path, wp);
+  if (!world_r) throw UsageError("--scene: " + world_r.error().message);
+  auto world = std::move(world_r).value();
+  auto cube_r = physics::RubiksCube::Attach(*world);
+  std::optional<physics::RubiksCube> cube;
+  if (cube_r) cube = std::move(cube_r).value();
+  fs::create_directories(o.out);
+  fs::create_directories(fs::path(o.out) / "keyframes");
+
+  sim::RubiksTaskParams tp;
+  tp.proxy_radius = wp.proxy.radius;
+  Pose X_cube0;
+  if (cube) {
+    X_cube0 = cube->core_pose();
+    tp.p_W_cube = X_cube0.p;
+  } else {
+    SceneSnapshot s0;
+    world->snapshot(s0, false);
+    reach_target(s0, &tp);
+    X_cube0.p = tp.p_W_cube;
+  }
+  auto task = std::make_shared<sim::RubiksTask>(tp);
+  const double seconds = o.seconds > 0 ? o.seconds : tp.duration;
+
+  // --- threads: simulated device ↔ servo loop ↔ physics ---
+  device::SimulatedSpidarParams dp;
+  dp.seed = o.seed;
+  device::SimulatedSpidar dev(cfg, dp, task);
+  device::ServoConfig servo;
+  servo.rate_hz = o.rate_hz;
+  servo.force_timeout_s = 0.05;
+  auto bridge = std::make_shared<sim::HapticForces>(wp.coupling, servo.rate_hz);
+  sim::PhysicsThread physics(*world, *bridge);
+  physics.set_snapshot_proxies(false);
+  core::Latest<CubeStatus> cube_status;
+  TurnCounter turns;
+  physics.set_before_step([&](physics::World& w) {
+    CubeStatus s;
+    s.t_s = w.time();
+    s.contacts = w.contact_count();
+    if (cube) {
+      s.lift = cube->core_pose().p.z() - X_cube0.p.z();
+      s.u_angle = cube->face_angle('U');
+      turns.update(*cube);
+      s.turns = turns.turns();
+      s.solved = cube->is_solved();
+    }
+    cube_status.publish(s);
+  });
+  device::ServoLoop loop(dev, cfg, servo, bridge);
+
+  // --- the frame side: GL, synthetic camera, user hands, pipeline ---
+  auto ctx_r = o.window ? render::Context::create_window({o.width, o.height, "spidar-mr demo"})
+                        : render::Context::create_headless();
+  if (!ctx_r) throw SpidarError("OpenGL: " + ctx_r.error().message);
+  auto context = std::move(ctx_r).value();
+  sim::SyntheticCameraParams cam_params;
+  cam_params.seed = o.seed;
+  auto film_r = sim::SyntheticCamera::create(*context, camera, truth_models, cam_params);
+  if (!film_r) throw SpidarError(film_r.error().message);
+  auto film = std::move(film_r).value();
+  sim::UserHands user(truth_models, *task);
+
+  pipeline::FramePipelineParams pp;
+  pp.chroma_key = vision_cfg.chroma_key;
+  pp.bracelet = vision_cfg.bracelet;
+  pp.registration = reg_params;
+  pp.registration.silhouette_term = o.silhouette;
+  pp.compositor.mode = *mode;
+  for (int h = 0; h < 2; ++h) {
+    const auto n = task->nominal(0.0, h == 0 ? hand::Side::kLeft : hand::Side::kRight);
+    pp.initial_r_W_hand[h] = n.r_W_hand();
+  }
+  auto pipe_r = pipeline::FramePipeline::create(*context, camera, models, pp);
+  if (!pipe_r) throw UsageError(pipe_r.error().message);
+  auto pipe = std::move(pipe_r).value();
+  // The comparison: the same registration with the silhouette term switched the other way.
+  pipeline::FramePipelineParams pp_alt = pp;
+  pp_alt.registration.silhouette_term = !o.silhouette;
+  pp_alt.other_composite = false;
+  auto alt_r = pipeline::FramePipeline::create(*context, camera, models, pp_alt);
+  if (!alt_r) throw UsageError(alt_r.error().message);
+  auto alt = std::move(alt_r).value();
+
+  std::unique_ptr<render::VideoOutput> video;
+  if (o.video) {
+    auto v = render::VideoOutput::open((fs::path(o.out) / "mixed_reality.mp4").string(), o.width,
+                                       o.height, o.fps);
+    if (!v) throw SpidarError(v.error().message);
+    video = std::move(v).value();
+  }
+
+  std::cout << "spidar-mr demo: mixed-reality Rubik's cube on a simulated " << cfg.name << "\n"
+            << "  scene " << scene_path << (cube ? "" : " (no cube: reaching for the nearest object)")
+            << "\n  user hands '" << o.user_profile << "' from " << hand_path << " ("
+            << truth_models[0].shape.dimensions.length * 1e3 << " mm; model "
+            << models[0].shape.dimensions.length * 1e3 << " mm), camera " << o.width << "x"
+            << o.height << " at " << o.fps << " fps, compositor " << o.compositor
+            << ", registration " << (o.silhouette ? "joint-balls + silhouette" : "joint-balls (paper)")
+            << "\n  servo " << servo.rate_hz << " Hz, physics " << 1.0 / world->timestep()
+            << " Hz in its own thread\n\n";
+
+  // --- run ---
+  if (auto st = dev.open(); !st.ok()) throw UsageError(st.error().message);
+  const std::int64_t t_open = core::monotonic_ns();
+  physics.start();
+  if (auto st = loop.start(); !st.ok()) throw UsageError(st.error().message);
+
+  const auto period_ns = static_cast<std::int64_t>(1e9 / o.fps);
+  std::vector<device::FingertipSample> servo_buf(1000), truth_buf(1000);
+  SceneSnapshot scene;
+  sim::SyntheticFrame frame;
+  pipeline::FrameResult result, alt_result;
+  sim::FrameTruthWorkspace ws;
+  MrTrace trace;
+  Progress progress(seconds, std::cerr);
+  const std::array<double, 5> keyframe_times{1.9, 3.0, 4.5, 8.5, 10.2};
+  std::size_t next_keyframe = 0;
+  int dropped = 0;
+  std::int64_t t_exp = t_open + period_ns;
+  std::int64_t last_servo_t = 0;
+
+  while (loop.running()) {
+    // The frame's exposure time; wait until the servo has samples past it.
+    const std::int64_t ready = t_exp + 2'000'000;
+    core::sleep_until_ns(ready);
+    const double t_script = core::ns_to_s(t_exp - t_open);
+    if (t_script > seconds) break;
+
+    const std::size_t nt = dev.truth_samples(truth_buf.data(), truth_buf.size());
+    const std::size_t ns = loop.newest_samples(servo_buf.data(), servo_buf.size());
+    const auto truth_tips = device::interpolate_samples({truth_buf.data(), nt}, t_exp);
+    const auto measured = device::interpolate_samples({servo_buf.data(), ns}, t_exp);
+    if (!truth_tips || !measured) {  // no samples around the exposure (a stall): skip the frame
+      ++dropped;
+      t_exp += period_ns;
+      continue;
+    }
+    user.update(t_script, caps_of(*truth_tips));
+    const auto& truth = user.params();
+    const sim::HandPoses poses{&truth[0], &truth[1]};
+    if (auto st = film->film(poses, &frame); !st) throw SpidarError(st.error().message);
+    physics.snapshots().update();
+    scene = physics.snapshots().front();
+
+    if (auto st = pipe->process(frame.bgr, *measured, scene, &result); !st)
+      throw SpidarError(st.error().message);
+    if (auto st = alt->process(frame.bgr, *measured, scene, &alt_result); !st)
+      throw SpidarError(st.error().message);
+    const std::int64_t done = core::monotonic_ns();
+
+    // --- metrics against the ground truth ---
+    MrFrame m;
+    m.t_s = t_script;
+    m.latency_ms = core::ns_to_s(done - t_exp) * 1e3;
+    m.pipeline_ms = result.timings.total_ms;
+    m.registration_ms = result.timings.registration_ms;
+    m.preprocess_ms = result.timings.key_ms + result.timings.bracelet_ms + result.timings.distance_ms;
+    auto main_m = sim::measure_frame(frame, result, *mode, models, truth_models, truth, camera, &ws);
+    if (!main_m) throw SpidarError(main_m.error().message);
+    m.truth[0] = *main_m;
+    auto alt_m = sim::measure_frame(frame, alt_result, *mode, models, truth_models, truth, camera, &ws);
+    if (!alt_m) throw SpidarError(alt_m.error().message);
+    m.truth[1] = *alt_m;
+    for (int h = 0; h < 2; ++h) {
+      m.iterations[h] = result.fits[h].iterations;
+      m.truth_cap_residual_mm[h] = user.cap_residual_m()[h] * 1e3;
+    }
+    if (auto s = cube_status.read()) {
+      m.lift_mm = s->lift * 1e3;
+      m.u_angle_deg = s->u_angle * 180 / M_PI;
+      m.turns = s->turns;
+    }
+    for (int f = 0; f < 8; ++f) {
+      m.force_n[f] = Vec3(measured->f_W[f][0], measured->f_W[f][1], measured->f_W[f][2]).norm();
+    }
+    // Servo timing since the last frame, from the published samples (newest first).
+    {
+      int cycles = 0;
+      double worst = 0;
+      const double nominal_us = 1e6 / servo.rate_hz;
+      for (std::size_t k = 0; k + 1 < ns && servo_buf[k].t_ns > last_servo_t; ++k) {
+        ++cycles;
+        worst = std::max(worst, std::abs(core::ns_to_s(servo_buf[k].t_ns - servo_buf[k + 1].t_ns) * 1e6 - nominal_us));
+      }
+      if (ns > 0 && last_servo_t > 0 && cycles > 0)
+        m.servo_rate_hz = cycles / core::ns_to_s(servo_buf[0].t_ns - last_servo_t);
+      m.servo_jitter_max_us = worst;
+      if (ns > 0) last_servo_t = servo_buf[0].t_ns;
+    }
+    trace.frames.push_back(m);
+
+    // --- output ---
+    cv::Mat& shown = result.composite;
+    if (video) {
+      if (auto st = video->write(shown); !st) throw SpidarError(st.error().message);
+    }
+    if (next_keyframe < keyframe_times.size() && t_script >= keyframe_times[next_keyframe]) {
+      char name[64];
+      std::snprintf(name, sizeof name, "keyframe_%d_t%04.1fs.png", static_cast<int>(next_keyframe) + 1, t_script);
+      const std::string caption = "t = " + std::to_string(t_script).substr(0, 4) + " s, " +
+                                  sim::RubiksTask::phase(t_script) + ", IoU " +
+                                  std::to_string(m.truth[0].iou).substr(0, 5);
+      if (auto st = render::write_png((fs::path(o.out) / "keyframes" / name).string(),
+                                      sim::keyframe_montage(frame.bgr, result, *mode, models, camera, caption));
+          !st)
+        throw SpidarError(st.error().message);
+      ++next_keyframe;
+    }
+    if (o.window) (void)pipe->present(*context, shown);
+    {
+      std::ostringstream st;
+      st << std::fixed << std::setprecision(1) << "t " << t_script << "/" << seconds << " s  "
+         << std::left << std::setw(24) << sim::RubiksTask::phase(t_script) << std::right
+         << std::setprecision(3) << " IoU " << m.truth[0].iou << std::setprecision(1)
+         << "  tip " << 0.5 * (m.truth[0].fingertip_mm[0] + m.truth[0].fingertip_mm[1])
+         << " mm  occlusion " << m.truth[0].occlusion_pct << " % (paper "
+         << m.truth[0].occlusion_pct_paper << " %)  layer " << m.u_angle_deg << " deg";
+      progress.update(t_script, st.str());
+    }
+
+    // Next exposure; frames whose time has already passed are dropped (the camera does not wait).
+    t_exp += period_ns;
+    const std::int64_t now = core::monotonic_ns();
+    while (t_exp + 2'000'000 < now - period_ns / 2) {
+      t_exp += period_ns;
+      ++dropped;
+    }
+  }
+  const double wall_s = core::ns_to_s(core::monotonic_ns() - t_open);
+  loop.stop();
+  physics.stop();
+  dev.close();
+  if (video) video->close();
+  progress.finish();
+
+  // --- report ---
+  MrSummary summary;
+  summary.seconds = seconds;
+  summary.wall_s = wall_s;
+  summary.dropped = dropped;
+  summary.servo = loop.stats();
+  summary.physics = physics.stats();
+  if (auto s = cube_status.read()) {
+    summary.turns = s->turns;
+    summary.solved = s->solved;
+  }
+  summary.has_cube = cube.has_value();
+  summary.facelets = cube ? cube->facelets() : "";
+  summary.video_path = video ? video->path() : "";
+  summary.video_format = video ? render::video_format_name(video->format()) : "";
+  summary.main_silhouette = o.silhouette;
+  summary.compositor = o.compositor;
+  summary.width = o.width;
+  summary.height = o.height;
+  summary.scene = scene_path;
+  summary.user_hand = hand_path;
+  return write_mr_report(o.out, trace, summary, std::cout);
+}
+
+}  // namespace spidar::app

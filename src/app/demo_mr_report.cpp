@@ -1,0 +1,225 @@
+#include "demo_mr_report.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <functional>
+#include <nlohmann/json.hpp>
+
+#include "spidar/device/device.hpp"
+#include "spidar/render/plot.hpp"
+#include "spidar/render/video_output.hpp"
+
+namespace spidar::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto i = static_cast<std::size_t>(pos);
+  const double f = pos - static_cast<double>(i);
+  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+}
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / static_cast<double>(v.size());
+}
+
+template <typename F>
+std::vector<double> column(const MrTrace& t, F f) {
+  std::vector<double> v;
+  v.reserve(t.frames.size());
+  for (const auto& m : t.frames) v.push_back(f(m));
+  return v;
+}
+
+/// Registration figures of one variant (0 main, 1 comparison).
+nlohmann::json registration_json(const MrTrace& t, int k) {
+  const auto iou = column(t, [k](const MrFrame& m) { return m.truth[k].iou; });
+  const auto jp = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].joint_px[0] + m.truth[k].joint_px[1]); });
+  const auto tip = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].fingertip_mm[0] + m.truth[k].fingertip_mm[1]); });
+  const auto occ = column(t, [k](const MrFrame& m) { return m.truth[k].occlusion_pct; });
+  return {{"iou_mean", mean(iou)},
+          {"iou_p5", quantile(iou, 0.05)},
+          {"joint_px_mean", mean(jp)},
+          {"fingertip_mm_mean", mean(tip)},
+          {"fingertip_mm_p95", quantile(tip, 0.95)},
+          {"occlusion_error_pct", mean(occ)}};
+}
+
+void save_plot(const std::string& path, const render::PlotSpec& spec,
+               const std::vector<render::PlotSeries>& series) {
+  auto img = render::plot_lines(spec, series);
+  if (!img) throw SpidarError(img.error().message);
+  if (auto st = render::write_png(path, *img); !st) throw SpidarError(st.error().message);
+}
+
+render::PlotSeries series(const MrTrace& t, const std::string& label, int colour,
+                          const std::function<double(const MrFrame&)>& f) {
+  render::PlotSeries s;
+  s.label = label;
+  s.bgr = render::plot_colour(colour);
+  s.x = column(t, [](const MrFrame& m) { return m.t_s; });
+  s.y = column(t, f);
+  return s;
+}
+
+void write_plots(const fs::path& dir, const MrTrace& t) {
+  using S = std::vector<render::PlotSeries>;
+  {
+    render::PlotSpec spec;
+    spec.title = "Registration error vs ground truth (main registration)";
+    spec.x_label = "time [s]";
+    spec.y_label = "mm / px";
+    spec.references = {{"target 2 mm", 2.0, render::plot_colour(7)}};
+    save_plot((dir / "registration_error.png").string(), spec,
+              S{series(t, "left fingertip [mm]", 0, [](const MrFrame& m) { return m.truth[0].fingertip_mm[0]; }),
+                series(t, "right fingertip [mm]", 1, [](const MrFrame& m) { return m.truth[0].fingertip_mm[1]; }),
+                series(t, "left joints [px]", 2, [](const MrFrame& m) { return m.truth[0].joint_px[0]; }),
+                series(t, "right joints [px]", 3, [](const MrFrame& m) { return m.truth[0].joint_px[1]; })});
+  }
+  {
+    render::PlotSpec spec;
+    spec.title = "Silhouette IoU and occlusion error";
+    spec.x_label = "time [s]";
+    spec.y_label = "IoU / %";
+    spec.references = {{"IoU target 0.93", 0.93, render::plot_colour(7)}};
+    save_plot((dir / "iou_occlusion.png").string(), spec,
+              S{series(t, "IoU joint-balls", 0, [](const MrFrame& m) { return m.truth[0].iou; }),
+                series(t, "IoU other", 1, [](const MrFrame& m) { return m.truth[1].iou; }),
+                series(t, "occl. depth [%]", 2, [](const MrFrame& m) { return m.truth[0].occlusion_pct; }),
+                series(t, "occl. paper [%]", 5, [](const MrFrame& m) { return m.truth[0].occlusion_pct_paper; })});
+  }
+  {
+    render::PlotSpec spec;
+    spec.title = "Displayed fingertip forces";
+    spec.x_label = "time [s]";
+    spec.y_label = "|F| [N]";
+    static const char* kNames[8] = {"L thumb", "L index", "L middle", "L ring",
+                                    "R thumb", "R index", "R middle", "R ring"};
+    S s;
+    for (int f = 0; f < 8; ++f)
+      s.push_back(series(t, kNames[f], f, [f](const MrFrame& m) { return m.force_n[f]; }));
+    save_plot((dir / "fingertip_forces.png").string(), spec, s);
+  }
+  {
+    render::PlotSpec spec;
+    spec.title = "Loop timing per camera frame";
+    spec.x_label = "time [s]";
+    spec.y_label = "ms";
+    spec.references = {{"33.3 ms (30 fps)", 33.3, render::plot_colour(7)}};
+    save_plot((dir / "loop_timing.png").string(), spec,
+              S{series(t, "latency [ms]", 0, [](const MrFrame& m) { return m.latency_ms; }),
+                series(t, "pipeline [ms]", 1, [](const MrFrame& m) { return m.pipeline_ms; }),
+                series(t, "registration [ms]", 2, [](const MrFrame& m) { return m.registration_ms; }),
+                series(t, "servo jitter max [ms]", 3, [](const MrFrame& m) { return m.servo_jitter_max_us * 1e-3; })});
+  }
+  {
+    render::PlotSpec spec;
+    spec.title = "The cube";
+    spec.x_label = "time [s]";
+    spec.y_label = "deg / mm";
+    save_plot((dir / "cube.png").string(), spec,
+              S{series(t, "top layer [deg]", 0, [](const MrFrame& m) { return m.u_angle_deg; }),
+                series(t, "lift [mm] x10", 1, [](const MrFrame& m) { return 10 * m.lift_mm; })});
+  }
+}
+
+}  // namespace
+
+int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s, std::ostream& os) {
+  const fs::path dir(out);
+  const int frames = static_cast<int>(t.frames.size());
+  const auto reg_ms = column(t, [](const MrFrame& m) { return m.registration_ms; });
+  const auto pre_ms = column(t, [](const MrFrame& m) { return m.preprocess_ms; });
+  const auto pipe_ms = column(t, [](const MrFrame& m) { return m.pipeline_ms; });
+  const auto lat_ms = column(t, [](const MrFrame& m) { return m.latency_ms; });
+  const auto iters = column(t, [](const MrFrame& m) { return 0.5 * (m.iterations[0] + m.iterations[1]); });
+  const auto occ = column(t, [](const MrFrame& m) { return m.truth[0].occlusion_pct; });
+  const auto occ_paper = column(t, [](const MrFrame& m) { return m.truth[0].occlusion_pct_paper; });
+  const auto cap_res = column(t, [](const MrFrame& m) { return std::max(m.truth_cap_residual_mm[0], m.truth_cap_residual_mm[1]); });
+  const double fps = s.wall_s > 0 ? frames / s.wall_s : 0;
+
+  nlohmann::json reg = registration_json(t, 0);
+  reg["ms_per_frame_median"] = quantile(reg_ms, 0.5);
+  reg["ms_per_frame_p95"] = quantile(reg_ms, 0.95);
+  reg["preprocess_ms_median"] = quantile(pre_ms, 0.5);
+  reg["iterations_mean"] = mean(iters);
+  reg["method"] = s.main_silhouette ? "joint-balls + silhouette" : "joint-balls (paper)";
+  nlohmann::json other = registration_json(t, 1);
+  other["method"] = s.main_silhouette ? "joint-balls (paper)" : "joint-balls + silhouette";
+  reg["comparison"] = other;
+
+  nlohmann::json report = {
+      {"frames", frames},
+      {"seconds", s.seconds},
+      {"wall_seconds", s.wall_s},
+      {"dropped_frames", s.dropped},
+      {"image", {{"width", s.width}, {"height", s.height}}},
+      {"scene", s.scene},
+      {"user_hand", s.user_hand},
+      {"haptic",
+       {{"rate_hz", s.servo.rate_hz},
+        {"jitter_p50_us", s.servo.jitter_p50_us},
+        {"jitter_p99_us", s.servo.jitter_p99_us},
+        {"jitter_max_us", s.servo.jitter_max_us},
+        {"overruns", s.servo.overruns},
+        {"cycle_us_median", s.servo.cycle_us_median},
+        {"faults", device::fault_names(s.servo.faults)}}},
+      {"physics",
+       {{"rate_hz", s.physics.rate_hz},
+        {"step_ms_median", s.physics.step_ms_median},
+        {"step_ms_p99", s.physics.step_ms_p99}}},
+      {"registration", reg},
+      {"composite",
+       {{"mode", s.compositor},
+        {"occlusion_error_pct", mean(occ)},
+        {"occlusion_error_pct_paper", mean(occ_paper)},
+        {"occlusion_error_pct_p95", quantile(occ, 0.95)}}},
+      {"pipeline",
+       {{"fps", fps},
+        {"latency_ms_median", quantile(lat_ms, 0.5)},
+        {"latency_ms_p95", quantile(lat_ms, 0.95)},
+        {"ms_per_frame_median", quantile(pipe_ms, 0.5)}}},
+      {"cube",
+       {{"present", s.has_cube},
+        {"turns_completed", s.turns},
+        {"solved", s.solved},
+        {"facelets", s.facelets}}},
+      {"ground_truth", {{"cap_residual_mm_max", quantile(cap_res, 1.0)}}},
+      {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
+  std::ofstream(dir / "report.json") << report.dump(2) << "\n";
+  if (frames > 1) write_plots(dir, t);
+
+  os << "\nresult (" << frames << " frames in " << std::fixed << std::setprecision(1) << s.wall_s
+     << " s, " << s.dropped << " dropped):\n"
+     << std::setprecision(3)
+     << "  registration   IoU mean " << reg["iou_mean"].get<double>() << " (p5 "
+     << reg["iou_p5"].get<double>() << "), fingertip " << std::setprecision(2)
+     << reg["fingertip_mm_mean"].get<double>() << " mm, joints " << reg["joint_px_mean"].get<double>()
+     << " px, " << reg["ms_per_frame_median"].get<double>() << " ms/frame (both hands), "
+     << reg["iterations_mean"].get<double>() << " iterations\n"
+     << "  comparison     " << other["method"].get<std::string>() << ": IoU "
+     << std::setprecision(3) << other["iou_mean"].get<double>() << ", fingertip "
+     << std::setprecision(2) << other["fingertip_mm_mean"].get<double>() << " mm, joints "
+     << other["joint_px_mean"].get<double>() << " px\n"
+     << "  compositing    occlusion error " << mean(occ) << " % (" << s.compositor
+     << "), paper's method " << mean(occ_paper) << " %\n"
+     << "  pipeline       " << std::setprecision(1) << fps << " fps, latency median "
+     << quantile(lat_ms, 0.5) << " ms, " << quantile(pipe_ms, 0.5) << " ms/frame\n"
+     << "  haptics        servo " << s.servo.rate_hz << " Hz, jitter p99 " << s.servo.jitter_p99_us
+     << " us, overruns " << s.servo.overruns << ", faults " << device::fault_names(s.servo.faults)
+     << "; physics step median " << std::setprecision(2) << s.physics.step_ms_median << " ms\n"
+     << "  cube           " << s.turns << " layer turns completed, "
+     << (s.solved ? "solved" : "not solved") << "\n"
+     << "wrote " << (dir / "report.json").string() << ", plots (*.png), keyframes/"
+     << (s.video_path.empty() ? "" : ", " + s.video_path) << "\n";
+  return 0;
+}
+
+}  // namespace spidar::app

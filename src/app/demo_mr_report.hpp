@@ -1,0 +1,51 @@
+#pragma once
+/// What the mixed-reality demo records per frame, and its report: report.json, plot PNGs and the
+/// printed summary.
+#include <array>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "spidar/device/servo_loop.hpp"
+#include "spidar/sim/frame_truth.hpp"
+#include "spidar/sim/haptic_bridge.hpp"
+
+namespace spidar::app {
+
+struct MrFrame {
+  double t_s = 0;              ///< script time of the exposure [s]
+  double latency_ms = 0;       ///< exposure → composite ready [ms]
+  double pipeline_ms = 0;      ///< frame pipeline cost [ms]
+  double registration_ms = 0;  ///< both hands [ms]
+  double preprocess_ms = 0;    ///< chroma key, bracelets, distance transform [ms]
+  /// [0]: the main registration, [1]: the comparison (silhouette term switched the other way).
+  std::array<sim::FrameTruthMetrics, 2> truth{};
+  std::array<int, 2> iterations{};
+  std::array<double, 2> truth_cap_residual_mm{};
+  double lift_mm = 0, u_angle_deg = 0;
+  int turns = 0;
+  std::array<double, 8> force_n{};
+  double servo_rate_hz = 0, servo_jitter_max_us = 0;
+};
+
+struct MrTrace {
+  std::vector<MrFrame> frames;
+};
+
+struct MrSummary {
+  double seconds = 0, wall_s = 0;
+  int dropped = 0;
+  device::ServoStats servo;
+  sim::PhysicsThreadStats physics;
+  int turns = 0;
+  bool solved = false, has_cube = false;
+  std::string facelets, video_path, video_format, compositor, scene, user_hand;
+  bool main_silhouette = false;
+  int width = 0, height = 0;
+};
+
+/// Writes report.json and the plots into `out`, prints the summary; returns the exit code.
+int write_mr_report(const std::string& out, const MrTrace& trace, const MrSummary& summary,
+                    std::ostream& os);
+
+}  // namespace spidar::app

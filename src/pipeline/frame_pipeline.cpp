@@ -1,0 +1,216 @@
+#include "spidar/pipeline/frame_pipeline.hpp"
+
+#include <chrono>
+#include <opencv2/core.hpp>
+
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/hand/render_geometry.hpp"
+#include "spidar/render/hand_shapes.hpp"
+#include "spidar/vision/silhouette.hpp"
+
+namespace spidar::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+/// A cold-start pose: a relaxed hand with the given rotation, placed so that its fingertips'
+/// centroid lies on the measured one.
+hand::HandParams cold_start(const hand::HandModel& model, const Vec3& r_W_hand,
+                            const registration::HandObservation& obs) {
+  hand::HandParams q;
+  q.set_wrist(Vec3::Zero(), r_W_hand);
+  for (int p = hand::kThumbCmcFlexion; p < hand::kParamCount; ++p) q[p] = 0.3;
+  q[hand::kIndexMcpAbduction] = q[hand::kRingMcpAbduction] = 0.0;
+  q = hand::clamp_to_limits(q, model.limits);
+  const hand::HandPoints pts = hand::forward_kinematics(model, q);
+  Vec3 model_mean = Vec3::Zero(), measured_mean = Vec3::Zero();
+  int n = 0;
+  for (int f = 0; f < hand::kFingertipCount; ++f) {
+    if (!obs.fingertip_valid[f]) continue;
+    model_mean += pts.p_W_fingertip[f];
+    measured_mean += obs.p_W_fingertip[f];
+    ++n;
+  }
+  if (n > 0) q.set_wrist((measured_mean - model_mean) / n, r_W_hand);
+  return q;
+}
+
+}  // namespace
+
+struct FramePipeline::Impl {
+  FramePipelineParams params;
+  vision::Camera camera;
+  std::array<hand::HandModel, 2> models;
+  std::unique_ptr<render::Renderer> renderer;
+  vision::ChromaKeyer keyer;
+  vision::BraceletWorkspace bracelet_ws;
+  vision::SilhouetteDistance distance;
+  registration::SuccessiveAdjustment solver;
+  render::Compositor main, other;
+  SceneSnapshot scene;  ///< the world plus the fitted hands (reused)
+  std::array<hand::HandParams, 2> previous;
+  bool have_previous = false;
+
+  Impl(const FramePipelineParams& p, vision::ChromaKeyer k)
+      : params(p), keyer(std::move(k)), solver(p.registration), main(p.compositor) {
+    render::CompositorParams o = p.compositor;
+    o.mode = p.compositor.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper
+                                                                : render::CompositeMode::kDepth;
+    other.set_params(o);
+  }
+};
+
+Result<std::unique_ptr<FramePipeline>> FramePipeline::create(
+    render::Context& context, const vision::Camera& camera,
+    const std::array<hand::HandModel, 2>& models, const FramePipelineParams& params) {
+  if (models[0].side != hand::Side::kLeft || models[1].side != hand::Side::kRight)
+    return Error{"frame pipeline: hand models must be {left, right}"};
+  if (auto s = registration::validate(params.registration); !s) return s.error();
+  if (auto s = vision::validate(params.bracelet); !s) return s.error();
+  if (auto s = render::validate(params.compositor); !s) return s.error();
+  for (const auto& hand_fingers : params.fingers) {
+    for (int f : hand_fingers) {
+      if (f < 0 || f >= device::kMaxFingers)
+        return Error{"frame pipeline: finger index " + std::to_string(f) + " outside 0.." +
+                     std::to_string(device::kMaxFingers - 1)};
+    }
+  }
+  auto keyer = vision::ChromaKeyer::create(params.chroma_key);
+  if (!keyer) return keyer.error();
+  auto impl = std::make_unique<Impl>(params, std::move(keyer).value());
+  impl->camera = camera;
+  impl->models = models;
+  auto renderer = render::Renderer::create(context, camera.width(), camera.height());
+  if (!renderer) return renderer.error();
+  impl->renderer = std::move(renderer).value();
+  return std::unique_ptr<FramePipeline>(new FramePipeline(std::move(impl)));
+}
+
+FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+FramePipeline::~FramePipeline() = default;
+void FramePipeline::reset() { impl_->have_previous = false; }
+Status FramePipeline::present(render::Context& context, const cv::Mat& bgr) {
+  return impl_->renderer->present(context, bgr);
+}
+const FramePipelineParams& FramePipeline::params() const { return impl_->params; }
+const std::array<hand::HandModel, 2>& FramePipeline::models() const { return impl_->models; }
+
+Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample& tips,
+                              const SceneSnapshot& world, FrameResult* out) {
+  if (out == nullptr) return Error{"frame pipeline: no output given"};
+  Impl& s = *impl_;
+  const FramePipelineParams& p = s.params;
+  if (bgr.empty() || bgr.type() != CV_8UC3 || bgr.cols != s.camera.width() ||
+      bgr.rows != s.camera.height()) {
+    return Error{"frame pipeline: expected a CV_8UC3 frame of " + std::to_string(s.camera.width()) +
+                 "x" + std::to_string(s.camera.height()) + " px, got " + std::to_string(bgr.cols) +
+                 "x" + std::to_string(bgr.rows)};
+  }
+  const auto t_start = Clock::now();
+  FrameTimings& tm = out->timings;
+
+  // Chroma key.
+  auto t0 = Clock::now();
+  if (auto st = s.keyer.apply(bgr, &out->key); !st) return st;
+  tm.key_ms = ms_since(t0);
+
+  // Bracelets, predicted from the previous frame's wrists.
+  t0 = Clock::now();
+  vision::BraceletPrediction prediction;
+  if (s.have_previous) {
+    for (int h = 0; h < 2; ++h) prediction.wrist_px[h] = s.camera.project(s.previous[h].p_W_wrist());
+  }
+  auto bracelets = vision::detect_bracelets(bgr, p.bracelet, s.have_previous ? &prediction : nullptr,
+                                            &s.bracelet_ws);
+  if (!bracelets) return bracelets.error();
+  out->bracelets = *bracelets;
+  tm.bracelet_ms = ms_since(t0);
+
+  // Silhouette distance (only for the optional silhouette term).
+  t0 = Clock::now();
+  registration::ImageEvidence image;
+  image.camera = &s.camera;
+  image.alpha = out->key.alpha;
+  if (p.registration.silhouette_term) {
+    vision::SilhouetteDistanceOptions o;
+    o.max_distance_px = p.silhouette_margin_px;
+    if (auto st = vision::silhouette_distance(out->key.silhouette, &s.distance, o); !st) return st;
+    image.distance = &s.distance;
+  }
+  tm.distance_ms = ms_since(t0);
+
+  // Successive adjustment of both hands.
+  t0 = Clock::now();
+  for (int h = 0; h < 2; ++h) {
+    registration::HandObservation obs;
+    for (int f = 0; f < hand::kFingertipCount; ++f) {
+      const int d = p.fingers[h][f];
+      const Vec3 x(tips.p_W[d][0], tips.p_W[d][1], tips.p_W[d][2]);
+      obs.p_W_fingertip[f] = x;
+      obs.fingertip_valid[f] = d < tips.finger_count && x.allFinite();
+    }
+    if (out->bracelets[h].found) {
+      obs.wrist_px = out->bracelets[h].wrist_px;
+      obs.wrist_confidence = out->bracelets[h].confidence;
+    }
+    hand::HandParams q;
+    const bool cold = !s.have_previous;
+    q = cold ? cold_start(s.models[h], p.initial_r_W_hand[h], obs) : s.previous[h];
+    const hand::HandParams prior = q;
+    const int rounds = cold ? p.first_frame_rounds : 1;
+    registration::FitReport report;
+    for (int r = 0; r < rounds; ++r) {
+      const registration::FitReport rr =
+          s.solver.fit(s.models[h], obs, image, cold ? nullptr : &prior, &q);
+      if (r == 0) report.cost_initial = rr.cost_initial;
+      report.iterations += rr.iterations;
+      report.cost_final = rr.cost_final;
+      report.terms = rr.terms;
+      report.converged = rr.converged;
+    }
+    out->hands[h] = q;
+    out->fits[h] = report;
+  }
+  s.previous = out->hands;
+  s.have_previous = true;
+  tm.registration_ms = ms_since(t0);
+
+  // The virtual scene with the fitted hands (hidden: they only give depth).
+  t0 = Clock::now();
+  s.scene.t_s = world.t_s;
+  s.scene.meshes = world.meshes;
+  s.scene.shapes = world.shapes;
+  for (int h = 0; h < 2; ++h) {
+    render::append_hand_shapes(hand::hand_render_shapes(s.models[h], out->hands[h]), &s.scene);
+  }
+  render::RenderParams rp;
+  rp.hands = render::HandDrawMode::kHidden;
+  if (auto st = s.renderer->render(s.scene, s.camera, rp); !st) return st;
+  if (auto st = s.renderer->read(&out->virt, render::kAllTargets); !st) return st;
+  tm.render_ms = ms_since(t0);
+
+  // Compositing.
+  t0 = Clock::now();
+  auto compose = [&](render::Compositor& c, cv::Mat* img, cv::Mat* alpha) -> Status {
+    render::CompositeInputs in;
+    in.virt = &out->virt;
+    const bool depth = c.params().mode == render::CompositeMode::kDepth;
+    in.real_bgr = depth && !out->key.foreground.empty() ? out->key.foreground : bgr;
+    in.real_alpha = out->key.alpha;
+    if (auto st = c.compose(in, img); !st) return st;
+    c.last_alpha().copyTo(*alpha);
+    return Ok{};
+  };
+  if (auto st = compose(s.main, &out->composite, &out->composite_alpha); !st) return st;
+  if (p.other_composite) {
+    if (auto st = compose(s.other, &out->other, &out->other_alpha); !st) return st;
+  }
+  tm.composite_ms = ms_since(t0);
+  tm.total_ms = ms_since(t_start);
+  return Ok{};
+}
+
+}  // namespace spidar::pipeline

@@ -1,0 +1,42 @@
+#include "spidar/render/composite_metrics.hpp"
+
+#include <opencv2/core.hpp>
+
+namespace spidar::render {
+
+Status truth_composite_mask(const cv::Mat& mask, const cv::Mat& depth, const cv::Mat& scene,
+                            cv::Mat* out) {
+  if (out == nullptr) return Error{"truth_composite_mask: no output given"};
+  if (mask.type() != CV_8UC1 || depth.type() != CV_32FC1 || scene.type() != CV_32FC1 ||
+      mask.size() != depth.size() || mask.size() != scene.size())
+    return Error{"truth_composite_mask: expected a CV_8UC1 mask and two CV_32FC1 depths of one size"};
+  out->create(mask.size(), CV_8UC1);
+  for (int y = 0; y < mask.rows; ++y) {
+    const std::uint8_t* m = mask.ptr<std::uint8_t>(y);
+    const float* d = depth.ptr<float>(y);
+    const float* s = scene.ptr<float>(y);
+    std::uint8_t* o = out->ptr<std::uint8_t>(y);
+    for (int x = 0; x < mask.cols; ++x) o[x] = m[x] != 0 && d[x] < s[x] ? 255 : 0;
+  }
+  return Ok{};
+}
+
+Result<double> occlusion_error_pct(const cv::Mat& alpha, const cv::Mat& truth, const cv::Mat& region) {
+  if (alpha.type() != CV_32FC1 || truth.type() != CV_8UC1 || region.type() != CV_8UC1 ||
+      alpha.size() != truth.size() || alpha.size() != region.size())
+    return Error{"occlusion_error_pct: expected CV_32FC1 alpha, CV_8UC1 truth and region of one size"};
+  long in = 0, wrong = 0;
+  for (int y = 0; y < alpha.rows; ++y) {
+    const float* a = alpha.ptr<float>(y);
+    const std::uint8_t* t = truth.ptr<std::uint8_t>(y);
+    const std::uint8_t* r = region.ptr<std::uint8_t>(y);
+    for (int x = 0; x < alpha.cols; ++x) {
+      if (r[x] == 0) continue;
+      ++in;
+      if ((a[x] >= 0.5f) != (t[x] != 0)) ++wrong;
+    }
+  }
+  return in == 0 ? 0.0 : 100.0 * static_cast<double>(wrong) / static_cast<double>(in);
+}
+
+}  // namespace spidar::render

@@ -1,0 +1,90 @@
+#include "spidar/sim/frame_truth.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/hand/render_geometry.hpp"
+#include "spidar/registration/metrics.hpp"
+#include "spidar/render/composite_metrics.hpp"
+#include "spidar/render/overlay.hpp"
+
+namespace spidar::sim {
+
+Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
+                                        const pipeline::FrameResult& result,
+                                        render::CompositeMode main_mode,
+                                        const std::array<hand::HandModel, 2>& models,
+                                        const std::array<hand::HandModel, 2>& truth_models,
+                                        const std::array<hand::HandParams, 2>& truth,
+                                        const vision::Camera& camera, FrameTruthWorkspace* ws) {
+  if (result.other_alpha.empty() || result.composite_alpha.empty())
+    return Error{"measure_frame: both composites are needed (FramePipelineParams::other_composite)"};
+  FrameTruthMetrics m;
+  for (int h = 0; h < 2; ++h) {
+    const hand::HandPoints t = hand::forward_kinematics(truth_models[h], truth[h]);
+    const hand::HandPoints f = hand::forward_kinematics(models[h], result.hands[h]);
+    m.fingertip_mm[h] = registration::fingertip_error_m(f, t) * 1e3;
+    m.joint_px[h] = registration::joint_px_error(f, t, camera);
+  }
+  cv::compare(result.virt.hand_id, 0, ws->model_mask, cv::CMP_GT);
+  m.iou = registration::mask_iou(ws->model_mask, frame.hand_only);
+
+  if (auto st = render::truth_composite_mask(frame.mask, frame.depth, result.virt.depth,
+                                             &ws->truth_alpha);
+      !st)
+    return st.error();
+  // The hand region: the real hands and wherever either composite shows the real image.
+  cv::compare(result.composite_alpha, 0.5, ws->region, cv::CMP_GE);
+  cv::compare(result.other_alpha, 0.5, ws->tmp, cv::CMP_GE);
+  cv::bitwise_or(ws->region, ws->tmp, ws->region);
+  cv::bitwise_or(ws->region, frame.mask, ws->region);
+  const bool depth_main = main_mode == render::CompositeMode::kDepth;
+  const cv::Mat& depth_alpha = depth_main ? result.composite_alpha : result.other_alpha;
+  const cv::Mat& paper_alpha = depth_main ? result.other_alpha : result.composite_alpha;
+  auto d = render::occlusion_error_pct(depth_alpha, ws->truth_alpha, ws->region);
+  if (!d) return d.error();
+  auto p = render::occlusion_error_pct(paper_alpha, ws->truth_alpha, ws->region);
+  if (!p) return p.error();
+  m.occlusion_pct = *d;
+  m.occlusion_pct_paper = *p;
+  return m;
+}
+
+cv::Mat keyframe_montage(const cv::Mat& camera_bgr, const pipeline::FrameResult& result,
+                         render::CompositeMode main_mode,
+                         const std::array<hand::HandModel, 2>& models,
+                         const vision::Camera& camera, const std::string& caption) {
+  const int w = camera_bgr.cols, h = camera_bgr.rows;
+  cv::Mat out(2 * h + 28, 2 * w, CV_8UC3, cv::Scalar(30, 30, 30));
+  cv::Mat matte;
+  result.key.alpha.convertTo(matte, CV_8U, 255.0);
+  cv::cvtColor(matte, matte, cv::COLOR_GRAY2BGR);
+  for (int k = 0; k < 2; ++k) {
+    render::draw_hand_wireframe(matte, camera, hand::hand_render_shapes(models[k], result.hands[k]));
+    if (result.bracelets[k].found) {
+      const Vec2 c = result.bracelets[k].wrist_px;
+      cv::circle(matte, cv::Point(cvRound(c.x()), cvRound(c.y())), 5, cv::Scalar(0, 0, 255), 2, cv::LINE_AA);
+    }
+  }
+  const bool depth_main = main_mode == render::CompositeMode::kDepth;
+  const cv::Mat& depth_img = depth_main ? result.composite : result.other;
+  const cv::Mat& paper_img = depth_main ? result.other : result.composite;
+  const std::array<std::pair<const cv::Mat*, const char*>, 4> tiles{{
+      {&camera_bgr, "camera (synthetic)"},
+      {&matte, "matte + fitted hands"},
+      {&depth_img, "composite: depth"},
+      {&paper_img, "composite: paper"}}};
+  for (int i = 0; i < 4; ++i) {
+    if (tiles[i].first->empty()) continue;
+    const cv::Rect at((i % 2) * w, (i / 2) * h, w, h);
+    tiles[i].first->copyTo(out(at));
+    cv::putText(out, tiles[i].second, cv::Point(at.x + 8, at.y + 20), cv::FONT_HERSHEY_SIMPLEX,
+                0.55, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  }
+  cv::putText(out, caption, cv::Point(8, 2 * h + 20), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              cv::Scalar(230, 230, 230), 1, cv::LINE_AA);
+  return out;
+}
+
+}  // namespace spidar::sim

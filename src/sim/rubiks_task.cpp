@@ -1,0 +1,141 @@
+#include "spidar/sim/rubiks_task.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace spidar::sim {
+namespace {
+
+/// 0 before t0, 1 after t1, smooth in between.
+double ramp(double t, double t0, double t1) {
+  const double x = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+  return x * x * (3.0 - 2.0 * x);
+}
+
+Mat3 rot_z(double a) { return Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix(); }
+
+struct Contacts {
+  std::array<Vec3, 4> left, right;
+};
+
+/// Grasp contacts in the cube frame (world axes at the start), thumb, index, middle, ring.
+Contacts contacts(const RubiksTaskParams& p) {
+  const double face = p.half + p.proxy_radius - p.squeeze;
+  const double a = p.pitch;
+  Contacts c;
+  // Left hand on the two lower layers from the left: thumb in front (−y), fingers behind (+y).
+  c.left = {Vec3(-0.012, -face, -0.45 * a), Vec3(-0.008, face, -0.2 * a),
+            Vec3(-0.016, face, -0.6 * a), Vec3(-0.022, face, -0.95 * a)};
+  // Right hand over the top layer: thumb in front, index, middle and ring behind, spread in x.
+  c.right = {Vec3(0.006, -face, a), Vec3(-0.008, face, a), Vec3(0.007, face, a),
+             Vec3(0.021, face, a)};
+  return c;
+}
+
+/// Where a contact's fingertip is with the hand open: out along the face normal, up a little.
+Vec3 opened(const Vec3& c, double face) {
+  Vec3 out = c;
+  if (std::abs(c.y()) >= face - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.035;
+  else out.z() += 0.035;
+  return out + Vec3(0, 0, 0.01);
+}
+
+// Nominal hand poses at the grasp, cube frame: wrist position [m], hand rotation, finger angles.
+struct Nominal {
+  Vec3 p_wrist;
+  Mat3 R;
+};
+Nominal nominal_grasp(hand::Side side) {
+  if (side == hand::Side::kRight) {
+    // Over the top, fingers forward and a little down, wrist toward the user.
+    return {Vec3(0.012, -0.105, 0.072), Eigen::AngleAxisd(-0.25, Vec3::UnitX()).toRotationMatrix()};
+  }
+  // From the left, palm toward +x (the cube), thumb up, fingers forward.
+  return {Vec3(-0.070, -0.080, 0.0), Eigen::AngleAxisd(-1.45, Vec3::UnitY()).toRotationMatrix()};
+}
+
+}  // namespace
+
+const char* RubiksTask::phase(double t) {
+  if (t < 1.0) return "approach";
+  if (t < 2.0) return "grasp";
+  if (t < 3.0) return "lift";
+  if (t < 5.0) return "turn 1 (top layer)";
+  if (t < 5.7) return "right hand lets go";
+  if (t < 6.5) return "right hand goes back";
+  if (t < 7.2) return "right hand grasps";
+  if (t < 9.2) return "turn 2 (top layer back)";
+  if (t < 9.9) return "right hand lets go";
+  if (t < 10.6) return "set the cube down";
+  if (t < 11.3) return "open both hands";
+  if (t < 12.0) return "withdraw";
+  return "done";
+}
+
+double RubiksTask::closeness(double t, hand::Side side) {
+  if (side == hand::Side::kLeft) return ramp(t, 1.0, 2.0) - ramp(t, 10.6, 11.3);
+  return ramp(t, 1.0, 2.0) - ramp(t, 5.0, 5.7) + ramp(t, 6.5, 7.2) - ramp(t, 9.2, 9.9);
+}
+
+RubiksTask::HandState RubiksTask::state(double t, hand::Side side, int /*finger*/) const {
+  HandState s;
+  s.lift = p_.lift * (ramp(t, 2.0, 3.0) - ramp(t, 9.9, 10.6));
+  if (side == hand::Side::kRight) {
+    s.yaw = p_.turn * (ramp(t, 3.0, 5.0) - ramp(t, 5.7, 6.5) - ramp(t, 7.2, 9.2) + ramp(t, 10.6, 11.3));
+  }
+  return s;
+}
+
+void RubiksTask::goals(double t, std::span<Vec3> goal) { goals_at(t, goal); }
+
+void RubiksTask::goals_at(double t, std::span<Vec3> goal) const {
+  const Contacts c = contacts(p_);
+  const double face = p_.half + p_.proxy_radius - p_.squeeze;
+  const double approach = ramp(t, 0.0, 1.0);
+  const double withdraw = ramp(t, 11.3, 12.0);
+  const double close_left = closeness(t, hand::Side::kLeft);
+  const double close_right = closeness(t, hand::Side::kRight);
+  for (int f = 0; f < 8 && f < static_cast<int>(goal.size()); ++f) {
+    const bool right = f >= 4;
+    const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
+    const Vec3& contact = right ? c.right[f - 4] : c.left[f];
+    const Vec3 open = opened(contact, face);
+    const Vec3 away(right ? p_.withdraw * 0.6 : -p_.withdraw * 0.6, -p_.withdraw * 0.5, p_.withdraw * 0.5);
+    const Vec3 far = open + away;
+    Vec3 p = far + (open - far) * approach + (far - open) * withdraw;
+    p += (contact - open) * (right ? close_right : close_left);
+    const HandState s = state(t, side, f);
+    goal[f] = p_.p_W_cube + rot_z(s.yaw) * p + Vec3(0, 0, s.lift);
+  }
+}
+
+hand::HandParams RubiksTask::nominal(double t, hand::Side side) const {
+  const bool right = side == hand::Side::kRight;
+  const Contacts c = contacts(p_);
+  const auto& cs = right ? c.right : c.left;
+  // The wrist follows the fingertips' mean displacement from the grasp.
+  std::array<Vec3, 8> g;
+  goals_at(t, g);
+  const HandState s = state(t, side, 0);
+  const Mat3 Rz = rot_z(s.yaw);
+  Vec3 shift = Vec3::Zero();
+  for (int f = 0; f < 4; ++f) {
+    const Vec3 rel = Rz.transpose() * (g[(right ? 4 : 0) + f] - p_.p_W_cube - Vec3(0, 0, s.lift));
+    shift += (rel - cs[f]) / 4.0;
+  }
+  const Nominal n = nominal_grasp(side);
+  hand::HandParams q;
+  const Eigen::AngleAxisd aa(Rz * n.R);
+  q.set_wrist(p_.p_W_cube + Rz * (n.p_wrist + shift) + Vec3(0, 0, s.lift), aa.angle() * aa.axis());
+  // A relaxed grip: more flexion as the hand closes.
+  const double k = 0.3 + 0.7 * closeness(t, side);
+  q[hand::kThumbCmcFlexion] = 0.2 * k;
+  q[hand::kThumbCmcAbduction] = 0.3 + 0.5 * k;
+  q[hand::kThumbIp] = 0.2 + 0.3 * k;
+  for (int p : {hand::kIndexMcpFlexion, hand::kMiddleMcpFlexion, hand::kRingMcpFlexion}) q[p] = 0.2 + 0.5 * k;
+  for (int p : {hand::kIndexDip, hand::kMiddleDip, hand::kRingDip}) q[p] = 0.2 + 0.5 * k;
+  return q;
+}
+
+}  // namespace spidar::sim

@@ -1,0 +1,68 @@
+#include "spidar/sim/user_hands.hpp"
+
+#include <cmath>
+
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/hand/joint_limits.hpp"
+
+namespace spidar::sim {
+namespace {
+
+registration::RegistrationParams ik_params(const UserHandsParams& p) {
+  registration::RegistrationParams r;
+  r.fingertip_sigma_m = p.fingertip_sigma_m;
+  r.prior_sigma_wrist_m = p.wrist_sigma_m;
+  r.prior_sigma_rotation_rad = p.rotation_sigma_rad;
+  r.prior_sigma_joint_rad = p.joint_sigma_rad;
+  r.max_iterations = p.iterations;
+  r.cost_epsilon = 0.0;  // run to the step criterion: ground truth should be tight
+  r.step_epsilon = 1e-9;
+  return r;
+}
+
+}  // namespace
+
+UserHands::UserHands(const std::array<hand::HandModel, 2>& truth, const RubiksTask& task,
+                     const UserHandsParams& params)
+    : truth_(truth), task_(task), p_(params), solver_(ik_params(params)) {}
+
+void UserHands::update(double t, std::span<const Vec3> caps) {
+  for (int h = 0; h < 2; ++h) {
+    const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
+    const hand::HandParams nominal = task_.nominal(t, side);
+    if (first_) q_[h] = nominal;
+    registration::HandObservation obs;
+    for (int f = 0; f < hand::kFingertipCount; ++f) {
+      const std::size_t k = static_cast<std::size_t>(4 * h + f);
+      if (k >= caps.size()) continue;
+      obs.p_W_fingertip[f] = caps[k];
+      obs.fingertip_valid[f] = caps[k].allFinite();
+    }
+    obs.wrist_px.reset();
+    // First frame: many iterations from the nominal pose; then a warm start.
+    const int rounds = first_ ? 8 : 1;
+    for (int r = 0; r < rounds; ++r) {
+      solver_.fit(truth_[h], obs, registration::ImageEvidence{}, &nominal, &q_[h]);
+    }
+    q_[h].little_independent = true;
+    q_[h].little = Vec3(q_[h][hand::kRingMcpFlexion], q_[h][hand::kRingMcpAbduction],
+                        q_[h][hand::kRingDip]) +
+                   p_.little_offset + Vec3(p_.little_sway * std::sin(2 * M_PI * 0.7 * t), 0, 0);
+    const auto& lim = truth_[h].limits;
+    q_[h].little.x() = std::clamp(q_[h].little.x(), lim.lower[hand::kRingMcpFlexion], lim.upper[hand::kRingMcpFlexion]);
+    q_[h].little.y() = std::clamp(q_[h].little.y(), lim.lower[hand::kRingMcpAbduction], lim.upper[hand::kRingMcpAbduction]);
+    q_[h].little.z() = std::clamp(q_[h].little.z(), lim.lower[hand::kRingDip], lim.upper[hand::kRingDip]);
+    const hand::HandPoints pts = hand::forward_kinematics(truth_[h], q_[h]);
+    double sum = 0;
+    int n = 0;
+    for (int f = 0; f < hand::kFingertipCount; ++f) {
+      if (!obs.fingertip_valid[f]) continue;
+      sum += (pts.p_W_fingertip[f] - obs.p_W_fingertip[f]).norm();
+      ++n;
+    }
+    residual_[h] = n > 0 ? sum / n : 0.0;
+  }
+  first_ = false;
+}
+
+}  // namespace spidar::sim

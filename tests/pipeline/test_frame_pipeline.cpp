@@ -1,0 +1,115 @@
+// The frame pipeline on synthetic frames: the simulated user's hands (their own proportions)
+// filmed over the blue screen, registered with the default model hands, composited into a scene.
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+
+#include "spidar/hand/hand_config.hpp"
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/sim/frame_truth.hpp"
+#include "spidar/sim/rubiks_task.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/sim/user_hands.hpp"
+#include "spidar/vision/vision_config.hpp"
+
+namespace spidar::pipeline {
+namespace {
+
+std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
+
+class FramePipelineTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto ctx = render::Context::create_headless();
+    if (!ctx) GTEST_SKIP() << "no headless OpenGL: " << ctx.error().message;
+    context_ = std::move(ctx).value();
+    const auto profiles = hand::load_hand_profiles(source("configs/hands.yaml"));
+    const auto* user = profiles.find("user");
+    truth_models_ = {user->model(hand::Side::kLeft), user->model(hand::Side::kRight)};
+    models_ = {hand::default_hand_model(hand::Side::kLeft), hand::default_hand_model(hand::Side::kRight)};
+    camera_ = vision::default_rig_camera();
+    film_ = sim::SyntheticCamera::create(*context_, camera_, truth_models_).value();
+    // The virtual cube where the user grasps.
+    Shape cube;
+    cube.type = Shape::Type::kBox;
+    cube.size = Vec3(0.0285, 0.0285, 0.0285);
+    cube.rgba = {0.9f, 0.9f, 0.9f, 1.f};
+    cube.body = 1;
+    scene_.shapes.push_back(cube);
+  }
+
+  // The user's hands at script time t with their caps on the goals; the fingertip sample as the
+  // servo loop would publish it.
+  device::FingertipSample pose_user(sim::UserHands& user, sim::RubiksTask& task, double t) {
+    std::array<Vec3, 8> g;
+    task.goals(t, g);
+    user.update(t, g);
+    device::FingertipSample s;
+    s.finger_count = 8;
+    for (int f = 0; f < 8; ++f) s.p_W[f] = {g[f].x(), g[f].y(), g[f].z()};
+    return s;
+  }
+
+  std::unique_ptr<render::Context> context_;
+  std::array<hand::HandModel, 2> truth_models_, models_;
+  vision::Camera camera_;
+  std::unique_ptr<sim::SyntheticCamera> film_;
+  SceneSnapshot scene_;
+};
+
+TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  sim::RubiksTask task({});
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(1.5, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  auto pipe = FramePipeline::create(*context_, camera_, models_, p).value();
+  sim::UserHands user(truth_models_, task);
+  sim::SyntheticFrame frame;
+  FrameResult r;
+  sim::FrameTruthWorkspace ws;
+  double tip_sum = 0, iou_sum = 0, occ = 0, occ_paper = 0;
+  int n = 0;
+  for (double t = 1.5; t < 3.5; t += 1.0 / 30) {
+    const auto sample = pose_user(user, task, t);
+    const auto& truth = user.params();
+    ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+    ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());
+    ASSERT_EQ(r.composite.size(), frame.bgr.size());
+    ASSERT_FALSE(r.other.empty());
+    const auto m = sim::measure_frame(frame, r, p.compositor.mode, models_, truth_models_, truth,
+                                      camera_, &ws).value();
+    if (t < 1.8) continue;  // let the cold start settle
+    tip_sum += 0.5 * (m.fingertip_mm[0] + m.fingertip_mm[1]);
+    iou_sum += m.iou;
+    occ += m.occlusion_pct;
+    occ_paper += m.occlusion_pct_paper;
+    ++n;
+  }
+  ASSERT_GT(n, 40);
+  EXPECT_LT(tip_sum / n, 3.0);   // the strings give the fingertips (noise-free here)
+  EXPECT_GT(iou_sum / n, 0.80);  // a different hand's shape over the model's capsules
+  EXPECT_LT(occ / n, occ_paper / n);  // the depth compositor beats the paper's cut-outs
+  EXPECT_TRUE(r.bracelets[0].found && r.bracelets[1].found);
+}
+
+TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {
+  auto pipe = FramePipeline::create(*context_, camera_, models_, {}).value();
+  FrameResult r;
+  device::FingertipSample s;
+  const auto e = pipe->process(cv::Mat(10, 10, CV_8UC3), s, scene_, &r);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.error().message.find("640x480"), std::string::npos) << e.error().message;
+  EXPECT_FALSE(pipe->process(cv::Mat(480, 640, CV_8UC1), s, scene_, &r).ok());
+  FramePipelineParams bad;
+  bad.fingers[1][2] = 9;
+  const auto c = FramePipeline::create(*context_, camera_, models_, bad);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().message.find("finger index 9"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace spidar::pipeline
