@@ -26,7 +26,7 @@ struct RegistrationParams {
   double ball_radius_scale = 1.0;     ///< ball radius = scale × the bone's projected radius
   double matte_threshold = 0.5;       ///< a neighbour is "on the silhouette" if alpha ≥ this
   bool silhouette_term = false;       ///< the distance-transform term (off: the paper's method)
-  double silhouette_sigma_px = 3.0;   ///< σ of a silhouette sample's distance [px]
+  double silhouette_sigma_px = 10.0;  ///< σ of a silhouette sample's distance [px]
   int silhouette_samples_per_bone = 3;  ///< samples along each bone (each gives 3 points), 1..8
   // --- temporal prior (toward the previous frame's parameters) ---
   double prior_sigma_wrist_m = 0.02;     ///< [m]
