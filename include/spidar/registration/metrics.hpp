@@ -9,7 +9,8 @@
 
 namespace spidar::registration {
 
-/// |A ∩ B| / |A ∪ B| of two CV_8UC1 masks (non-zero = inside); 1 when both are empty.
+/// |A ∩ B| / |A ∪ B| of two CV_8UC1 masks (non-zero = inside); 1 when both are empty. Throws
+/// SpidarError if the masks are not CV_8UC1 or differ in size.
 double mask_iou(const cv::Mat& a, const cv::Mat& b);
 
 /// Mean image distance [px] between the projected joints of a fitted and a true hand (all 21

@@ -17,23 +17,30 @@ struct RegistrationParams {
   // --- terms ---
   double fingertip_sigma_m = 0.0015;  ///< σ of a string-measured fingertip [m]
   double wrist_sigma_px = 4.0;        ///< σ of the bracelet's projected wrist [px]
+  /// Where the bracelet sits: its centre lies this far from the wrist joint toward the elbow
+  /// (along −y of the hand frame) [m]; the wrist term compares the projection of that point with
+  /// the bracelet's midpoint. 0 = the paper's "the bracelet marks the wrist".
+  double bracelet_offset_m = 0.012;
   double joint_ball_sigma_px = 4.0;   ///< σ of a joint-ball target [px]
   double joint_ball_alpha = 0.5;      ///< α of eq. 21 (dimensionless, 0..1)
   double ball_radius_scale = 1.0;     ///< ball radius = scale × the bone's projected radius
   double matte_threshold = 0.5;       ///< a neighbour is "on the silhouette" if alpha ≥ this
   bool silhouette_term = false;       ///< the distance-transform term (off: the paper's method)
-  double silhouette_sigma_px = 3.0;   ///< σ of a silhouette sample's distance [px]
-  int silhouette_samples_per_bone = 3;  ///< samples along each bone (each gives 3 points)
+  double silhouette_sigma_px = 10.0;  ///< σ of a silhouette sample's distance [px]
+  int silhouette_samples_per_bone = 3;  ///< samples along each bone (each gives 3 points), 1..8
   // --- temporal prior (toward the previous frame's parameters) ---
   double prior_sigma_wrist_m = 0.02;     ///< [m]
   double prior_sigma_rotation_rad = 0.2; ///< [rad]
   double prior_sigma_joint_rad = 0.3;    ///< [rad]
   // --- solver ---
   double lambda_initial = 1e-3;  ///< Levenberg-Marquardt damping, relative to diag(A)
-  int max_iterations = 10;
+  int max_iterations = 10;       ///< linear solves per fit, accepted or rejected (1..1000)
   double cost_epsilon = 1e-3;    ///< stop when J < ε (dimensionless)
   double step_epsilon = 1e-6;    ///< stop when ‖Δθ‖ < this (mixed m/rad)
 };
+
+/// Upper bound of silhouette_samples_per_bone (fixed-size storage, no allocation per frame).
+inline constexpr int kMaxSilhouetteSamplesPerBone = 8;
 
 /// Error naming the bad field and what was expected (all σ > 0, α in [0, 1], ...).
 Status validate(const RegistrationParams& params);

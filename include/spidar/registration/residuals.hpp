@@ -1,0 +1,80 @@
+#pragma once
+/// The residuals of the successive adjustment (successive_adjustment.hpp) with their image targets
+/// frozen: what one linearisation holds fixed. Exposed for tests (the Jacobian against finite
+/// differences, the optimum against a generic solver) and diagnostics; the solver itself never
+/// stacks them (it accumulates the normal equations block by block).
+///
+/// Residual blocks, each divided by its σ (registration_params.hpp), in this order:
+///   fingertip  p_W_fingertip(θ) − p̃_W (3 rows per valid, finite fingertip)            [m / m]
+///   wrist      √conf · (uv(p_W_bracelet(θ)) − wrist_px) / σ_wrist (2 rows)              [px / px]
+///              p_W_bracelet = p_W_wrist + R_WH·(0, −bracelet_offset_m, 0)
+///   joint-ball (uv(joint j)(θ) − P̃_j) / σ_ball (2 rows per ball with on_count ≥ 1)       [px / px]
+///   silhouette (uv(axis point)(θ) + offset − nearest) / σ_sil (2 rows per point found outside
+///              the real silhouette by more than 0.5 px when frozen)                      [px / px]
+///   prior      (θ_i − θ_prior,i) / σ_group (1 row per parameter with a finite prior)
+/// Frozen with the targets: the joint-ball targets P̃, each silhouette point's nearest silhouette
+/// pixel and its offset from the projected axis point (± the projected radius across the bone),
+/// and whether the wrist term is active (bracelet point in front of the camera).
+#include <array>
+
+#include "spidar/core/types.hpp"
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/registration/joint_balls.hpp"
+#include "spidar/registration/registration_params.hpp"
+#include "spidar/registration/successive_adjustment.hpp"
+
+namespace spidar::registration {
+
+/// Bones sampled by the silhouette term: the thumb's 3 (metacarpal, proximal, distal), then 4 per
+/// finger (metacarpal, proximal, middle, distal) for index, middle, ring, little.
+inline constexpr int kSilhouetteBoneCount = 3 + 4 * 4;  // 19
+inline constexpr int kMaxSilhouettePoints =
+    kSilhouetteBoneCount * kMaxSilhouetteSamplesPerBone * 3;
+
+/// Finger and segment (0 = metacarpal, hand_shape.hpp) of silhouette bone `bone` (0..18).
+struct BoneRef {
+  int finger;
+  int segment;
+};
+BoneRef silhouette_bone(int bone);
+
+/// One silhouette sample that lies outside the real silhouette (frozen at the linearisation).
+struct SilhouettePoint {
+  int bone = 0;                  ///< 0..18 (silhouette_bone)
+  double t = 0;                  ///< along the bone axis: 0 proximal joint, 1 distal joint
+  Vec2 offset_px = Vec2::Zero(); ///< from the projected axis point to this point [px]
+  Vec2 target_px = Vec2::Zero(); ///< the nearest silhouette pixel [px]
+};
+
+/// Everything one linearisation holds fixed. Plain fixed-size storage (about 30 KiB).
+struct FrozenTargets {
+  bool wrist_active = false;
+  JointBalls balls{};
+  std::array<SilhouettePoint, kMaxSilhouettePoints> silhouette{};
+  int silhouette_count = 0;  ///< entries of `silhouette` in use
+};
+
+/// What the residuals are about besides the parameters. Pointers are borrowed; `prior` may be
+/// null (no prior term).
+struct ResidualProblem {
+  const hand::HandModel* model = nullptr;
+  const HandObservation* observation = nullptr;
+  const ImageEvidence* image = nullptr;
+  const hand::HandParams* prior = nullptr;
+  const RegistrationParams* params = nullptr;
+};
+
+/// Recomputes the image targets at pose `q` (joint-balls, silhouette points, wrist activity).
+void freeze_targets(const ResidualProblem& problem, const hand::HandParams& q,
+                    FrozenTargets* targets);
+
+/// The per-term costs (squared norms of the residual blocks) at `q` with frozen targets.
+TermCosts term_costs(const ResidualProblem& problem, const FrozenTargets& targets,
+                     const hand::HandParams& q);
+
+/// The stacked residual vector and, if `J` is non-null, its Jacobian (rows × 17) at `q` with
+/// frozen targets. Allocates: for tests and diagnostics only.
+void stacked_residuals(const ResidualProblem& problem, const FrozenTargets& targets,
+                       const hand::HandParams& q, VecX* r, MatX* J);
+
+}  // namespace spidar::registration

@@ -1,0 +1,108 @@
+#include "spidar/registration/registration_params.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+namespace spidar::registration {
+namespace {
+
+// One table of every numeric field with its range, shared by validate() and the parser so that
+// both say the same thing and the parser can point at the offending key's line.
+struct Field {
+  const char* key;
+  double RegistrationParams::*real = nullptr;  // exactly one of real / integer is set
+  int RegistrationParams::*integer = nullptr;
+  double lo;
+  double hi;
+  bool lo_open;  // (lo, hi] instead of [lo, hi]
+  const char* unit;
+};
+
+constexpr Field kFields[] = {
+    {"fingertip_sigma_m", &RegistrationParams::fingertip_sigma_m, nullptr, 0.0, 0.1, true, "m"},
+    {"wrist_sigma_px", &RegistrationParams::wrist_sigma_px, nullptr, 0.0, 1000.0, true, "px"},
+    {"bracelet_offset_m", &RegistrationParams::bracelet_offset_m, nullptr, -0.05, 0.05, false, "m"},
+    {"joint_ball_sigma_px", &RegistrationParams::joint_ball_sigma_px, nullptr, 0.0, 1000.0, true,
+     "px"},
+    {"joint_ball_alpha", &RegistrationParams::joint_ball_alpha, nullptr, 0.0, 1.0, false, ""},
+    {"ball_radius_scale", &RegistrationParams::ball_radius_scale, nullptr, 0.0, 5.0, true, ""},
+    {"matte_threshold", &RegistrationParams::matte_threshold, nullptr, 0.0, 1.0, true, ""},
+    {"silhouette_sigma_px", &RegistrationParams::silhouette_sigma_px, nullptr, 0.0, 1000.0, true,
+     "px"},
+    {"silhouette_samples_per_bone", nullptr, &RegistrationParams::silhouette_samples_per_bone, 1.0,
+     kMaxSilhouetteSamplesPerBone, false, ""},
+    {"prior_sigma_wrist_m", &RegistrationParams::prior_sigma_wrist_m, nullptr, 0.0, 100.0, true,
+     "m"},
+    {"prior_sigma_rotation_rad", &RegistrationParams::prior_sigma_rotation_rad, nullptr, 0.0,
+     100.0, true, "rad"},
+    {"prior_sigma_joint_rad", &RegistrationParams::prior_sigma_joint_rad, nullptr, 0.0, 100.0,
+     true, "rad"},
+    {"lambda_initial", &RegistrationParams::lambda_initial, nullptr, 0.0, 1e6, false, ""},
+    {"max_iterations", nullptr, &RegistrationParams::max_iterations, 1.0, 1000.0, false, ""},
+    {"cost_epsilon", &RegistrationParams::cost_epsilon, nullptr, 0.0, 1e6, false, ""},
+    {"step_epsilon", &RegistrationParams::step_epsilon, nullptr, 0.0, 1.0, false, ""},
+};
+
+double value_of(const RegistrationParams& p, const Field& f) {
+  return f.real ? p.*f.real : static_cast<double>(p.*f.integer);
+}
+
+bool in_range(const Field& f, double v) {
+  if (!std::isfinite(v)) return false;
+  return (f.lo_open ? v > f.lo : v >= f.lo) && v <= f.hi;
+}
+
+// "expected a value in (0, 0.1] m, got -1"
+std::string expectation(const Field& f, double v) {
+  std::ostringstream os;
+  os << "expected " << (f.integer ? "an integer" : "a value") << " in " << (f.lo_open ? '(' : '[')
+     << f.lo << ", " << f.hi << ']';
+  if (*f.unit) os << ' ' << f.unit;
+  os << ", got " << v;
+  return os.str();
+}
+
+}  // namespace
+
+Status validate(const RegistrationParams& p) {
+  for (const Field& f : kFields) {
+    const double v = value_of(p, f);
+    if (!in_range(f, v)) {
+      return Error{std::string("registration: ") + f.key + ": " + expectation(f, v)};
+    }
+  }
+  return Ok{};
+}
+
+RegistrationParams parse_registration_params(const core::ConfigNode& node) {
+  if (!node.is_map()) node.fail("expected a map of registration settings");
+  node.expect_keys({"fingertip_sigma_m", "wrist_sigma_px", "bracelet_offset_m",
+                    "joint_ball_sigma_px", "joint_ball_alpha", "ball_radius_scale",
+                    "matte_threshold", "silhouette_term", "silhouette_sigma_px",
+                    "silhouette_samples_per_bone", "prior_sigma_wrist_m",
+                    "prior_sigma_rotation_rad", "prior_sigma_joint_rad", "lambda_initial",
+                    "max_iterations", "cost_epsilon", "step_epsilon"});
+  RegistrationParams p;
+  for (const Field& f : kFields) {
+    const auto child = node.find(f.key);
+    if (!child) continue;
+    double v = 0;
+    if (f.real) {
+      v = child->as_double();
+      p.*f.real = v;
+    } else {
+      const std::int64_t i = child->as_int();
+      v = static_cast<double>(i);
+      if (in_range(f, v)) p.*f.integer = static_cast<int>(i);
+    }
+    if (!in_range(f, v)) child->fail(expectation(f, v));
+  }
+  if (auto b = node.find("silhouette_term")) p.silhouette_term = b->as_bool();
+  // Every field was range-checked at its key; this only guards against the table and the
+  // struct drifting apart.
+  if (auto s = validate(p); !s.ok()) node.fail(s.error().message);
+  return p;
+}
+
+}  // namespace spidar::registration

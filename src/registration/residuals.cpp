@@ -1,0 +1,127 @@
+#include "spidar/registration/residuals.hpp"
+
+#include <vector>
+
+#include "residual_terms.hpp"
+
+namespace spidar::registration {
+
+BoneRef silhouette_bone(int bone) {
+  if (bone < 3) return {hand::kThumb, bone};
+  return {hand::kIndex + (bone - 3) / 4, (bone - 3) % 4};
+}
+
+namespace {
+
+/// Silhouette points of one pose: for each bone, samples at t = (i + ½)/n on its axis and two
+/// edge points ± the projected capsule radius across the projected bone; those farther than
+/// the tolerance from the real silhouette are kept with their nearest silhouette pixel.
+void freeze_silhouette(const ResidualProblem& pr, const detail::PoseState& s,
+                       const vision::Camera& camera, const vision::SilhouetteDistance& dist,
+                       FrozenTargets* tg) {
+  const hand::HandModel& model = *pr.model;
+  const int n = pr.params->silhouette_samples_per_bone;
+  const double focal = 0.5 * (camera.intrinsics().fx + camera.intrinsics().fy);
+  for (int bone = 0; bone < kSilhouetteBoneCount; ++bone) {
+    const BoneRef b = silhouette_bone(bone);
+    const Vec3 a = detail::bone_end(model, s, b, 0, nullptr);
+    const Vec3 c = detail::bone_end(model, s, b, 1, nullptr);
+    if (camera.depth(a) < detail::kMinImageDepth || camera.depth(c) < detail::kMinImageDepth) {
+      continue;
+    }
+    Vec2 dir = camera.project(c) - camera.project(a);
+    const double len = dir.norm();
+    const bool has_dir = len > 1e-6;
+    if (has_dir) dir /= len;
+    const Vec2 across(-dir.y(), dir.x());
+    const double radius_m = model.shape.digits[b.finger].radius[b.segment];
+    for (int i = 0; i < n; ++i) {
+      const double t = (i + 0.5) / n;
+      const Vec3 p = (1.0 - t) * a + t * c;
+      const double depth = camera.depth(p);
+      if (!(depth >= detail::kMinImageDepth)) continue;
+      const Vec2 uv = camera.project(p);
+      const double r_px = radius_m * focal / depth;
+      for (int side : {0, 1, -1}) {
+        if (side != 0 && !has_dir) continue;
+        const Vec2 offset = (side * r_px) * across;
+        const Vec2 q = uv + offset;
+        const auto nearest = dist.nearest(q);
+        if (!nearest || (q - *nearest).norm() <= detail::kSilhouetteTolerancePx) continue;
+        if (tg->silhouette_count >= kMaxSilhouettePoints) return;
+        tg->silhouette[tg->silhouette_count++] = SilhouettePoint{bone, t, offset, *nearest};
+      }
+    }
+  }
+}
+
+/// Collects the rows (tests only).
+struct StackSink {
+  std::vector<double> r;
+  std::vector<Eigen::Matrix<double, 1, hand::kParamCount>> J;
+  template <int R>
+  void add(detail::Term, const detail::Block<R>& res, const detail::BlockJacobian<R>* Jb) {
+    for (int k = 0; k < R; ++k) {
+      r.push_back(res[k]);
+      if (Jb) J.push_back(Jb->row(k));
+    }
+  }
+  void add_prior(int i, double res, double j) {
+    r.push_back(res);
+    Eigen::Matrix<double, 1, hand::kParamCount> row = Eigen::Matrix<double, 1, hand::kParamCount>::Zero();
+    row[i] = j;
+    J.push_back(row);
+  }
+};
+
+}  // namespace
+
+void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, FrozenTargets* tg) {
+  tg->wrist_active = false;
+  for (JointBall& b : tg->balls) b = JointBall{};
+  tg->silhouette_count = 0;
+  const ImageEvidence* image = pr.image;
+  if (!image || !image->camera) return;
+  const vision::Camera& camera = *image->camera;
+  detail::PoseState s;
+  detail::pose_state(*pr.model, q, false, &s);
+  if (detail::wrist_observed(*pr.observation)) {
+    tg->wrist_active =
+        camera.depth(detail::bracelet_point(s, *pr.params, nullptr)) >= detail::kMinImageDepth;
+  }
+  if (!image->alpha.empty() && image->alpha.type() == CV_32FC1) {
+    joint_ball_targets(*pr.model, s.points, camera, image->alpha, *pr.params, &tg->balls);
+  }
+  if (pr.params->silhouette_term && image->distance && !image->distance->empty) {
+    freeze_silhouette(pr, s, camera, *image->distance, tg);
+  }
+}
+
+TermCosts term_costs(const ResidualProblem& pr, const FrozenTargets& tg, const hand::HandParams& q) {
+  detail::PoseState s;
+  detail::pose_state(*pr.model, q, false, &s);
+  detail::CostSink sink;
+  detail::visit_residuals<false>(pr, tg, q, s, sink);
+  return sink.costs;
+}
+
+void stacked_residuals(const ResidualProblem& pr, const FrozenTargets& tg,
+                       const hand::HandParams& q, VecX* r, MatX* J) {
+  detail::PoseState s;
+  detail::pose_state(*pr.model, q, J != nullptr, &s);
+  StackSink sink;
+  if (J) {
+    detail::visit_residuals<true>(pr, tg, q, s, sink);
+  } else {
+    detail::visit_residuals<false>(pr, tg, q, s, sink);
+  }
+  const auto rows = static_cast<Eigen::Index>(sink.r.size());
+  r->resize(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) (*r)[i] = sink.r[static_cast<std::size_t>(i)];
+  if (J) {
+    J->resize(rows, hand::kParamCount);
+    for (Eigen::Index i = 0; i < rows; ++i) J->row(i) = sink.J[static_cast<std::size_t>(i)];
+  }
+}
+
+}  // namespace spidar::registration

@@ -1,0 +1,162 @@
+// Convergence from perturbed poses on synthetic frames: the simulated camera films the user's
+// true hands ("user" profile of configs/hands.yaml: 4 % longer, 3 % narrower than the model,
+// tapered bones, a fuller palm) as skin over a blue screen with red bracelets; chroma key,
+// bracelet detection and the distance transform run on that image; the registration fits the
+// default model hands to it and to string fingertips with 0.5 mm noise.
+//
+// Bounds. The model hand is not the user's hand, so even a perfect fit leaves projected joints
+// off: at the true parameters the model's joints are 5.9 px and its caps 6.2 mm from the truth,
+// and a fit started there settles at 3.9 px / 1.3 mm (paper's terms; 3.2 px / 1.1 mm with the
+// silhouette term; FromTheTruthStaysAtTheFloor). Measured from ±1.5 cm / ±0.15 rad / ±0.2 rad
+// starts (8 seeds × 2 hands, default settings): paper's terms 21.5 → 1.4 mm, 19.8 → 3.7 px mean,
+// worst 2.0 mm / 5.8 px; with the silhouette term 1.1 mm / 3.3 px, worst 1.4 mm / 4.1 px. The
+// bounds (3 mm and 7 px per fit, 2 mm and 4.5 px mean) leave ~1 px over the worst fit and fail on
+// a broken term (bracelet_offset_m = 0 alone gives 6.6 px means, a 3 px silhouette σ 6.3 px).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "registration_test_util.hpp"
+#include "spidar/registration/metrics.hpp"
+
+namespace spidar::registration {
+namespace {
+
+struct Stats {
+  double tip_before_mm = 0, tip_after_mm = 0, px_before = 0, px_after = 0;
+  double worst_tip_after_mm = 0, worst_px_after = 0;
+  int fits = 0, not_improved = 0;
+};
+
+struct Scene {
+  std::array<hand::HandModel, 2> truth_models = test::truth_models();
+  std::array<hand::HandModel, 2> models = test::model_hands();
+  vision::Camera camera = vision::default_rig_camera();
+  std::array<hand::HandParams, 2> truth = test::reaching_hands();
+  test::FrameEvidence ev;
+  ImageEvidence image;
+};
+
+void film(Scene* s) {
+  auto cam = sim::SyntheticCamera::create(*test::gl().context, s->camera, s->truth_models);
+  ASSERT_TRUE(cam.ok()) << cam.error().message;
+  test::film_and_key(**cam, s->truth, &s->ev);
+  for (int h = 0; h < 2; ++h) ASSERT_TRUE(s->ev.bracelets[h].found) << "hand " << h;
+  s->image.camera = &s->camera;
+  s->image.alpha = s->ev.key.alpha;
+  s->image.distance = &s->ev.distance;
+}
+
+// Fits both hands from perturbed starts (prior = the start, as a tracker's previous frame).
+Stats run(const Scene& sc, const RegistrationParams& params, const std::vector<std::uint32_t>& seeds,
+          double wrist_m, double rot, double joint) {
+  const SuccessiveAdjustment solver(params);
+  Stats s;
+  for (std::uint32_t seed : seeds) {
+    std::mt19937 rng(seed);
+    for (int h = 0; h < 2; ++h) {
+      const HandObservation obs = test::observe(sc.truth_models[h], sc.truth[h], sc.ev.bracelets[h], rng);
+      const hand::HandParams start = test::perturb(sc.truth[h], sc.models[h], rng, wrist_m, rot, joint);
+      hand::HandParams q = start;
+      const FitReport rep = solver.fit(sc.models[h], obs, sc.image, &start, &q);
+      EXPECT_TRUE(q.q.allFinite());
+      EXPECT_TRUE(hand::within_limits(q, sc.models[h].limits));
+      EXPECT_GT(rep.iterations, 0);
+      const hand::HandPoints t = hand::forward_kinematics(sc.truth_models[h], sc.truth[h]);
+      const hand::HandPoints a = hand::forward_kinematics(sc.models[h], start);
+      const hand::HandPoints b = hand::forward_kinematics(sc.models[h], q);
+      const double tb = 1e3 * fingertip_error_m(a, t), ta = 1e3 * fingertip_error_m(b, t);
+      const double pb = joint_px_error(a, t, sc.camera), pa = joint_px_error(b, t, sc.camera);
+      s.tip_before_mm += tb;
+      s.tip_after_mm += ta;
+      s.px_before += pb;
+      s.px_after += pa;
+      s.worst_tip_after_mm = std::max(s.worst_tip_after_mm, ta);
+      s.worst_px_after = std::max(s.worst_px_after, pa);
+      s.not_improved += (ta >= tb || pa >= pb) ? 1 : 0;
+      ++s.fits;
+    }
+  }
+  s.tip_before_mm /= s.fits;
+  s.tip_after_mm /= s.fits;
+  s.px_before /= s.fits;
+  s.px_after /= s.fits;
+  return s;
+}
+
+void print(const char* name, const Stats& s) {
+  std::printf("%-22s fingertip %.2f -> %.2f mm (worst %.2f), joints %.1f -> %.2f px (worst %.2f), "
+              "%d fits\n",
+              name, s.tip_before_mm, s.tip_after_mm, s.worst_tip_after_mm, s.px_before, s.px_after,
+              s.worst_px_after, s.fits);
+}
+
+const std::vector<std::uint32_t> kSeeds{1, 2, 3, 4, 5, 6, 7, 8};
+
+void expect_converged(const Stats& s) {
+  EXPECT_EQ(s.not_improved, 0);
+  EXPECT_LT(s.worst_tip_after_mm, 3.0);
+  EXPECT_LT(s.worst_px_after, 7.0);
+  EXPECT_LT(s.px_after, 4.5);
+  EXPECT_LT(s.tip_after_mm, 2.0);
+}
+
+TEST(Convergence, PaperTermsFromPerturbedStarts) {
+  SPIDAR_SKIP_WITHOUT_GL();
+  Scene sc;
+  film(&sc);
+  const Stats s = run(sc, RegistrationParams{}, kSeeds, 0.015, 0.15, 0.2);
+  print("paper terms", s);
+  expect_converged(s);
+}
+
+TEST(Convergence, JointBallsAndSilhouetteFromPerturbedStarts) {
+  SPIDAR_SKIP_WITHOUT_GL();
+  Scene sc;
+  film(&sc);
+  RegistrationParams p;
+  p.silhouette_term = true;
+  const Stats s = run(sc, p, kSeeds, 0.015, 0.15, 0.2);
+  print("balls + silhouette", s);
+  expect_converged(s);
+}
+
+TEST(Convergence, LargerStartErrorsWithMoreIterations) {
+  SPIDAR_SKIP_WITHOUT_GL();
+  Scene sc;
+  film(&sc);
+  RegistrationParams p;
+  p.silhouette_term = true;
+  p.max_iterations = 20;
+  const Stats s = run(sc, p, kSeeds, 0.02, 0.2, 0.3);
+  print("2 cm / 0.2 rad / 0.3 rad", s);
+  expect_converged(s);
+}
+
+TEST(Convergence, FromTheTruthStaysAtTheFloor) {
+  SPIDAR_SKIP_WITHOUT_GL();
+  Scene sc;
+  film(&sc);
+  for (bool sil : {false, true}) {
+    RegistrationParams p;
+    p.silhouette_term = sil;
+    const Stats s = run(sc, p, {1, 2, 3}, 0.0, 0.0, 0.0);
+    print(sil ? "from truth, silhouette" : "from truth, paper", s);
+    EXPECT_LT(s.worst_tip_after_mm, 2.0);
+    EXPECT_LT(s.worst_px_after, 5.5);
+  }
+}
+
+TEST(Convergence, WithoutImageOnlyTheStringsAndThePriorAct) {
+  SPIDAR_SKIP_WITHOUT_GL();
+  Scene sc;
+  film(&sc);
+  sc.image = ImageEvidence{};  // no camera: fingertips and prior only
+  const Stats s = run(sc, RegistrationParams{}, {1, 2, 3}, 0.015, 0.15, 0.2);
+  print("no image", s);
+  EXPECT_EQ(s.not_improved, 0);
+  EXPECT_LT(s.worst_tip_after_mm, 3.0);
+}
+
+}  // namespace
+}  // namespace spidar::registration

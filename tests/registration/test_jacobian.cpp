@@ -1,0 +1,106 @@
+// The full residual Jacobian (every term, targets frozen) against central finite differences of
+// the residual vector.
+#include <gtest/gtest.h>
+
+#include "registration_test_util.hpp"
+#include "spidar/registration/residuals.hpp"
+
+namespace spidar::registration {
+namespace {
+
+struct Case {
+  hand::HandModel model;
+  hand::HandParams truth, q, prior;
+  HandObservation obs;
+  vision::Camera camera = vision::default_rig_camera();
+  test::MaskEvidence mask;
+  RegistrationParams params;
+};
+
+// The true hand draws the silhouette; the evaluation pose q is a perturbation of it, so that
+// every term has rows (balls near edges, silhouette points outside, nonzero prior).
+void make_case(int side, std::uint32_t seed, Case* c) {
+  const auto models = test::model_hands();
+  c->model = models[side];
+  c->truth = test::reaching_hands()[side];
+  std::mt19937 rng(seed);
+  c->q = test::perturb(c->truth, c->model, rng, 0.01, 0.08, 0.15);
+  c->prior = test::perturb(c->truth, c->model, rng);
+  cv::Mat m;
+  test::draw_capsule_mask(c->model, c->truth, c->camera, &m);
+  test::evidence_from_mask(m, &c->mask);
+  vision::BraceletObservation b;
+  b.found = true;
+  b.wrist_px = c->camera.project(c->truth.p_W_wrist()) + Vec2(3, -2);
+  b.confidence = 0.8;
+  c->obs = test::observe(c->model, c->truth, b, rng, 0.001);
+  c->params.silhouette_term = true;
+  c->params.silhouette_samples_per_bone = 4;
+}
+
+TEST(ResidualJacobian, MatchesCentralDifferences) {
+  for (int side = 0; side < 2; ++side) {
+    for (std::uint32_t seed : {1u, 2u, 3u}) {
+      Case c;
+      make_case(side, seed, &c);
+      const ImageEvidence image = c.mask.evidence(&c.camera, true);
+      const ResidualProblem pr{&c.model, &c.obs, &image, &c.prior, &c.params};
+      FrozenTargets tg;
+      freeze_targets(pr, c.q, &tg);
+      // Every term is present.
+      const TermCosts costs = term_costs(pr, tg, c.q);
+      EXPECT_GT(costs.fingertip, 0.0);
+      EXPECT_GT(costs.wrist, 0.0);
+      EXPECT_GT(costs.joint_ball, 0.0) << "side " << side << " seed " << seed;
+      EXPECT_GT(costs.silhouette, 0.0);
+      EXPECT_GT(costs.prior, 0.0);
+      EXPECT_GT(tg.silhouette_count, 5);
+
+      VecX r;
+      MatX J;
+      stacked_residuals(pr, tg, c.q, &r, &J);
+      ASSERT_EQ(J.rows(), r.size());
+      EXPECT_NEAR(r.squaredNorm(), costs.total(), 1e-9 * costs.total());
+      MatX J_fd(J.rows(), J.cols());
+      const double h = 1e-6;
+      for (int i = 0; i < hand::kParamCount; ++i) {
+        hand::HandParams qp = c.q, qm = c.q;
+        qp[i] += h;
+        qm[i] -= h;
+        VecX rp, rm;
+        stacked_residuals(pr, tg, qp, &rp, nullptr);
+        stacked_residuals(pr, tg, qm, &rm, nullptr);
+        ASSERT_EQ(rp.size(), r.size());
+        J_fd.col(i) = (rp - rm) / (2 * h);
+      }
+      const double scale = std::max(1.0, J.cwiseAbs().maxCoeff());
+      for (int row = 0; row < J.rows(); ++row) {
+        for (int col = 0; col < J.cols(); ++col) {
+          ASSERT_NEAR(J(row, col), J_fd(row, col), 2e-6 * scale)
+              << "side " << side << " seed " << seed << " row " << row << " of " << J.rows()
+              << ", parameter " << hand::param_name(col);
+        }
+      }
+    }
+  }
+}
+
+TEST(ResidualJacobian, NonFiniteObservationsAreIgnored) {
+  Case c;
+  make_case(1, 7, &c);
+  const ImageEvidence image = c.mask.evidence(&c.camera, false);
+  const ResidualProblem pr{&c.model, &c.obs, &image, nullptr, &c.params};
+  FrozenTargets tg;
+  freeze_targets(pr, c.q, &tg);
+  VecX r0, r1;
+  stacked_residuals(pr, tg, c.q, &r0, nullptr);
+  c.obs.p_W_fingertip[2].x() = std::numeric_limits<double>::quiet_NaN();
+  c.obs.wrist_px = Vec2(std::numeric_limits<double>::infinity(), 3.0);
+  freeze_targets(pr, c.q, &tg);
+  stacked_residuals(pr, tg, c.q, &r1, nullptr);
+  EXPECT_EQ(r1.size(), r0.size() - 3 - 2);
+  EXPECT_TRUE(r1.allFinite());
+}
+
+}  // namespace
+}  // namespace spidar::registration

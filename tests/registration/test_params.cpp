@@ -1,0 +1,98 @@
+// Registration settings: defaults valid, configs/registration.yaml equals the defaults, and errors
+// name the key (and, when parsed, file:line).
+#include <gtest/gtest.h>
+
+#include "spidar/core/config.hpp"
+#include "spidar/registration/registration_params.hpp"
+
+namespace spidar::registration {
+namespace {
+
+TEST(RegistrationParams, DefaultsAreValid) { EXPECT_TRUE(validate(RegistrationParams{}).ok()); }
+
+TEST(RegistrationParams, ValidateNamesTheField) {
+  RegistrationParams p;
+  p.wrist_sigma_px = 0;
+  auto s = validate(p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("wrist_sigma_px"), std::string::npos) << s.error().message;
+  p = {};
+  p.joint_ball_alpha = 1.5;
+  EXPECT_NE(validate(p).error().message.find("joint_ball_alpha"), std::string::npos);
+  p = {};
+  p.silhouette_samples_per_bone = kMaxSilhouetteSamplesPerBone + 1;
+  EXPECT_NE(validate(p).error().message.find("silhouette_samples_per_bone"), std::string::npos);
+  p = {};
+  p.fingertip_sigma_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(validate(p).error().message.find("fingertip_sigma_m"), std::string::npos);
+  p = {};
+  p.max_iterations = 0;
+  EXPECT_NE(validate(p).error().message.find("max_iterations"), std::string::npos);
+}
+
+TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
+  const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
+  const RegistrationParams p = parse_registration_params(root["registration"]);
+  const RegistrationParams d;
+  EXPECT_EQ(p.fingertip_sigma_m, d.fingertip_sigma_m);
+  EXPECT_EQ(p.wrist_sigma_px, d.wrist_sigma_px);
+  EXPECT_EQ(p.bracelet_offset_m, d.bracelet_offset_m);
+  EXPECT_EQ(p.joint_ball_sigma_px, d.joint_ball_sigma_px);
+  EXPECT_EQ(p.joint_ball_alpha, d.joint_ball_alpha);
+  EXPECT_EQ(p.ball_radius_scale, d.ball_radius_scale);
+  EXPECT_EQ(p.matte_threshold, d.matte_threshold);
+  EXPECT_EQ(p.silhouette_term, d.silhouette_term);
+  EXPECT_EQ(p.silhouette_sigma_px, d.silhouette_sigma_px);
+  EXPECT_EQ(p.silhouette_samples_per_bone, d.silhouette_samples_per_bone);
+  EXPECT_EQ(p.prior_sigma_wrist_m, d.prior_sigma_wrist_m);
+  EXPECT_EQ(p.prior_sigma_rotation_rad, d.prior_sigma_rotation_rad);
+  EXPECT_EQ(p.prior_sigma_joint_rad, d.prior_sigma_joint_rad);
+  EXPECT_EQ(p.lambda_initial, d.lambda_initial);
+  EXPECT_EQ(p.max_iterations, d.max_iterations);
+  EXPECT_EQ(p.cost_epsilon, d.cost_epsilon);
+  EXPECT_EQ(p.step_epsilon, d.step_epsilon);
+}
+
+TEST(RegistrationParams, ParsesValues) {
+  const auto root = core::ConfigNode::Parse(
+      "registration:\n  silhouette_term: true\n  wrist_sigma_px: 6\n  max_iterations: 4\n",
+      "reg.yaml");
+  const RegistrationParams p = parse_registration_params(root["registration"]);
+  EXPECT_TRUE(p.silhouette_term);
+  EXPECT_EQ(p.wrist_sigma_px, 6.0);
+  EXPECT_EQ(p.max_iterations, 4);
+  EXPECT_EQ(p.fingertip_sigma_m, RegistrationParams{}.fingertip_sigma_m);
+}
+
+std::string parse_error(const std::string& yaml) {
+  try {
+    (void)parse_registration_params(core::ConfigNode::Parse(yaml, "reg.yaml")["registration"]);
+  } catch (const core::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RegistrationParams, ParseErrorsNameFileLineAndKey) {
+  // Out of range: the message points at the key's own line.
+  std::string e = parse_error("registration:\n  wrist_sigma_px: 4\n  joint_ball_alpha: 2\n");
+  EXPECT_NE(e.find("reg.yaml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("registration.joint_ball_alpha"), std::string::npos) << e;
+  EXPECT_NE(e.find("[0, 1]"), std::string::npos) << e;
+  // Wrong type.
+  e = parse_error("registration:\n  max_iterations: many\n");
+  EXPECT_NE(e.find("reg.yaml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("max_iterations"), std::string::npos) << e;
+  // Out-of-range integer.
+  e = parse_error("registration:\n  silhouette_samples_per_bone: 0\n");
+  EXPECT_NE(e.find("registration.silhouette_samples_per_bone"), std::string::npos) << e;
+  // A typo is rejected, naming the key.
+  e = parse_error("registration:\n  fingertip_sigma: 0.002\n");
+  EXPECT_NE(e.find("fingertip_sigma"), std::string::npos) << e;
+  // Not a map.
+  e = parse_error("registration: 3\n");
+  EXPECT_NE(e.find("registration"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace spidar::registration
