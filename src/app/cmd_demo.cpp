@@ -21,6 +21,10 @@ Action add_demo(CLI::App& app) {
   cmd->add_option("--user-hand", o->user_hand,
                   "hands YAML of the simulated user (profile 'user', else the first)")
       ->capture_default_str();
+  cmd->add_option("--model-hand", o->model_profile,
+                  "profile in configs/hands.yaml of the registration's hand model (a user who "
+                  "measured their hand names theirs)")
+      ->capture_default_str();
   cmd->add_option("--camera", o->camera, "camera YAML (rubiks)")->capture_default_str();
   cmd->add_option("--width", o->width, "camera image width [px]")->capture_default_str();
   cmd->add_option("--height", o->height, "camera image height [px]")->capture_default_str();

@@ -16,6 +16,7 @@ struct DemoOptions {
   // rubiks (the mixed-reality demo)
   std::string user_hand = "configs/hands.yaml";  ///< the simulated user's hands (profile "user")
   std::string user_profile = "user";
+  std::string model_profile = "model";  ///< the registration's hand sizes (configs/hands.yaml)
   std::string camera = "configs/camera.yaml";
   int width = 640, height = 480;   ///< camera image [px]
   double fps = 30.0;               ///< camera rate [Hz]

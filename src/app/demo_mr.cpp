@@ -6,6 +6,7 @@
 // image, renders the virtual world, composites the real hands into it, and measures everything
 // against the ground truth.
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -26,6 +27,7 @@
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/render/video_output.hpp"
+#include "spidar/sim/camera_thread.hpp"
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
 #include "spidar/sim/rubiks_task.hpp"
@@ -110,11 +112,6 @@ void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
   }
 }
 
-std::array<Vec3, 8> caps_of(const device::FingertipSample& s) {
-  std::array<Vec3, 8> c;
-  for (int f = 0; f < 8; ++f) c[f] = Vec3(s.p_W[f][0], s.p_W[f][1], s.p_W[f][2]);
-  return c;
-}
 
 }  // namespace
 
@@ -125,8 +122,12 @@ int run_mr_demo(const DemoOptions& o) {
   const std::string scene_path = resolve_data_path(o.scene);
   const std::string hand_path = resolve_data_path(o.user_hand);
   const auto truth_models = user_models(hand_path, o.user_profile);
-  const std::array<hand::HandModel, 2> models{hand::default_hand_model(hand::Side::kLeft),
-                                              hand::default_hand_model(hand::Side::kRight)};
+  const auto models = [&] {
+    const auto profiles = hand::load_hand_profiles(resolve_data_path("configs/hands.yaml"));
+    const hand::HandProfile* p = profiles.find(o.model_profile);
+    if (p == nullptr) throw UsageError("--model-hand: no profile '" + o.model_profile + "' in " + profiles.source);
+    return std::array<hand::HandModel, 2>{p->model(hand::Side::kLeft), p->model(hand::Side::kRight)};
+  }();
   const vision::Camera camera = scaled_camera(
       vision::load_camera_file(resolve_data_path(o.camera)).camera, o.width, o.height);
   const auto vision_cfg = vision::load_vision_config(resolve_data_path("configs/vision.yaml"));
@@ -171,13 +172,17 @@ int run_mr_demo(const DemoOptions& o) {
   sim::PhysicsThread physics(*world, *bridge);
   physics.set_snapshot_proxies(false);
   core::Latest<CubeStatus> cube_status;
+  core::Latest<sim::CubePoseSample> cube_pose;  // the user watches the cube
+  if (cube) task->track(&cube_pose);
   TurnCounter turns;
   physics.set_before_step([&](physics::World& w) {
     CubeStatus s;
     s.t_s = w.time();
     s.contacts = w.contact_count();
     if (cube) {
-      s.lift = cube->core_pose().p.z() - X_cube0.p.z();
+      const Pose X = cube->core_pose();
+      cube_pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+      s.lift = X.p.z() - X_cube0.p.z();
       s.u_angle = cube->face_angle('U');
       turns.update(*cube);
       s.turns = turns.turns();
@@ -194,10 +199,6 @@ int run_mr_demo(const DemoOptions& o) {
   auto context = std::move(ctx_r).value();
   sim::SyntheticCameraParams cam_params;
   cam_params.seed = o.seed;
-  auto film_r = sim::SyntheticCamera::create(*context, camera, truth_models, cam_params);
-  if (!film_r) throw SpidarError(film_r.error().message);
-  auto film = std::move(film_r).value();
-  sim::UserHands user(truth_models, *task);
 
   pipeline::FramePipelineParams pp;
   pp.chroma_key = vision_cfg.chroma_key;
@@ -215,7 +216,6 @@ int run_mr_demo(const DemoOptions& o) {
   // The comparison: the same registration with the silhouette term switched the other way.
   pipeline::FramePipelineParams pp_alt = pp;
   pp_alt.registration.silhouette_term = !o.silhouette;
-  pp_alt.other_composite = false;
   auto alt_r = pipeline::FramePipeline::create(*context, camera, models, pp_alt);
   if (!alt_r) throw UsageError(alt_r.error().message);
   auto alt = std::move(alt_r).value();
@@ -244,48 +244,61 @@ int run_mr_demo(const DemoOptions& o) {
   physics.start();
   if (auto st = loop.start(); !st.ok()) throw UsageError(st.error().message);
 
-  const auto period_ns = static_cast<std::int64_t>(1e9 / o.fps);
-  std::vector<device::FingertipSample> servo_buf(1000), truth_buf(1000);
+  // The camera films in its own thread; the ground truth comes from the simulated device.
+  std::vector<device::FingertipSample> truth_buf(1000);
+  sim::TruthAt truth_at = [&dev, &truth_buf](std::int64_t t_ns, std::span<Vec3> out) {
+    const std::size_t n = dev.truth_samples(truth_buf.data(), truth_buf.size());
+    const auto s = device::interpolate_samples({truth_buf.data(), n}, t_ns);
+    if (!s) return false;
+    for (std::size_t f = 0; f < out.size() && f < 8; ++f) out[f] = Vec3(s->p_W[f][0], s->p_W[f][1], s->p_W[f][2]);
+    return true;
+  };
+  sim::CameraThreadParams ctp;
+  ctp.fps = o.fps;
+  ctp.t0_ns = t_open;
+  auto cam_r = sim::CameraThread::start(camera, truth_models, cam_params, *task, truth_at, ctp);
+  if (!cam_r) throw SpidarError(cam_r.error().message);
+  auto camera_thread = std::move(cam_r).value();
+
+  std::vector<device::FingertipSample> servo_buf(1000);
   SceneSnapshot scene;
-  sim::SyntheticFrame frame;
   pipeline::FrameResult result, alt_result;
   sim::FrameTruthWorkspace ws;
   MrTrace trace;
   Progress progress(seconds, std::cerr);
   const std::array<double, 5> keyframe_times{1.9, 3.0, 4.5, 8.5, 10.2};
   std::size_t next_keyframe = 0;
-  int dropped = 0;
-  std::int64_t t_exp = t_open + period_ns;
   std::int64_t last_servo_t = 0;
+  constexpr int kCompareEvery = 5;
+  int frame_index = 0;
 
   while (loop.running()) {
-    // The frame's exposure time; wait until the servo has samples past it.
-    const std::int64_t ready = t_exp + 2'000'000;
-    core::sleep_until_ns(ready);
-    const double t_script = core::ns_to_s(t_exp - t_open);
-    if (t_script > seconds) break;
-
-    const std::size_t nt = dev.truth_samples(truth_buf.data(), truth_buf.size());
-    const std::size_t ns = loop.newest_samples(servo_buf.data(), servo_buf.size());
-    const auto truth_tips = device::interpolate_samples({truth_buf.data(), nt}, t_exp);
-    const auto measured = device::interpolate_samples({servo_buf.data(), ns}, t_exp);
-    if (!truth_tips || !measured) {  // no samples around the exposure (a stall): skip the frame
-      ++dropped;
-      t_exp += period_ns;
+    if (!camera_thread->take()) {  // wait for the next frame
+      if (core::ns_to_s(core::monotonic_ns() - t_open) > seconds + 1.0) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
       continue;
     }
-    user.update(t_script, caps_of(*truth_tips));
-    const auto& truth = user.params();
-    const sim::HandPoses poses{&truth[0], &truth[1]};
-    if (auto st = film->film(poses, &frame); !st) throw SpidarError(st.error().message);
+    const sim::FilmedFrame& filmed = camera_thread->frame();
+    const sim::SyntheticFrame& frame = filmed.frame;
+    const std::int64_t t_exp = filmed.t_exposure_ns;
+    const double t_script = filmed.t_script_s;
+    if (t_script > seconds) break;
+    const std::size_t ns = loop.newest_samples(servo_buf.data(), servo_buf.size());
+    const auto measured = device::interpolate_samples({servo_buf.data(), ns}, t_exp);
+    if (!measured) continue;  // no servo samples around the exposure (a stall): skip the frame
+    const auto& truth = filmed.truth;
+    const double film_ms = filmed.film_ms;
     physics.snapshots().update();
     scene = physics.snapshots().front();
 
     if (auto st = pipe->process(frame.bgr, *measured, scene, &result); !st)
       throw SpidarError(st.error().message);
-    if (auto st = alt->process(frame.bgr, *measured, scene, &alt_result); !st)
-      throw SpidarError(st.error().message);
     const std::int64_t done = core::monotonic_ns();
+    // The comparison registration runs every frame (it must track), its rendering and metrics
+    // every kCompareEvery-th frame (a sample of the run; it costs as much as the main pipeline).
+    const bool compare = frame_index % kCompareEvery == 0;
+    if (auto st = alt->process(frame.bgr, *measured, scene, &alt_result, !compare); !st)
+      throw SpidarError(st.error().message);
 
     // --- metrics against the ground truth ---
     MrFrame m;
@@ -294,15 +307,21 @@ int run_mr_demo(const DemoOptions& o) {
     m.pipeline_ms = result.timings.total_ms;
     m.registration_ms = result.timings.registration_ms;
     m.preprocess_ms = result.timings.key_ms + result.timings.bracelet_ms + result.timings.distance_ms;
+    m.stages = result.timings;
+    m.film_ms = film_ms;
     auto main_m = sim::measure_frame(frame, result, *mode, models, truth_models, truth, camera, &ws);
     if (!main_m) throw SpidarError(main_m.error().message);
     m.truth[0] = *main_m;
-    auto alt_m = sim::measure_frame(frame, alt_result, *mode, models, truth_models, truth, camera, &ws);
-    if (!alt_m) throw SpidarError(alt_m.error().message);
-    m.truth[1] = *alt_m;
+    if (compare) {
+      auto alt_m = sim::measure_frame(frame, alt_result, *mode, models, truth_models, truth, camera, &ws);
+      if (!alt_m) throw SpidarError(alt_m.error().message);
+      m.truth[1] = *alt_m;
+      m.compared = true;
+    }
+    ++frame_index;
     for (int h = 0; h < 2; ++h) {
       m.iterations[h] = result.fits[h].iterations;
-      m.truth_cap_residual_mm[h] = user.cap_residual_m()[h] * 1e3;
+      m.truth_cap_residual_mm[h] = filmed.cap_residual_m[h] * 1e3;
     }
     if (auto s = cube_status.read()) {
       m.lift_mm = s->lift * 1e3;
@@ -326,8 +345,9 @@ int run_mr_demo(const DemoOptions& o) {
       m.servo_jitter_max_us = worst;
       if (ns > 0) last_servo_t = servo_buf[0].t_ns;
     }
+    m.truth_ms = core::ns_to_s(core::monotonic_ns() - done) * 1e3;
     trace.frames.push_back(m);
-
+    const std::int64_t t_out0 = core::monotonic_ns();
     // --- output ---
     cv::Mat& shown = result.composite;
     if (video) {
@@ -346,6 +366,7 @@ int run_mr_demo(const DemoOptions& o) {
       ++next_keyframe;
     }
     if (o.window) (void)pipe->present(*context, shown);
+    trace.frames.back().output_ms = core::ns_to_s(core::monotonic_ns() - t_out0) * 1e3;
     {
       std::ostringstream st;
       st << std::fixed << std::setprecision(1) << "t " << t_script << "/" << seconds << " s  "
@@ -357,15 +378,11 @@ int run_mr_demo(const DemoOptions& o) {
       progress.update(t_script, st.str());
     }
 
-    // Next exposure; frames whose time has already passed are dropped (the camera does not wait).
-    t_exp += period_ns;
-    const std::int64_t now = core::monotonic_ns();
-    while (t_exp + 2'000'000 < now - period_ns / 2) {
-      t_exp += period_ns;
-      ++dropped;
-    }
   }
   const double wall_s = core::ns_to_s(core::monotonic_ns() - t_open);
+  camera_thread->stop();
+  const int dropped = static_cast<int>(camera_thread->filmed()) - static_cast<int>(trace.frames.size());
+  if (!camera_thread->error().empty()) throw SpidarError(camera_thread->error());
   loop.stop();
   physics.stop();
   dev.close();

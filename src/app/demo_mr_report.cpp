@@ -39,7 +39,11 @@ std::vector<double> column(const MrTrace& t, F f) {
 }
 
 /// Registration figures of one variant (0 main, 1 comparison).
-nlohmann::json registration_json(const MrTrace& t, int k) {
+nlohmann::json registration_json(const MrTrace& all, int k) {
+  MrTrace t;
+  for (const auto& m : all.frames) {
+    if (k == 0 || m.compared) t.frames.push_back(m);
+  }
   const auto iou = column(t, [k](const MrFrame& m) { return m.truth[k].iou; });
   const auto jp = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].joint_px[0] + m.truth[k].joint_px[1]); });
   const auto tip = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].fingertip_mm[0] + m.truth[k].fingertip_mm[1]); });
@@ -49,7 +53,8 @@ nlohmann::json registration_json(const MrTrace& t, int k) {
           {"joint_px_mean", mean(jp)},
           {"fingertip_mm_mean", mean(tip)},
           {"fingertip_mm_p95", quantile(tip, 0.95)},
-          {"occlusion_error_pct", mean(occ)}};
+          {"occlusion_error_pct", mean(occ)},
+          {"frames", t.frames.size()}};
 }
 
 void save_plot(const std::string& path, const render::PlotSpec& spec,
@@ -90,8 +95,7 @@ void write_plots(const fs::path& dir, const MrTrace& t) {
     spec.y_label = "IoU / %";
     spec.references = {{"IoU target 0.93", 0.93, render::plot_colour(7)}};
     save_plot((dir / "iou_occlusion.png").string(), spec,
-              S{series(t, "IoU joint-balls", 0, [](const MrFrame& m) { return m.truth[0].iou; }),
-                series(t, "IoU other", 1, [](const MrFrame& m) { return m.truth[1].iou; }),
+              S{series(t, "IoU", 0, [](const MrFrame& m) { return m.truth[0].iou; }),
                 series(t, "occl. depth [%]", 2, [](const MrFrame& m) { return m.truth[0].occlusion_pct; }),
                 series(t, "occl. paper [%]", 5, [](const MrFrame& m) { return m.truth[0].occlusion_pct_paper; })});
   }
@@ -185,7 +189,18 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
        {{"fps", fps},
         {"latency_ms_median", quantile(lat_ms, 0.5)},
         {"latency_ms_p95", quantile(lat_ms, 0.95)},
-        {"ms_per_frame_median", quantile(pipe_ms, 0.5)}}},
+        {"ms_per_frame_median", quantile(pipe_ms, 0.5)},
+        {"stage_ms_median",
+         {{"chroma_key", quantile(column(t, [](const MrFrame& m) { return m.stages.key_ms; }), 0.5)},
+          {"bracelets", quantile(column(t, [](const MrFrame& m) { return m.stages.bracelet_ms; }), 0.5)},
+          {"distance_transform", quantile(column(t, [](const MrFrame& m) { return m.stages.distance_ms; }), 0.5)},
+          {"registration", quantile(column(t, [](const MrFrame& m) { return m.stages.registration_ms; }), 0.5)},
+          {"render", quantile(column(t, [](const MrFrame& m) { return m.stages.render_ms; }), 0.5)},
+          {"composite", quantile(column(t, [](const MrFrame& m) { return m.stages.composite_ms; }), 0.5)}}},
+        {"simulation_ms_median",
+         {{"synthetic_camera", quantile(column(t, [](const MrFrame& m) { return m.film_ms; }), 0.5)},
+          {"truth_and_comparison", quantile(column(t, [](const MrFrame& m) { return m.truth_ms; }), 0.5)},
+          {"video_output", quantile(column(t, [](const MrFrame& m) { return m.output_ms; }), 0.5)}}}}},
       {"cube",
        {{"present", s.has_cube},
         {"turns_completed", s.turns},

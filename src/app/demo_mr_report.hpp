@@ -18,8 +18,13 @@ struct MrFrame {
   double pipeline_ms = 0;      ///< frame pipeline cost [ms]
   double registration_ms = 0;  ///< both hands [ms]
   double preprocess_ms = 0;    ///< chroma key, bracelets, distance transform [ms]
+  pipeline::FrameTimings stages;  ///< the main pipeline's stages [ms]
+  double film_ms = 0;          ///< synthetic camera (simulation cost, not pipeline) [ms]
+  double truth_ms = 0;         ///< ground-truth posture, comparison fit, metrics [ms]
+  double output_ms = 0;        ///< video and keyframes [ms]
   /// [0]: the main registration, [1]: the comparison (silhouette term switched the other way).
   std::array<sim::FrameTruthMetrics, 2> truth{};
+  bool compared = false;  ///< truth[1] measured in this frame
   std::array<int, 2> iterations{};
   std::array<double, 2> truth_cap_residual_mm{};
   double lift_mm = 0, u_angle_deg = 0;

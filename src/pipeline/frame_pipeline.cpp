@@ -51,6 +51,10 @@ struct FramePipeline::Impl {
   registration::SuccessiveAdjustment solver;
   render::Compositor main, other;
   SceneSnapshot scene;  ///< the world plus the fitted hands (reused)
+  /// The world's meshes followed by the hand skins' (rebuilt when the world's list changes).
+  const void* world_meshes = nullptr;
+  std::shared_ptr<std::vector<MeshData>> meshes;
+  std::array<render::HandSkin, 2> skins;
   std::array<hand::HandParams, 2> previous;
   bool have_previous = false;
 
@@ -99,7 +103,8 @@ const FramePipelineParams& FramePipeline::params() const { return impl_->params;
 const std::array<hand::HandModel, 2>& FramePipeline::models() const { return impl_->models; }
 
 Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample& tips,
-                              const SceneSnapshot& world, FrameResult* out) {
+                              const SceneSnapshot& world, FrameResult* out,
+                              bool registration_only) {
   if (out == nullptr) return Error{"frame pipeline: no output given"};
   Impl& s = *impl_;
   const FramePipelineParams& p = s.params;
@@ -177,19 +182,36 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   s.previous = out->hands;
   s.have_previous = true;
   tm.registration_ms = ms_since(t0);
+  if (registration_only) {
+    tm.render_ms = tm.composite_ms = 0;
+    tm.total_ms = ms_since(t_start);
+    return Ok{};
+  }
 
   // The virtual scene with the fitted hands (hidden: they only give depth).
   t0 = Clock::now();
   s.scene.t_s = world.t_s;
-  s.scene.meshes = world.meshes;
   s.scene.shapes = world.shapes;
-  for (int h = 0; h < 2; ++h) {
-    render::append_hand_shapes(hand::hand_render_shapes(s.models[h], out->hands[h]), &s.scene);
+  if (p.skinned_hands) {
+    if (!s.meshes || s.world_meshes != world.meshes.get()) {
+      auto meshes = std::make_shared<std::vector<MeshData>>();
+      if (world.meshes) *meshes = *world.meshes;
+      for (int h = 0; h < 2; ++h) s.skins[h] = render::build_hand_skin(s.models[h], p.model_skin, meshes.get());
+      s.meshes = std::move(meshes);
+      s.world_meshes = world.meshes.get();
+    }
+    s.scene.meshes = s.meshes;
+    for (int h = 0; h < 2; ++h)
+      render::pose_hand_skin(s.models[h], s.skins[h], out->hands[h], p.model_skin, &s.scene);
+  } else {
+    s.scene.meshes = world.meshes;
+    for (int h = 0; h < 2; ++h)
+      render::append_hand_shapes(hand::hand_render_shapes(s.models[h], out->hands[h]), &s.scene);
   }
   render::RenderParams rp;
   rp.hands = render::HandDrawMode::kHidden;
   if (auto st = s.renderer->render(s.scene, s.camera, rp); !st) return st;
-  if (auto st = s.renderer->read(&out->virt, render::kAllTargets); !st) return st;
+  if (auto st = s.renderer->read(&out->virt, render::kColour | render::kDepth | render::kHandDepth); !st) return st;
   tm.render_ms = ms_since(t0);
 
   // Compositing.

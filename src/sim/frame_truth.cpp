@@ -1,5 +1,6 @@
 #include "spidar/sim/frame_truth.hpp"
 
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -27,18 +28,24 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     m.fingertip_mm[h] = registration::fingertip_error_m(f, t) * 1e3;
     m.joint_px[h] = registration::joint_px_error(f, t, camera);
   }
-  cv::compare(result.virt.hand_id, 0, ws->model_mask, cv::CMP_GT);
+  // Every pixel a fitted hand covers, in front of the scene or not (the truth's hand_only mask is
+  // filmed without a scene too).
+  cv::compare(result.virt.hand_depth, std::numeric_limits<float>::max(), ws->model_mask, cv::CMP_LT);
   m.iou = registration::mask_iou(ws->model_mask, frame.hand_only);
 
   if (auto st = render::truth_composite_mask(frame.mask, frame.depth, result.virt.depth,
                                              &ws->truth_alpha);
       !st)
     return st.error();
-  // The hand region: the real hands and wherever either composite shows the real image.
+  // The hand region: the real hands and wherever either composite shows the real image, less the
+  // forearms and bracelets (neither method models them; the depth compositor shows them, the
+  // paper's hides them).
   cv::compare(result.composite_alpha, 0.5, ws->region, cv::CMP_GE);
   cv::compare(result.other_alpha, 0.5, ws->tmp, cv::CMP_GE);
   cv::bitwise_or(ws->region, ws->tmp, ws->region);
-  cv::bitwise_or(ws->region, frame.mask, ws->region);
+  cv::bitwise_or(ws->region, frame.hand_only, ws->region);
+  cv::bitwise_xor(frame.mask, frame.hand_only, ws->tmp);  // forearm and bracelet pixels
+  ws->region.setTo(0, ws->tmp);
   const bool depth_main = main_mode == render::CompositeMode::kDepth;
   const cv::Mat& depth_alpha = depth_main ? result.composite_alpha : result.other_alpha;
   const cv::Mat& paper_alpha = depth_main ? result.other_alpha : result.composite_alpha;

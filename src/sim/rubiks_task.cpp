@@ -87,9 +87,38 @@ RubiksTask::HandState RubiksTask::state(double t, hand::Side side, int /*finger*
   return s;
 }
 
-void RubiksTask::goals(double t, std::span<Vec3> goal) { goals_at(t, goal); }
+RubiksTask::RubiksTask(RubiksTaskParams p) : p_(p) {
+  for (int h = 0; h < 2; ++h) {
+    frames_.p_W[h] = {p_.p_W_cube.x(), p_.p_W_cube.y(), p_.p_W_cube.z()};
+    frames_.q_WG[h] = {1, 0, 0, 0};
+    frames_.lift[h] = 0;
+  }
+  published_.publish(frames_);
+}
 
-void RubiksTask::goals_at(double t, std::span<Vec3> goal) const {
+void RubiksTask::goals(double t, std::span<Vec3> goal) {
+  if (cube_ != nullptr) {
+    if (const auto c = cube_->read()) {
+      // The cube's orientation with its yaw reduced to (−45°, 45°] by its 90° symmetry.
+      const Quat q(c->q_WC[0], c->q_WC[1], c->q_WC[2], c->q_WC[3]);
+      const Mat3 R = q.normalized().toRotationMatrix();
+      const double yaw = std::atan2(R(1, 0), R(0, 0));
+      const double k = std::round(yaw / (M_PI / 2));
+      const Quat g(R * rot_z(-k * M_PI / 2));
+      for (int h = 0; h < 2; ++h) {
+        const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
+        if (closeness(t, side) > 0.02) continue;  // holding on: keep the grasp frame
+        frames_.p_W[h] = c->p_W;
+        frames_.q_WG[h] = {g.w(), g.x(), g.y(), g.z()};
+        frames_.lift[h] = state(t, side, 0).lift;
+      }
+      published_.publish(frames_);
+    }
+  }
+  goals_at(t, frames_, goal);
+}
+
+void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal) const {
   const Contacts c = contacts(p_);
   const double face = p_.half + p_.proxy_radius - p_.squeeze;
   const double approach = ramp(t, 0.0, 1.0);
@@ -106,7 +135,10 @@ void RubiksTask::goals_at(double t, std::span<Vec3> goal) const {
     Vec3 p = far + (open - far) * approach + (far - open) * withdraw;
     p += (contact - open) * (right ? close_right : close_left);
     const HandState s = state(t, side, f);
-    goal[f] = p_.p_W_cube + rot_z(s.yaw) * p + Vec3(0, 0, s.lift);
+    const int h = right ? 1 : 0;
+    const Quat q_WG(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
+    const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
+    goal[f] = p_WG + q_WG * (rot_z(s.yaw) * p) + Vec3(0, 0, s.lift - fr.lift[h]);
   }
 }
 
@@ -115,19 +147,24 @@ hand::HandParams RubiksTask::nominal(double t, hand::Side side) const {
   const Contacts c = contacts(p_);
   const auto& cs = right ? c.right : c.left;
   // The wrist follows the fingertips' mean displacement from the grasp.
+  const GraspFrames fr = published_.read().value_or(frames_);
+  const int h = right ? 1 : 0;
+  const Quat qg(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
+  const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
   std::array<Vec3, 8> g;
-  goals_at(t, g);
+  goals_at(t, fr, g);
   const HandState s = state(t, side, 0);
-  const Mat3 Rz = rot_z(s.yaw);
+  const Vec3 up(0, 0, s.lift - fr.lift[h]);
+  const Mat3 R = qg.toRotationMatrix() * rot_z(s.yaw);  // the grasp frame, turned
   Vec3 shift = Vec3::Zero();
   for (int f = 0; f < 4; ++f) {
-    const Vec3 rel = Rz.transpose() * (g[(right ? 4 : 0) + f] - p_.p_W_cube - Vec3(0, 0, s.lift));
+    const Vec3 rel = R.transpose() * (g[(right ? 4 : 0) + f] - p_WG - up);
     shift += (rel - cs[f]) / 4.0;
   }
   const Nominal n = nominal_grasp(side);
   hand::HandParams q;
-  const Eigen::AngleAxisd aa(Rz * n.R);
-  q.set_wrist(p_.p_W_cube + Rz * (n.p_wrist + shift) + Vec3(0, 0, s.lift), aa.angle() * aa.axis());
+  const Eigen::AngleAxisd aa(R * n.R);
+  q.set_wrist(p_WG + R * (n.p_wrist + shift) + up, aa.angle() * aa.axis());
   // A relaxed grip: more flexion as the hand closes.
   const double k = 0.3 + 0.7 * closeness(t, side);
   q[hand::kThumbCmcFlexion] = 0.2 * k;

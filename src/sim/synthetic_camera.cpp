@@ -4,7 +4,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "hand_skin.hpp"
+#include "spidar/render/hand_skin.hpp"
 #include "spidar/render/renderer.hpp"
 
 namespace spidar::sim {
@@ -35,7 +35,8 @@ struct SyntheticCamera::Impl {
   vision::Camera camera;
   SyntheticCameraParams params;
   std::array<hand::HandModel, 2> models;
-  std::array<HandSkin, 2> skins;
+  std::array<render::HandSkin, 2> skins;
+  render::HandSkinParams skin;
   std::shared_ptr<const std::vector<MeshData>> meshes;
   std::unique_ptr<render::Renderer> renderer;
   render::RenderParams render_params;
@@ -48,7 +49,7 @@ struct SyntheticCamera::Impl {
     scene.shapes.clear();
     scene.meshes = meshes;
     for (int h = 0; h < 2; ++h)
-      if (poses[h]) pose_hand_skin(models[h], skins[h], *poses[h], params, &scene);
+      if (poses[h]) render::pose_hand_skin(models[h], skins[h], *poses[h], skin, &scene);
   }
 };
 
@@ -65,8 +66,17 @@ Result<std::unique_ptr<SyntheticCamera>> SyntheticCamera::create(
   impl->camera = camera;
   impl->params = params;
   impl->models = truth;
+  render::HandSkinParams& k = impl->skin;
+  k.taper = params.taper;
+  k.palm_fullness = params.palm_fullness;
+  k.forearm_length_m = params.forearm_length_m;
+  k.bracelet = true;
+  k.bracelet_width_m = params.bracelet_width_m;
+  k.bracelet_offset_m = params.bracelet_offset_m;
+  k.skin_rgb = params.skin_rgb;
+  k.bracelet_rgb = params.bracelet_rgb;
   auto meshes = std::make_shared<std::vector<MeshData>>();
-  for (int h = 0; h < 2; ++h) impl->skins[h] = build_hand_skin(truth[h], params, meshes.get());
+  for (int h = 0; h < 2; ++h) impl->skins[h] = render::build_hand_skin(truth[h], impl->skin, meshes.get());
   impl->meshes = meshes;
   auto renderer = render::Renderer::create(context, camera.width(), camera.height());
   if (!renderer) return renderer.error();
@@ -107,7 +117,8 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
     s.build_scene(at);
     if (auto st = s.renderer->render(s.scene, s.camera, s.render_params); !st) return st;
     const bool last = k == samples;
-    if (auto st = s.renderer->read(&s.targets, last ? render::kAllTargets : render::kColour); !st)
+    if (auto st = s.renderer->read(&s.targets, last ? render::kColour | render::kHandDepth | render::kHandId
+                                                   : render::kColour); !st)
       return st;
     if (samples > 1) {
       if (k == 1) s.targets.colour.convertTo(s.accumulator, CV_32FC3);
@@ -128,7 +139,7 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
     for (int x = 0; x < out->mask.cols; ++x) {
       const render::HandId d = render::decode_hand_id(id[x]);
       hi[x] = id[x] == 0 ? 0 : static_cast<std::uint8_t>(d.hand + 1);
-      ho[x] = id[x] != 0 && d.finger != kBraceletPart && d.finger != kForearmPart ? 255 : 0;
+      ho[x] = id[x] != 0 && d.finger != render::kBraceletPart && d.finger != render::kForearmPart ? 255 : 0;
     }
   }
   s.targets.hand_depth.copyTo(out->depth);

@@ -2,6 +2,7 @@
 // filmed over the blue screen, registered with the default model hands, composited into a scene.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <opencv2/core.hpp>
 
 #include "spidar/hand/hand_config.hpp"
@@ -109,6 +110,45 @@ TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {
   const auto c = FramePipeline::create(*context_, camera_, models_, bad);
   ASSERT_FALSE(c.ok());
   EXPECT_NE(c.error().message.find("finger index 9"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace spidar::pipeline
+
+#include "spidar/registration/metrics.hpp"
+#include "spidar/render/hand_shapes.hpp"
+
+namespace spidar::pipeline {
+namespace {
+
+// How much of the IoU a perfect pose can reach: the user's hands at their true pose drawn as the
+// model's capsules (with the user's own sizes) against the filmed hands (tapered bones, fuller
+// palm). Prints the ceiling over the script (run with --gtest_also_run_disabled_tests).
+TEST_F(FramePipelineTest, DISABLED_PrintIouCeilingOfTheCapsuleHand) {
+  auto renderer = render::Renderer::create(*context_, camera_.width(), camera_.height()).value();
+  sim::RubiksTask task({});
+  sim::UserHands user(truth_models_, task);
+  sim::SyntheticFrame frame;
+  render::RenderTargets t;
+  double sum = 0;
+  int n = 0;
+  for (double time = 0.0; time < 12.0; time += 0.25) {
+    pose_user(user, task, time);
+    const auto& truth = user.params();
+    ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+    SceneSnapshot hands;
+    for (int h = 0; h < 2; ++h)
+      render::append_hand_shapes(hand::hand_render_shapes(truth_models_[h], truth[h]), &hands);
+    ASSERT_TRUE(renderer->render(hands, camera_).ok());
+    ASSERT_TRUE(renderer->read(&t, render::kHandDepth).ok());
+    cv::Mat mask;
+    cv::compare(t.hand_depth, std::numeric_limits<float>::max(), mask, cv::CMP_LT);
+    const double iou = registration::mask_iou(mask, frame.hand_only);
+    sum += iou;
+    ++n;
+    std::printf("t %5.2f  IoU(true pose, capsules) %.3f\n", time, iou);
+  }
+  std::printf("mean %.3f over %d poses\n", sum / n, n);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/render/compositor.hpp"
 #include "spidar/render/context.hpp"
+#include "spidar/render/hand_skin.hpp"
 #include "spidar/render/renderer.hpp"
 #include "spidar/vision/bracelet.hpp"
 #include "spidar/vision/camera.hpp"
@@ -36,6 +37,11 @@ struct FramePipelineParams {
   bool other_composite = true;          ///< also compose in the other mode (for comparison)
   int silhouette_margin_px = 40;        ///< distance-transform margin (silhouette term only)
   int first_frame_rounds = 6;           ///< registration rounds on the first frame (cold start)
+  /// How the fitted hands are drawn (their depth decides occlusion; their pixels give the IoU):
+  /// a skin (tapered bones, rounded palm: render/hand_skin.hpp) or the model's capsules.
+  bool skinned_hands = true;
+  /// The model hands' skin: a typical hand, no forearm, no bracelet.
+  render::HandSkinParams model_skin{0.10, 1.12, 0.0, false};
   /// Hand rotations to start from on the first frame (rotation vectors, world) [rad].
   std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};
   /// Device finger index of each hand's thumb, index, middle, ring (the config's order).
@@ -53,7 +59,8 @@ struct FrameResult {
   std::array<registration::FitReport, 2> fits;
   std::array<vision::BraceletObservation, 2> bracelets;
   vision::ChromaKeyResult key;
-  render::RenderTargets virt;   ///< the virtual scene with the fitted hands (hidden)
+  render::RenderTargets virt;   ///< the virtual scene with the fitted hands (hidden): colour,
+                                ///< depth, hand_depth (no hand_id)
   cv::Mat composite;            ///< in params.compositor.mode
   cv::Mat composite_alpha;      ///< CV_32FC1, share of the real image in `composite`
   cv::Mat other;                ///< the other mode (if other_composite)
@@ -74,8 +81,9 @@ class FramePipeline {
 
   /// Processes one frame: `bgr` the camera image (camera's size), `fingertips` the servo sample
   /// at its exposure time, `scene` the virtual world. Error on a bad frame (naming what).
+  /// With `registration_only` it stops after fitting the hands (no rendering, no composites).
   Status process(const cv::Mat& bgr, const device::FingertipSample& fingertips,
-                 const SceneSnapshot& scene, FrameResult* out);
+                 const SceneSnapshot& scene, FrameResult* out, bool registration_only = false);
   /// Shows an image (e.g. the composite) in the window of `context` (error when headless).
   Status present(render::Context& context, const cv::Mat& bgr);
   /// Forgets the previous frame (the next one is a cold start).

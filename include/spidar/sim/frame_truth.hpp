@@ -17,6 +17,8 @@ struct FrameTruthMetrics {
   double iou = 0;                     ///< fitted hands' pixels vs the real hands' (no bracelet/arm)
   std::array<double, 2> fingertip_mm{};  ///< mean fingertip cap error per hand [mm]
   std::array<double, 2> joint_px{};      ///< mean projected joint error per hand [px]
+  /// Hand region: the real hands (without forearm and bracelet) and wherever either composite
+  /// shows the real image, except on the real forearm and bracelet.
   double occlusion_pct = 0;        ///< depth-mode composite vs the truth [% of the hand region]
   double occlusion_pct_paper = 0;  ///< paper-mode composite vs the truth [%]
 };

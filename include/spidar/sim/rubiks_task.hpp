@@ -15,8 +15,15 @@
 /// Goals lie `squeeze` inside the faces, so the fingertips' impedance sets the grip force.
 /// In a scene without a cube, p_W_cube and half describe the object to reach for (any box-like
 /// object): the same motions then grasp, push and turn it.
+///
+/// The user watches the cube: with track() given, a hand that is open takes the cube's current
+/// pose (from the physics thread) as the frame of its next grasp, so a cube that tilted or slid
+/// while held is grasped where it is (up to its 90° symmetry about its vertical axis).
+#include <array>
 #include <span>
 
+#include "spidar/core/pose.hpp"
+#include "spidar/core/seqlock.hpp"
 #include "spidar/core/types.hpp"
 #include "spidar/device/fingertip_source.hpp"
 #include "spidar/hand/parameters.hpp"
@@ -35,9 +42,17 @@ struct RubiksTaskParams {
   double duration = 12.0;        ///< [s]
 };
 
+/// The cube's pose as the physics thread publishes it (plain data for core::Latest).
+struct CubePoseSample {
+  std::array<double, 3> p_W{};           ///< centre [m]
+  std::array<double, 4> q_WC{1, 0, 0, 0};  ///< orientation (w, x, y, z)
+};
+
 class RubiksTask final : public device::FingertipSource {
  public:
-  explicit RubiksTask(RubiksTaskParams p) : p_(p) {}
+  explicit RubiksTask(RubiksTaskParams p);
+  /// Follow the cube's published pose (must outlive the task); nullptr = the start pose.
+  void track(const core::Latest<CubePoseSample>* cube) { cube_ = cube; }
   /// Goals of the eight fingertips at time t [s] (world, m).
   void goals(double t_s, std::span<Vec3> p_W_goal) override;
   /// The nominal pose of one hand at time t (wrist in world, relaxed finger angles).
@@ -54,11 +69,21 @@ class RubiksTask final : public device::FingertipSource {
     double yaw = 0;              ///< rotation of the hand about the cube's vertical axis [rad]
     double lift = 0;             ///< [m]
   };
+  /// Where each hand's grasp is: the cube's pose when the hand last was open, and the script's
+  /// lift at that time (plain data: published by the servo thread, read by the frame thread).
+  struct GraspFrames {
+    std::array<std::array<double, 3>, 2> p_W{};
+    std::array<std::array<double, 4>, 2> q_WG{};
+    std::array<double, 2> lift{};
+  };
   HandState state(double t_s, hand::Side side, int finger) const;
   /// 0 = hand open, 1 = closed on the grasp.
   static double closeness(double t_s, hand::Side side);
-  void goals_at(double t_s, std::span<Vec3> p_W_goal) const;
+  void goals_at(double t_s, const GraspFrames& frames, std::span<Vec3> p_W_goal) const;
   RubiksTaskParams p_;
+  const core::Latest<CubePoseSample>* cube_ = nullptr;
+  GraspFrames frames_;                      ///< servo thread's copy
+  core::Latest<GraspFrames> published_;     ///< for nominal()
 };
 
 }  // namespace spidar::sim

@@ -1,4 +1,4 @@
-#include "hand_skin.hpp"
+#include "spidar/render/hand_skin.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -6,7 +6,7 @@
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/hand/rotation_vector.hpp"
 
-namespace spidar::sim {
+namespace spidar::render {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -81,7 +81,7 @@ MeshData rounded_box(const Vec3& half, double e, int slices, int stacks) {
   return m;
 }
 
-HandSkin build_hand_skin(const hand::HandModel& model, const SyntheticCameraParams& p,
+HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
                          std::vector<MeshData>* meshes) {
   HandSkin skin;
   // Bone lengths are fixed by the shape: measure them at the zero pose.
@@ -104,7 +104,7 @@ HandSkin build_hand_skin(const hand::HandModel& model, const SyntheticCameraPara
 }
 
 void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const hand::HandParams& q,
-                    const SyntheticCameraParams& p, SceneSnapshot* scene) {
+                    const HandSkinParams& p, SceneSnapshot* scene) {
   const hand::HandRenderShapes shapes = hand::hand_render_shapes(model, q);
   const int hand = static_cast<int>(model.side);
   auto add = [&](Shape s, int finger, const std::array<float, 3>& colour) {
@@ -136,6 +136,7 @@ void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const ha
     arm.X_WS = along(q.p_W_wrist(), toward_elbow);
     add(arm, kForearmPart, p.skin_rgb);
   }
+  if (!p.bracelet) return;
   Shape bracelet;
   bracelet.type = Shape::Type::kCylinder;
   bracelet.X_WS = along(q.p_W_wrist() + p.bracelet_offset_m * toward_elbow, toward_elbow);
@@ -144,4 +145,4 @@ void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const ha
   add(bracelet, kBraceletPart, p.bracelet_rgb);
 }
 
-}  // namespace spidar::sim
+}  // namespace spidar::render

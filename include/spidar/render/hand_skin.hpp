@@ -1,15 +1,30 @@
 #pragma once
-// The synthetic camera's hand geometry: smooth meshes built once per hand shape, posed per frame.
-// Tapered bones (sphere-swept cones), a superellipsoid palm, a forearm and a bracelet, all
-// derived from the same joints as the model's capsules but shaped differently.
+/// A hand's skin: smooth meshes built once per hand shape, posed per frame. Tapered bones
+/// (sphere-swept cones, thicker at their proximal end), a superellipsoid palm, optionally a
+/// forearm and a bracelet, all on the same joints as the model's capsules
+/// (hand/render_geometry.hpp). The synthetic camera films users' hands with it; the frame
+/// pipeline draws the fitted model hands with it (with the model's own, slightly different,
+/// skin parameters), so that a hand is compared with a hand, not with sticks.
 #include <array>
 #include <vector>
 
 #include "spidar/core/scene_snapshot.hpp"
 #include "spidar/hand/hand_model.hpp"
-#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/core/types.hpp"
 
-namespace spidar::sim {
+namespace spidar::render {
+
+/// The skin's shape and colours.
+struct HandSkinParams {
+  double taper = 0.12;                ///< bone radius: (1 + taper)·r proximal, (1 − taper)·r distal
+  double palm_fullness = 1.2;         ///< palm thickness × this (vs the model's box)
+  double forearm_length_m = 0.10;     ///< visible forearm beyond the wrist [m]; 0 = none
+  bool bracelet = true;               ///< a bracelet around the wrist
+  double bracelet_width_m = 0.018;    ///< along the forearm [m]
+  double bracelet_offset_m = 0.012;   ///< bracelet centre, from the wrist toward the elbow [m]
+  std::array<float, 3> skin_rgb{0.88f, 0.66f, 0.54f};
+  std::array<float, 3> bracelet_rgb{0.85f, 0.07f, 0.07f};
+};
 
 /// Finger ids of the non-digit parts in the shapes' `finger` field.
 inline constexpr int kPalmPart = -1;
@@ -36,12 +51,12 @@ struct HandSkin {
 };
 
 /// Builds one hand's meshes into `meshes`.
-HandSkin build_hand_skin(const hand::HandModel& model, const SyntheticCameraParams& params,
+HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& params,
                          std::vector<MeshData>* meshes);
 
 /// Appends the hand posed by `q` (non-hand shapes with their own colours; hand/finger set so the
 /// renderer's hand targets give ground truth).
 void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const hand::HandParams& q,
-                    const SyntheticCameraParams& params, SceneSnapshot* scene);
+                    const HandSkinParams& params, SceneSnapshot* scene);
 
-}  // namespace spidar::sim
+}  // namespace spidar::render

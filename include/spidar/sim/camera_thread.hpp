@@ -1,0 +1,81 @@
+#pragma once
+/// The simulated rig's camera as a camera is to a frame thread: its own thread films the user's
+/// real hands at the camera rate (with its own headless GL context) and hands over each frame
+/// with its exposure time and its ground truth; the frame thread takes the newest frame whenever
+/// it is ready for one, so a slow frame thread drops frames, it never slows the camera.
+///
+/// Per frame: the true fingertip caps at the exposure time (the simulated device's ground truth,
+/// interpolated), the user's hand posture for them (UserHands), then the synthetic camera.
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <thread>
+
+#include "spidar/core/result.hpp"
+#include "spidar/core/triple_buffer.hpp"
+#include "spidar/device/servo_types.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/sim/user_hands.hpp"
+
+namespace spidar::sim {
+
+struct FilmedFrame {
+  std::uint64_t index = 0;         ///< frame number since start (gaps: frames not taken)
+  std::int64_t t_exposure_ns = 0;  ///< host monotonic time of the exposure [ns]
+  double t_script_s = 0;           ///< the scenario's time at the exposure [s]
+  SyntheticFrame frame;
+  std::array<hand::HandParams, 2> truth;  ///< the user's hands at the exposure
+  std::array<double, 2> cap_residual_m{};  ///< UserHands::cap_residual_m
+  double film_ms = 0;              ///< cost of posing and filming [ms]
+};
+
+/// Fills `out` with the true fingertip caps at t_ns (8 of them); false if there are none yet.
+using TruthAt = std::function<bool(std::int64_t t_ns, std::span<Vec3> out)>;
+
+struct CameraThreadParams {
+  double fps = 30.0;
+  std::int64_t t0_ns = 0;        ///< script time 0 (host monotonic) [ns]
+  std::int64_t readout_ns = 2'000'000;  ///< wait after the exposure before filming [ns]
+};
+
+class CameraThread {
+ public:
+  /// Starts the thread; returns once its GL context and camera exist (or the error why not).
+  static Result<std::unique_ptr<CameraThread>> start(const vision::Camera& camera,
+                                                     const std::array<hand::HandModel, 2>& truth,
+                                                     const SyntheticCameraParams& film_params,
+                                                     const RubiksTask& task, TruthAt truth_at,
+                                                     const CameraThreadParams& params);
+  ~CameraThread();
+  CameraThread(const CameraThread&) = delete;
+  CameraThread& operator=(const CameraThread&) = delete;
+
+  /// The newest frame if one arrived since the last call (then `frame()` holds it).
+  bool take();
+  const FilmedFrame& frame() const { return frames_.front(); }
+  /// Frames filmed so far.
+  std::uint64_t filmed() const { return filmed_.load(std::memory_order_acquire); }
+  /// The error that stopped the thread, if any (read after stop()).
+  const std::string& error() const { return error_; }
+  void stop();
+
+ private:
+  CameraThread() = default;
+  void run(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
+           const SyntheticCameraParams& film_params, const RubiksTask& task,
+           std::function<void(Status)> ready);
+
+  CameraThreadParams params_;
+  TruthAt truth_at_;
+  core::TripleBuffer<FilmedFrame> frames_;
+  std::atomic<std::uint64_t> filmed_{0};
+  std::atomic<bool> stop_{false};
+  std::string error_;
+  std::thread thread_;
+};
+
+}  // namespace spidar::sim

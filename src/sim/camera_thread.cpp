@@ -1,0 +1,91 @@
+#include "spidar/sim/camera_thread.hpp"
+
+#include <chrono>
+#include <future>
+
+#include "spidar/core/clock.hpp"
+#include "spidar/render/context.hpp"
+
+namespace spidar::sim {
+
+Result<std::unique_ptr<CameraThread>> CameraThread::start(
+    const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
+    const SyntheticCameraParams& film_params, const RubiksTask& task, TruthAt truth_at,
+    const CameraThreadParams& params) {
+  if (!(params.fps > 0 && params.fps <= 1000)) return Error{"camera thread: fps must be in (0, 1000]"};
+  if (!truth_at) return Error{"camera thread: no ground-truth source given"};
+  std::unique_ptr<CameraThread> c(new CameraThread());
+  c->params_ = params;
+  c->truth_at_ = std::move(truth_at);
+  std::promise<Status> ready;
+  auto started = ready.get_future();
+  CameraThread* self = c.get();
+  c->thread_ = std::thread([self, camera, truth, film_params, &task, &ready] {
+    self->run(camera, truth, film_params, task, [&ready](Status s) { ready.set_value(std::move(s)); });
+  });
+  Status s = started.get();
+  if (!s) {
+    c->stop();
+    return s.error();
+  }
+  return c;
+}
+
+CameraThread::~CameraThread() { stop(); }
+
+void CameraThread::stop() {
+  stop_.store(true, std::memory_order_release);
+  if (thread_.joinable()) thread_.join();
+}
+
+bool CameraThread::take() { return frames_.update(); }
+
+void CameraThread::run(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
+                       const SyntheticCameraParams& film_params, const RubiksTask& task,
+                       std::function<void(Status)> ready) {
+  // The GL context lives (and is current) on this thread only.
+  auto ctx = render::Context::create_headless();
+  if (!ctx) return ready(Error{"camera thread: OpenGL: " + ctx.error().message});
+  auto film = SyntheticCamera::create(*ctx.value(), camera, truth, film_params);
+  if (!film) return ready(Error{"camera thread: " + film.error().message});
+  UserHands user(truth, task);
+  ready(Ok{});
+
+  const auto period_ns = static_cast<std::int64_t>(1e9 / params_.fps);
+  std::array<Vec3, 8> caps;
+  std::uint64_t index = 0;
+  std::int64_t t_exp = params_.t0_ns;
+  while (!stop_.load(std::memory_order_acquire)) {
+    core::sleep_until_ns(t_exp + params_.readout_ns);
+    if (stop_.load(std::memory_order_acquire)) break;
+    const std::int64_t t_start = core::monotonic_ns();
+    if (truth_at_(t_exp, caps)) {
+      const double t_script = core::ns_to_s(t_exp - params_.t0_ns);
+      user.update(t_script, caps);
+      FilmedFrame& out = frames_.back();
+      out.index = index;
+      out.t_exposure_ns = t_exp;
+      out.t_script_s = t_script;
+      out.truth = user.params();
+      out.cap_residual_m = user.cap_residual_m();
+      const HandPoses poses{&out.truth[0], &out.truth[1]};
+      if (auto st = film.value()->film(poses, &out.frame); !st) {
+        error_ = st.error().message;
+        break;
+      }
+      out.film_ms = core::ns_to_s(core::monotonic_ns() - t_start) * 1e3;
+      frames_.publish();
+      filmed_.fetch_add(1, std::memory_order_acq_rel);
+    }
+    // The next exposure; exposures already past are skipped (a stalled camera drops frames).
+    ++index;
+    t_exp += period_ns;
+    const std::int64_t now = core::monotonic_ns();
+    while (t_exp + params_.readout_ns < now) {
+      t_exp += period_ns;
+      ++index;
+    }
+  }
+}
+
+}  // namespace spidar::sim
