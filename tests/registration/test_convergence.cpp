@@ -11,7 +11,8 @@
 // starts (8 seeds × 2 hands, default settings): paper's terms 21.5 → 1.4 mm, 19.8 → 3.7 px mean,
 // worst 2.0 mm / 5.8 px; with the silhouette term 1.1 mm / 3.3 px, worst 1.4 mm / 4.1 px. The
 // bounds (3 mm and 7 px per fit, 2 mm and 4.5 px mean) leave ~1 px over the worst fit and fail on
-// a broken term (bracelet_offset_m = 0 alone gives 6.6 px means, a 3 px silhouette σ 6.3 px).
+// a broken term (bracelet_offset_m = 0 alone gives 7.7 px / 2.6 mm means, a 3 px silhouette σ
+// 6.3 px).
 #include <gtest/gtest.h>
 
 #include <cstdio>

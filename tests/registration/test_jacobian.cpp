@@ -102,5 +102,32 @@ TEST(ResidualJacobian, NonFiniteObservationsAreIgnored) {
   EXPECT_TRUE(r1.allFinite());
 }
 
+TEST(SuccessiveAdjustment, NanStartAndObservationsGiveAFiniteFit) {
+  Case c;
+  make_case(0, 9, &c);
+  const ImageEvidence image = c.mask.evidence(&c.camera, true);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  c.obs.p_W_fingertip[1] = Vec3(nan, 0, 0);
+  c.obs.wrist_confidence = nan;
+  c.prior[hand::kIndexDip] = nan;
+  hand::HandParams q = c.q;
+  q[hand::kMiddleDip] = nan;
+  const FitReport rep = SuccessiveAdjustment(c.params).fit(c.model, c.obs, image, &c.prior, &q);
+  EXPECT_TRUE(q.q.allFinite());
+  EXPECT_TRUE(std::isfinite(rep.cost_final));
+  EXPECT_TRUE(hand::within_limits(q, c.model.limits));
+}
+
+TEST(SuccessiveAdjustment, RejectsInvalidParams) {
+  RegistrationParams p;
+  p.joint_ball_sigma_px = -1;
+  try {
+    SuccessiveAdjustment s(p);
+    FAIL() << "expected an exception";
+  } catch (const SpidarError& e) {
+    EXPECT_NE(std::string(e.what()).find("joint_ball_sigma_px"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace spidar::registration

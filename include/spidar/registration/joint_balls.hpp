@@ -30,7 +30,10 @@ using JointBalls = std::array<JointBall, hand::kJointCount>;
 Vec2 joint_ball_target(const cv::Mat& alpha, const Vec2& centre_px, const Vec2& bone_dir_px,
                        double radius_px, double gain, double threshold, int* on_count);
 
-/// The balls of one posed hand's joints.
+/// The balls of one posed hand's joints: MCP, PIP and DIP of every finger (little included) and
+/// the thumb's CMC, MCP and IP, each with its neighbours along the projected bone leaving the
+/// joint. No ball at the wrist or the tips, nor for joints off the image or within 1 cm of the
+/// camera plane. No balls at all if `alpha` is empty.
 void joint_ball_targets(const hand::HandModel& model, const hand::HandPoints& points,
                         const vision::Camera& camera, const cv::Mat& alpha,
                         const RegistrationParams& params, JointBalls* balls);

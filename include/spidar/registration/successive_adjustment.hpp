@@ -8,8 +8,20 @@
 /// the current pose, silhouette samples, the prior) and solves
 ///   (A + λ diag(A)) Δθ = b,   A = Σ JᵀJ,  b = −Σ Jᵀ r    (eq. 39's Δθ = A⁺ b when λ = 0)
 /// with the residuals divided by their σ (registration_params.hpp), then clamps θ + Δθ into the
-/// joint limits. A step that does not lower the cost is rejected and λ grows ×10; an accepted step
-/// shrinks it ÷10. It stops when J < cost_epsilon, ‖Δθ‖ < step_epsilon or after max_iterations.
+/// joint limits. A step that does not lower the cost (evaluated with the image targets frozen at
+/// the linearisation, residuals.hpp) is rejected and λ grows ×10; an accepted step shrinks it ÷10.
+/// Every solve, accepted or rejected, counts as one iteration. It stops when J < cost_epsilon,
+/// ‖Δθ‖ < step_epsilon or after max_iterations.
+///
+/// Details beyond the paper (residuals.hpp has the exact residuals):
+///  - the wrist term compares the bracelet's midpoint with the projection of the point
+///    bracelet_offset_m from the wrist joint toward the elbow (0 = joint 0 itself);
+///  - joint-balls sit at MCP, PIP and DIP of every finger (little included) and at the thumb's
+///    CMC, MCP and IP; not at the wrist nor the tips (joint_balls.cpp says why). A ball enters the
+///    cost only where eq. 21 moves its joint (P̃ ≠ P): one wholly inside the silhouette would add
+///    only a spring holding the joint at the current iterate, slowing convergence several-fold;
+///  - the silhouette term pulls points of the model's bones that lie outside the real silhouette
+///    (> 0.5 px) onto their nearest silhouette pixel, never the other way.
 /// Nothing here allocates per frame.
 #include <array>
 #include <opencv2/core/mat.hpp>
@@ -55,12 +67,16 @@ struct FitReport {
 
 class SuccessiveAdjustment {
  public:
+  /// Throws SpidarError (naming the field) if the params are invalid.
   explicit SuccessiveAdjustment(const RegistrationParams& params = {});
   const RegistrationParams& params() const { return params_; }
 
   /// Fits one hand. `params` holds the start (the previous frame's result: warm start) on entry
   /// and the fit on return; `prior` is the temporal prior's mean (usually the same previous
-  /// result; null = no prior). Never produces NaN: non-finite observations are ignored.
+  /// result; null = no prior). Never produces NaN: non-finite observations (fingertips, wrist
+  /// pixel, confidence, prior entries) are ignored, a NaN start is clamped to finite values, and
+  /// a matte that is not CV_32FC1 counts as no matte. The report's cost_final and terms are at
+  /// the final pose with the image targets recomputed there.
   FitReport fit(const hand::HandModel& model, const HandObservation& observation,
                 const ImageEvidence& image, const hand::HandParams* prior,
                 hand::HandParams* params) const;
