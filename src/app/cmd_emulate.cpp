@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "cli_support.hpp"
+#include "spidar/core/realtime.hpp"
 #include "commands.hpp"
 #include "device_backends.hpp"
 #include "spidar/core/clock.hpp"
@@ -70,16 +71,10 @@ Action add_emulate_device(CLI::App& app) {
     }
     // The emulator stands in for a microcontroller: real-time priority, on the first CPU (the
     // servo loop pins itself to the last).
-    sched_param sp{};
-    sp.sched_priority = 70;
-    if (const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp); rc != 0) {
-      std::cerr << "emulate-device: warning: SCHED_FIFO not permitted (" << std::strerror(rc)
-                << "); expect latency spikes\n";
+    if (const Status rt = core::set_fifo_priority(70); !rt.ok()) {
+      std::cerr << "emulate-device: warning: " << rt.error().message << "; expect latency spikes\n";
     }
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(0, &set);
-    (void)pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+    (void)core::pin_to_cpu(0);
     emulator.run(g_stop);
     if (timer.joinable()) timer.join();
     const auto c = emulator.counters();

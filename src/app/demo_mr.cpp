@@ -45,7 +45,7 @@ namespace fs = std::filesystem;
 struct CubeStatus {
   double t_s = 0;
   double lift = 0;
-  double u_angle = 0;
+  double u_angle = 0, d_angle = 0;
   int turns = 0;
   bool solved = true;
   int contacts = 0;
@@ -171,6 +171,7 @@ int run_mr_demo(const DemoOptions& o) {
   auto bridge = std::make_shared<sim::HapticForces>(wp.coupling, servo.rate_hz);
   sim::PhysicsThread physics(*world, *bridge);
   physics.set_snapshot_proxies(false);
+  physics.set_realtime_priority(60);  // above the rendering threads, below the servo loop
   core::Latest<CubeStatus> cube_status;
   core::Latest<sim::CubePoseSample> cube_pose;  // the user watches the cube
   if (cube) task->track(&cube_pose);
@@ -184,6 +185,7 @@ int run_mr_demo(const DemoOptions& o) {
       cube_pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
       s.lift = X.p.z() - X_cube0.p.z();
       s.u_angle = cube->face_angle('U');
+      s.d_angle = cube->face_angle('D');
       turns.update(*cube);
       s.turns = turns.turns();
       s.solved = cube->is_solved();
@@ -326,6 +328,7 @@ int run_mr_demo(const DemoOptions& o) {
     if (auto s = cube_status.read()) {
       m.lift_mm = s->lift * 1e3;
       m.u_angle_deg = s->u_angle * 180 / M_PI;
+      m.d_angle_deg = s->d_angle * 180 / M_PI;
       m.turns = s->turns;
     }
     for (int f = 0; f < 8; ++f) {
@@ -402,6 +405,9 @@ int run_mr_demo(const DemoOptions& o) {
   }
   summary.has_cube = cube.has_value();
   summary.facelets = cube ? cube->facelets() : "";
+  if (cube) {
+    for (char f : std::string("UDFBRL")) summary.face_deg[f] = cube->face_angle(f) * 180 / M_PI;
+  }
   summary.video_path = video ? video->path() : "";
   summary.video_format = video ? render::video_format_name(video->format()) : "";
   summary.main_silhouette = o.silhouette;

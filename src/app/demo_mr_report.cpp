@@ -130,6 +130,7 @@ void write_plots(const fs::path& dir, const MrTrace& t) {
     spec.y_label = "deg / mm";
     save_plot((dir / "cube.png").string(), spec,
               S{series(t, "top layer [deg]", 0, [](const MrFrame& m) { return m.u_angle_deg; }),
+                series(t, "bottom layer [deg]", 2, [](const MrFrame& m) { return m.d_angle_deg; }),
                 series(t, "lift [mm] x10", 1, [](const MrFrame& m) { return 10 * m.lift_mm; })});
   }
 }
@@ -178,7 +179,9 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"physics",
        {{"rate_hz", s.physics.rate_hz},
         {"step_ms_median", s.physics.step_ms_median},
-        {"step_ms_p99", s.physics.step_ms_p99}}},
+        {"step_ms_p99", s.physics.step_ms_p99},
+        {"late_steps", s.physics.late_steps},
+        {"realtime_scheduling", s.physics.realtime_scheduling}}},
       {"registration", reg},
       {"composite",
        {{"mode", s.compositor},
@@ -205,7 +208,12 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
        {{"present", s.has_cube},
         {"turns_completed", s.turns},
         {"solved", s.solved},
-        {"facelets", s.facelets}}},
+        {"facelets", s.facelets},
+        {"face_angles_deg", [&] {
+           nlohmann::json j = nlohmann::json::object();
+           for (const auto& [f, a] : s.face_deg) j[std::string(1, f)] = a;
+           return j;
+         }()}}},
       {"ground_truth", {{"cap_residual_mm_max", quantile(cap_res, 1.0)}}},
       {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
   std::ofstream(dir / "report.json") << report.dump(2) << "\n";

@@ -2,6 +2,7 @@
 /// What the mixed-reality demo records per frame, and its report: report.json, plot PNGs and the
 /// printed summary.
 #include <array>
+#include <map>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -27,7 +28,7 @@ struct MrFrame {
   bool compared = false;  ///< truth[1] measured in this frame
   std::array<int, 2> iterations{};
   std::array<double, 2> truth_cap_residual_mm{};
-  double lift_mm = 0, u_angle_deg = 0;
+  double lift_mm = 0, u_angle_deg = 0, d_angle_deg = 0;
   int turns = 0;
   std::array<double, 8> force_n{};
   double servo_rate_hz = 0, servo_jitter_max_us = 0;
@@ -44,6 +45,7 @@ struct MrSummary {
   sim::PhysicsThreadStats physics;
   int turns = 0;
   bool solved = false, has_cube = false;
+  std::map<char, double> face_deg;  ///< each face layer's final angle [deg]
   std::string facelets, video_path, video_format, compositor, scene, user_hand;
   bool main_silhouette = false;
   int width = 0, height = 0;

@@ -1,5 +1,7 @@
 #include "spidar/device/servo_loop.hpp"
 
+#include "spidar/core/realtime.hpp"
+
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -122,22 +124,14 @@ void ServoLoop::monitor() {
 void ServoLoop::run() {
   if (servo_.on_thread_start) servo_.on_thread_start();
   if (servo_.realtime) {
-    sched_param sp{};
-    sp.sched_priority = 80;
-    const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-    realtime_granted_ = rc == 0;
-    if (rc != 0) {
-      spdlog::warn("servo loop: SCHED_FIFO not permitted ({}); running with normal priority, "
-                   "expect more jitter (grant CAP_SYS_NICE or rtprio in limits.conf)",
-                   std::strerror(rc));
+    const Status rt = core::set_fifo_priority(80);
+    realtime_granted_ = rt.ok();
+    if (!rt.ok()) {
+      spdlog::warn("servo loop: {}; running with normal priority, expect more jitter",
+                   rt.error().message);
     }
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    const int cpu = servo_.cpu >= 0 ? servo_.cpu : static_cast<int>(std::max(0L, ncpu - 1));
-    CPU_SET(cpu, &set);
-    if (pthread_setaffinity_np(pthread_self(), sizeof(set), &set) != 0) {
-      spdlog::warn("servo loop: could not pin to CPU {}", cpu);
+    if (const Status pin = core::pin_to_cpu(servo_.cpu); !pin.ok()) {
+      spdlog::warn("servo loop: {}", pin.error().message);
     }
   }
   if (!(faults_.load() & kSafeStateFaults)) device_.clear_safe_state();

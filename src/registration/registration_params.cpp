@@ -42,6 +42,7 @@ constexpr Field kFields[] = {
     {"max_iterations", nullptr, &RegistrationParams::max_iterations, 1.0, 1000.0, false, ""},
     {"cost_epsilon", &RegistrationParams::cost_epsilon, nullptr, 0.0, 1e6, false, ""},
     {"step_epsilon", &RegistrationParams::step_epsilon, nullptr, 0.0, 1.0, false, ""},
+    {"relative_epsilon", &RegistrationParams::relative_epsilon, nullptr, 0.0, 1.0, false, ""},
 };
 
 double value_of(const RegistrationParams& p, const Field& f) {
@@ -82,7 +83,7 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
                     "matte_threshold", "silhouette_term", "silhouette_sigma_px",
                     "silhouette_samples_per_bone", "prior_sigma_wrist_m",
                     "prior_sigma_rotation_rad", "prior_sigma_joint_rad", "lambda_initial",
-                    "max_iterations", "cost_epsilon", "step_epsilon"});
+                    "max_iterations", "cost_epsilon", "step_epsilon", "relative_epsilon"});
   RegistrationParams p;
   for (const Field& f : kFields) {
     const auto child = node.find(f.key);

@@ -73,8 +73,13 @@ FitReport SuccessiveAdjustment::fit(const hand::HandModel& model,
     const double step = (candidate.q - q.q).norm();
     const double candidate_cost = term_costs(problem, targets, candidate).total();
     if (candidate_cost < cost) {
+      const bool small_gain = cost - candidate_cost < rp.relative_epsilon * cost;
       q = candidate;
       fresh = false;
+      if (small_gain) {
+        report.converged = true;
+        break;
+      }
       lambda /= 10.0;
       if (lambda < kLambdaMin) lambda = rp.lambda_initial > 0.0 ? kLambdaMin : 0.0;
     } else {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/core/realtime.hpp"
 #include "spidar/core/units.hpp"
 
 namespace spidar::sim {
@@ -87,6 +88,7 @@ void PhysicsThread::stop() {
 }
 
 void PhysicsThread::run() {
+  if (rt_priority_ > 0) realtime_ = core::set_fifo_priority(rt_priority_).ok();
   const auto n = static_cast<int>(world_.proxies().size());
   std::vector<Vec3> p(n, Vec3::Zero()), v(n, Vec3::Zero());
   const auto period = static_cast<std::int64_t>(1e9 / rate_hz_);
@@ -152,6 +154,7 @@ PhysicsThreadStats PhysicsThread::stats() const {
     s.step_ms_max = sorted.back();
   }
   s.late_steps = late_;
+  s.realtime_scheduling = realtime_;
   return s;
 }
 

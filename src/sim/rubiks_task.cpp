@@ -22,22 +22,25 @@ struct Contacts {
 /// Grasp contacts in the cube frame (world axes at the start), thumb, index, middle, ring.
 Contacts contacts(const RubiksTaskParams& p) {
   const double face = p.half + p.proxy_radius - p.squeeze;
+  const double hold = p.half + p.proxy_radius - p.hold_squeeze;
   const double a = p.pitch;
   Contacts c;
-  // Left hand on the two lower layers from the left: thumb in front (−y), fingers behind (+y).
-  c.left = {Vec3(-0.012, -face, -0.45 * a), Vec3(-0.008, face, -0.2 * a),
-            Vec3(-0.016, face, -0.6 * a), Vec3(-0.022, face, -0.95 * a)};
-  // Right hand over the top layer: thumb in front, index, middle and ring behind, spread in x.
-  c.right = {Vec3(0.006, -face, a), Vec3(-0.008, face, a), Vec3(0.007, face, a),
-             Vec3(0.021, face, a)};
+  // Left hand on the two lower layers: thumb in front (−y), fingers behind (+y). Middle and ring
+  // press the bottom layer symmetrically about its axis: off-centre pushes there would twist it
+  // (|x|·F ≈ 0.04 N·m, ten times the detent) — a D turn nobody wanted.
+  c.left = {Vec3(-0.012, -hold, -0.45 * a), Vec3(-0.016, hold, -0.2 * a),
+            Vec3(-0.006, hold, -0.7 * a), Vec3(-0.020, hold, -0.9 * a)};
+  // Right hand on the top layer: thumb in front, index and ring behind, middle on top.
+  c.right = {Vec3(0.006, -face, a), Vec3(0.002, face, a), Vec3(0.004, 0.004, p.half + p.proxy_radius - 0.6 * p.squeeze),
+             Vec3(0.012, face, a)};
   return c;
 }
 
 /// Where a contact's fingertip is with the hand open: out along the face normal, up a little.
-Vec3 opened(const Vec3& c, double face) {
+Vec3 opened(const Vec3& c, double half) {
   Vec3 out = c;
-  if (std::abs(c.y()) >= face - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.035;
-  else out.z() += 0.035;
+  if (std::abs(c.y()) >= half - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.035;  // side faces
+  else out.z() += 0.035;                                                       // the top
   return out + Vec3(0, 0, 0.01);
 }
 
@@ -62,27 +65,36 @@ const char* RubiksTask::phase(double t) {
   if (t < 2.0) return "grasp";
   if (t < 3.0) return "lift";
   if (t < 5.0) return "turn 1 (top layer)";
-  if (t < 5.7) return "right hand lets go";
+  if (t < 5.7) return "let go, set the cube down";
   if (t < 6.5) return "right hand goes back";
   if (t < 7.2) return "right hand grasps";
   if (t < 9.2) return "turn 2 (top layer back)";
   if (t < 9.9) return "right hand lets go";
-  if (t < 10.6) return "set the cube down";
-  if (t < 11.3) return "open both hands";
+  if (t < 10.6) return "left hand lets go";
+  if (t < 11.3) return "right hand turns back";
   if (t < 12.0) return "withdraw";
   return "done";
 }
 
+bool RubiksTask::looks_for_grasp(double t, hand::Side side) {
+  // While a hand approaches for a grasp (open, before closing), never while it holds the cube or
+  // lets go of it: an open hand that follows the cube could push it along without end.
+  if (t < 1.0) return true;
+  return side == hand::Side::kRight && t >= 5.7 && t < 6.5;
+}
+
 double RubiksTask::closeness(double t, hand::Side side) {
-  if (side == hand::Side::kLeft) return ramp(t, 1.0, 2.0) - ramp(t, 10.6, 11.3);
+  if (side == hand::Side::kLeft) return ramp(t, 1.0, 2.0) - ramp(t, 9.9, 10.6);
   return ramp(t, 1.0, 2.0) - ramp(t, 5.0, 5.7) + ramp(t, 6.5, 7.2) - ramp(t, 9.2, 9.9);
 }
 
 RubiksTask::HandState RubiksTask::state(double t, hand::Side side, int /*finger*/) const {
   HandState s;
-  s.lift = p_.lift * (ramp(t, 2.0, 3.0) - ramp(t, 9.9, 10.6));
+  // Set down while the right hand lets go after turn 1 (to just above the table: the cube may
+  // have slipped a little in the hand); turn 2 is made on the table.
+  s.lift = p_.lift * (ramp(t, 2.0, 3.0) - 0.75 * ramp(t, 5.0, 5.7));
   if (side == hand::Side::kRight) {
-    s.yaw = p_.turn * (ramp(t, 3.0, 5.0) - ramp(t, 5.7, 6.5) - ramp(t, 7.2, 9.2) + ramp(t, 10.6, 11.3));
+    s.yaw = p_.turn * (ramp(t, 3.0, 5.0) - ramp(t, 5.7, 6.5) + ramp(t, 7.2, 9.2) - ramp(t, 10.6, 11.3));
   }
   return s;
 }
@@ -107,7 +119,7 @@ void RubiksTask::goals(double t, std::span<Vec3> goal) {
       const Quat g(R * rot_z(-k * M_PI / 2));
       for (int h = 0; h < 2; ++h) {
         const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
-        if (closeness(t, side) > 0.02) continue;  // holding on: keep the grasp frame
+        if (!looks_for_grasp(t, side)) continue;  // holding on or leaving: keep the frame
         frames_.p_W[h] = c->p_W;
         frames_.q_WG[h] = {g.w(), g.x(), g.y(), g.z()};
         frames_.lift[h] = state(t, side, 0).lift;
@@ -120,7 +132,6 @@ void RubiksTask::goals(double t, std::span<Vec3> goal) {
 
 void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal) const {
   const Contacts c = contacts(p_);
-  const double face = p_.half + p_.proxy_radius - p_.squeeze;
   const double approach = ramp(t, 0.0, 1.0);
   const double withdraw = ramp(t, 11.3, 12.0);
   const double close_left = closeness(t, hand::Side::kLeft);
@@ -129,7 +140,7 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal)
     const bool right = f >= 4;
     const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
     const Vec3& contact = right ? c.right[f - 4] : c.left[f];
-    const Vec3 open = opened(contact, face);
+    const Vec3 open = opened(contact, p_.half);
     const Vec3 away(right ? p_.withdraw * 0.6 : -p_.withdraw * 0.6, -p_.withdraw * 0.5, p_.withdraw * 0.5);
     const Vec3 far = open + away;
     Vec3 p = far + (open - far) * approach + (far - open) * withdraw;

@@ -17,6 +17,7 @@ registration::RegistrationParams ik_params(const UserHandsParams& p) {
   r.max_iterations = p.iterations;
   r.cost_epsilon = 0.0;  // run to the step criterion: ground truth should be tight
   r.step_epsilon = 1e-9;
+  r.relative_epsilon = 1e-9;
   return r;
 }
 

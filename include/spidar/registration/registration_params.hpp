@@ -37,6 +37,9 @@ struct RegistrationParams {
   int max_iterations = 10;       ///< linear solves per fit, accepted or rejected (1..1000)
   double cost_epsilon = 1e-3;    ///< stop when J < ε (dimensionless)
   double step_epsilon = 1e-6;    ///< stop when ‖Δθ‖ < this (mixed m/rad)
+  /// Stop when an accepted step lowers J by less than this share of J (noisy data never reaches
+  /// cost_epsilon; this ends the fit once it no longer pays). 0 = off.
+  double relative_epsilon = 1e-3;
 };
 
 /// Upper bound of silhouette_samples_per_bone (fixed-size storage, no allocation per frame).

@@ -11,7 +11,8 @@
 /// joint limits. A step that does not lower the cost (evaluated with the image targets frozen at
 /// the linearisation, residuals.hpp) is rejected and λ grows ×10; an accepted step shrinks it ÷10.
 /// Every solve, accepted or rejected, counts as one iteration. It stops when J < cost_epsilon,
-/// ‖Δθ‖ < step_epsilon or after max_iterations.
+/// ‖Δθ‖ < step_epsilon, an accepted step gains less than relative_epsilon·J, or after
+/// max_iterations.
 ///
 /// Details beyond the paper (residuals.hpp has the exact residuals):
 ///  - the wrist term compares the bracelet's midpoint with the projection of the point

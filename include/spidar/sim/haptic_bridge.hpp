@@ -80,6 +80,7 @@ struct PhysicsThreadStats {
   double rate_hz = 0;
   double step_ms_median = 0, step_ms_p99 = 0, step_ms_max = 0;
   std::uint64_t late_steps = 0;  ///< steps that started after their deadline
+  bool realtime_scheduling = false;  ///< SCHED_FIFO was asked for and granted
 };
 
 /// Steps the world in its own thread at up to `rate_hz` (1/timestep by default), toward the
@@ -93,6 +94,10 @@ class PhysicsThread {
   void start();
   void stop();
   void set_before_step(std::function<void(physics::World&)> fn) { before_step_ = std::move(fn); }
+  /// SCHED_FIFO priority of the physics thread (0 = normal scheduling; set before start()). With
+  /// rendering threads competing for the CPUs, a real-time physics thread keeps world time in
+  /// step with the user (below the servo loop's 80). Falls back to normal with a warning.
+  void set_realtime_priority(int priority) { rt_priority_ = priority; }
   /// Whether snapshots show the fingertip proxies (default yes; set before start()).
   void set_snapshot_proxies(bool on) { snapshot_proxies_ = on; }
   /// Renderer side: true and the newest snapshot in `snapshots().front()` if there is a new one.
@@ -108,6 +113,8 @@ class PhysicsThread {
   int snapshot_every_;
   std::function<void(physics::World&)> before_step_;
   bool snapshot_proxies_ = true;
+  int rt_priority_ = 0;
+  bool realtime_ = false;
   core::TripleBuffer<SceneSnapshot> snapshots_;
   std::vector<double> step_ms_;
   std::int64_t t0_ = 0, t1_ = 0;

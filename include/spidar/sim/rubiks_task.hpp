@@ -4,10 +4,12 @@
 ///   0.0 – 1.0  hands approach           1.0 – 2.0  both hands close on the cube
 ///   2.0 – 3.0  lift: the left hand holds the two lower layers, the right hand the top layer
 ///   3.0 – 5.0  turn 1: the right hand turns the top layer by +turn about +z (past 90°, clicks)
-///   5.0 – 5.7  the right hand lets go    5.7 – 6.5  it goes back    6.5 – 7.2  it grasps again
-///   7.2 – 9.2  turn 2: the top layer by −turn (back past 0°: the cube is solved again)
-///   9.2 – 9.9  the right hand lets go    9.9 – 10.6 the left hand sets the cube down
-///  10.6 – 11.3 both hands open          11.3 – 12.0 both hands withdraw
+///   5.0 – 5.7  the right hand lets go, the left hand sets the cube down (to a quarter of the
+///              lift: the cube may have slipped a little in the hand)
+///   5.7 – 6.5  the right hand goes back  6.5 – 7.2  it grasps the top layer again
+///   7.2 – 9.2  turn 2: the top layer by +turn again, the cube on the table (U2 in all)
+///   9.2 – 9.9  the right hand lets go    9.9 – 10.6 the left hand lets go
+///  10.6 – 11.3 the right hand turns back 11.3 – 12.0 both hands withdraw
 ///
 /// It gives the eight fingertip goals (left thumb, index, middle, ring, then right; the simulated
 /// device's FingertipSource) and, per hand, a nominal hand pose that goes with them (wrist pose
@@ -16,8 +18,8 @@
 /// In a scene without a cube, p_W_cube and half describe the object to reach for (any box-like
 /// object): the same motions then grasp, push and turn it.
 ///
-/// The user watches the cube: with track() given, a hand that is open takes the cube's current
-/// pose (from the physics thread) as the frame of its next grasp, so a cube that tilted or slid
+/// The user watches the cube: with track() given, a hand approaching for a grasp takes the cube's
+/// current pose (from the physics thread) as the frame of that grasp, so a cube that tilted or slid
 /// while held is grasped where it is (up to its 90° symmetry about its vertical axis).
 #include <array>
 #include <span>
@@ -35,7 +37,8 @@ struct RubiksTaskParams {
   double half = 0.0285;          ///< half the cube's size [m]
   double pitch = 0.019;          ///< layer pitch [m]
   double proxy_radius = 0.008;   ///< [m]
-  double squeeze = 0.012;        ///< goal depth inside the faces [m]
+  double squeeze = 0.012;        ///< goal depth inside the faces (turning hand) [m]
+  double hold_squeeze = 0.012;   ///< the same for the holding (left) hand: it must resist the turn [m]
   double lift = 0.02;            ///< [m]
   double withdraw = 0.06;        ///< how far the hands start and end away from the grasp [m]
   double turn = 1.75;            ///< [rad] per turn, past 90° so that the detent finishes the click
@@ -79,6 +82,8 @@ class RubiksTask final : public device::FingertipSource {
   HandState state(double t_s, hand::Side side, int finger) const;
   /// 0 = hand open, 1 = closed on the grasp.
   static double closeness(double t_s, hand::Side side);
+  /// True while a hand approaches for a grasp: then it follows the cube's pose.
+  static bool looks_for_grasp(double t_s, hand::Side side);
   void goals_at(double t_s, const GraspFrames& frames, std::span<Vec3> p_W_goal) const;
   RubiksTaskParams p_;
   const core::Latest<CubePoseSample>* cube_ = nullptr;

@@ -1,0 +1,18 @@
+#pragma once
+/// Real-time scheduling of the calling thread (Linux): SCHED_FIFO at a priority, and pinning to a
+/// CPU. Both need privileges (CAP_SYS_NICE, or rtprio in limits.conf); without them the error
+/// says so and the thread keeps running with normal priority.
+///
+/// Priorities used by spidar-mr (higher runs first): servo loop 80, serial device emulator 70,
+/// physics thread 60. Everything else (frame thread, camera, GUI) stays SCHED_OTHER.
+#include "spidar/core/result.hpp"
+
+namespace spidar::core {
+
+/// SCHED_FIFO at `priority` (1..99) for the calling thread. Error names the reason.
+Status set_fifo_priority(int priority);
+
+/// Pins the calling thread to `cpu` (0-based; −1 = the last online CPU). Error names the CPU.
+Status pin_to_cpu(int cpu);
+
+}  // namespace spidar::core

@@ -1,0 +1,37 @@
+#include "spidar/core/realtime.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <string>
+
+namespace spidar::core {
+
+Status set_fifo_priority(int priority) {
+  if (priority < 1 || priority > 99)
+    return Error{"SCHED_FIFO priority must be in 1..99, got " + std::to_string(priority)};
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp); rc != 0) {
+    return Error{std::string("SCHED_FIFO ") + std::to_string(priority) + " not permitted (" +
+                 std::strerror(rc) + "); grant CAP_SYS_NICE or rtprio in limits.conf"};
+  }
+  return Ok{};
+}
+
+Status pin_to_cpu(int cpu) {
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  const int c = cpu >= 0 ? cpu : static_cast<int>(online > 0 ? online - 1 : 0);
+  if (online > 0 && c >= online)
+    return Error{"CPU " + std::to_string(c) + " is not online (" + std::to_string(online) + " CPUs)"};
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(c, &set);
+  if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set); rc != 0)
+    return Error{"could not pin to CPU " + std::to_string(c) + " (" + std::strerror(rc) + ")"};
+  return Ok{};
+}
+
+}  // namespace spidar::core
