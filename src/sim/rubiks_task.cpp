@@ -39,8 +39,8 @@ Contacts contacts(const RubiksTaskParams& p) {
 /// Where a contact's fingertip is with the hand open: out along the face normal, up a little.
 Vec3 opened(const Vec3& c, double half) {
   Vec3 out = c;
-  if (std::abs(c.y()) >= half - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.035;  // side faces
-  else out.z() += 0.035;                                                       // the top
+  if (std::abs(c.y()) >= half - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.025;  // side faces
+  else out.z() += 0.025;                                                       // the top
   return out + Vec3(0, 0, 0.01);
 }
 

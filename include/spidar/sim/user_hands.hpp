@@ -19,10 +19,10 @@ namespace spidar::sim {
 
 struct UserHandsParams {
   double fingertip_sigma_m = 0.0002;   ///< how tightly the caps are matched [m]
-  double wrist_sigma_m = 0.03;         ///< freedom of the wrist around the nominal pose [m]
-  double rotation_sigma_rad = 0.35;    ///< ... of the hand's rotation [rad]
-  double joint_sigma_rad = 0.6;        ///< ... of the finger joints [rad]
-  int iterations = 25;                 ///< per update (warm start)
+  double wrist_sigma_m = 0.10;         ///< freedom of the wrist around the nominal pose [m]
+  double rotation_sigma_rad = 1.0;     ///< ... of the hand's rotation [rad]
+  double joint_sigma_rad = 1.5;        ///< ... of the finger joints [rad]
+  int iterations = 40;                 ///< per update (warm start)
   /// The little finger's own posture relative to the ring finger's (MCP flexion, abduction, DIP)
   /// [rad]; it also sways with this amplitude [rad] at 0.7 Hz, as a real little finger does.
   Vec3 little_offset{0.15, 0.06, 0.12};
