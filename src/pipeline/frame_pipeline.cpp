@@ -211,7 +211,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   render::RenderParams rp;
   rp.hands = render::HandDrawMode::kHidden;
   if (auto st = s.renderer->render(s.scene, s.camera, rp); !st) return st;
-  if (auto st = s.renderer->read(&out->virt, render::kColour | render::kDepth | render::kHandDepth); !st) return st;
+  if (auto st = s.renderer->read(&out->virt, render::kAllTargets); !st) return st;
   tm.render_ms = ms_since(t0);
 
   // Compositing.

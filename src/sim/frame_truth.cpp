@@ -8,6 +8,7 @@
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/metrics.hpp"
 #include "spidar/render/composite_metrics.hpp"
+#include "spidar/render/hand_skin.hpp"
 #include "spidar/render/overlay.hpp"
 
 namespace spidar::sim {
@@ -28,9 +29,17 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     m.fingertip_mm[h] = registration::fingertip_error_m(f, t) * 1e3;
     m.joint_px[h] = registration::joint_px_error(f, t, camera);
   }
-  // Every pixel a fitted hand covers, in front of the scene or not (the truth's hand_only mask is
-  // filmed without a scene too).
-  cv::compare(result.virt.hand_depth, std::numeric_limits<float>::max(), ws->model_mask, cv::CMP_LT);
+  // The fitted hands' own pixels, where no forearm of theirs is in front (the truth's hand_only
+  // mask is filmed without a scene, so scene occlusion does not enter either).
+  ws->model_mask.create(result.virt.hand_id.size(), CV_8UC1);
+  for (int y = 0; y < ws->model_mask.rows; ++y) {
+    const std::uint8_t* id = result.virt.hand_id.ptr<std::uint8_t>(y);
+    std::uint8_t* o = ws->model_mask.ptr<std::uint8_t>(y);
+    for (int x = 0; x < ws->model_mask.cols; ++x) {
+      const render::HandId d = render::decode_hand_id(id[x]);
+      o[x] = id[x] != 0 && d.finger != render::kForearmPart && d.finger != render::kBraceletPart ? 255 : 0;
+    }
+  }
   m.iou = registration::mask_iou(ws->model_mask, frame.hand_only);
 
   if (auto st = render::truth_composite_mask(frame.mask, frame.depth, result.virt.depth,

@@ -123,38 +123,56 @@ TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {
 
 #include "spidar/registration/metrics.hpp"
 #include "spidar/render/hand_shapes.hpp"
+#include "spidar/render/hand_skin.hpp"
 
 namespace spidar::pipeline {
 namespace {
 
-// How much of the IoU a perfect pose can reach: the user's hands at their true pose drawn as the
-// model's capsules (with the user's own sizes) against the filmed hands (tapered bones, fuller
-// palm). Prints the ceiling over the script (run with --gtest_also_run_disabled_tests).
-TEST_F(FramePipelineTest, DISABLED_PrintIouCeilingOfTheCapsuleHand) {
+// How much of the IoU a perfect pose can reach: the user's hands at their true pose, with their
+// own sizes, drawn as the model's capsules and as the model's skin (render/hand_skin.hpp with
+// FramePipelineParams::model_skin) against the filmed hands. Prints both over the script (run with
+// --gtest_also_run_disabled_tests).
+TEST_F(FramePipelineTest, DISABLED_PrintIouCeilingOfTheModelShapes) {
   auto renderer = render::Renderer::create(*context_, camera_.width(), camera_.height()).value();
+  const render::HandSkinParams skin = FramePipelineParams{}.model_skin;
+  auto meshes = std::make_shared<std::vector<MeshData>>();
+  std::array<render::HandSkin, 2> skins;
+  for (int h = 0; h < 2; ++h) skins[h] = render::build_hand_skin(truth_models_[h], skin, meshes.get());
   sim::RubiksTask task({});
   sim::UserHands user(truth_models_, task);
   sim::SyntheticFrame frame;
   render::RenderTargets t;
-  double sum = 0;
+  double sum_caps = 0, sum_skin = 0;
   int n = 0;
+  auto iou_of = [&](const SceneSnapshot& hands) {
+    EXPECT_TRUE(renderer->render(hands, camera_).ok());
+    EXPECT_TRUE(renderer->read(&t, render::kHandId).ok());
+    cv::Mat mask(t.hand_id.size(), CV_8UC1);
+    for (int y = 0; y < mask.rows; ++y)
+      for (int x = 0; x < mask.cols; ++x) {
+        const auto id = t.hand_id.at<std::uint8_t>(y, x);
+        const int f = render::decode_hand_id(id).finger;
+        mask.at<std::uint8_t>(y, x) = id != 0 && f != render::kForearmPart && f != render::kBraceletPart ? 255 : 0;
+      }
+    return registration::mask_iou(mask, frame.hand_only);
+  };
   for (double time = 0.0; time < 12.0; time += 0.25) {
     pose_user(user, task, time);
     const auto& truth = user.params();
     ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
-    SceneSnapshot hands;
-    for (int h = 0; h < 2; ++h)
-      render::append_hand_shapes(hand::hand_render_shapes(truth_models_[h], truth[h]), &hands);
-    ASSERT_TRUE(renderer->render(hands, camera_).ok());
-    ASSERT_TRUE(renderer->read(&t, render::kHandDepth).ok());
-    cv::Mat mask;
-    cv::compare(t.hand_depth, std::numeric_limits<float>::max(), mask, cv::CMP_LT);
-    const double iou = registration::mask_iou(mask, frame.hand_only);
-    sum += iou;
+    SceneSnapshot capsules, skinned;
+    skinned.meshes = meshes;
+    for (int h = 0; h < 2; ++h) {
+      render::append_hand_shapes(hand::hand_render_shapes(truth_models_[h], truth[h]), &capsules);
+      render::pose_hand_skin(truth_models_[h], skins[h], truth[h], skin, &skinned);
+    }
+    const double a = iou_of(capsules), b = iou_of(skinned);
+    sum_caps += a;
+    sum_skin += b;
     ++n;
-    std::printf("t %5.2f  IoU(true pose, capsules) %.3f\n", time, iou);
+    std::printf("t %5.2f  IoU at the true pose: capsules %.3f, skin %.3f\n", time, a, b);
   }
-  std::printf("mean %.3f over %d poses\n", sum / n, n);
+  std::printf("mean over %d poses: capsules %.3f, skin %.3f\n", n, sum_caps / n, sum_skin / n);
 }
 
 }  // namespace

@@ -40,8 +40,11 @@ struct FramePipelineParams {
   /// How the fitted hands are drawn (their depth decides occlusion; their pixels give the IoU):
   /// a skin (tapered bones, rounded palm: render/hand_skin.hpp) or the model's capsules.
   bool skinned_hands = true;
-  /// The model hands' skin: a typical hand, no forearm, no bracelet.
-  render::HandSkinParams model_skin{0.10, 1.12, 0.0, false};
+  /// The model hands' skin: the taper and palm fullness of a typical hand (the same numbers the
+  /// synthetic camera gives its users) and a forearm (it lends the real forearm its depth, and it
+  /// hides the palm where the camera sees the forearm in front), no bracelet. The user's hand
+  /// still differs in length, width, fingertip caps, joint ranges and an independent little finger.
+  render::HandSkinParams model_skin{0.12, 1.2, 0.10, false};
   /// Hand rotations to start from on the first frame (rotation vectors, world) [rad].
   std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};
   /// Device finger index of each hand's thumb, index, middle, ring (the config's order).
@@ -60,7 +63,8 @@ struct FrameResult {
   std::array<vision::BraceletObservation, 2> bracelets;
   vision::ChromaKeyResult key;
   render::RenderTargets virt;   ///< the virtual scene with the fitted hands (hidden): colour,
-                                ///< depth, hand_depth (no hand_id)
+                                ///< depth, hand_depth, hand_id (finger render::kForearmPart on
+                                ///< the forearm)
   cv::Mat composite;            ///< in params.compositor.mode
   cv::Mat composite_alpha;      ///< CV_32FC1, share of the real image in `composite`
   cv::Mat other;                ///< the other mode (if other_composite)

@@ -1,0 +1,77 @@
+// The frame pipeline for one 640x480 frame (chroma key, bracelets, registration of both hands,
+// render of the Rubik's cube scene with the fitted hands, both composites): the frame thread's
+// cost per camera frame, without the simulation's own costs (synthetic camera, ground truth).
+#include <benchmark/benchmark.h>
+
+#include "spidar/hand/hand_config.hpp"
+#include "spidar/physics/world.hpp"
+#include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/sim/rubiks_task.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/sim/user_hands.hpp"
+#include "spidar/vision/vision_config.hpp"
+
+namespace {
+
+using namespace spidar;
+
+std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
+
+void FramePipeline640x480(benchmark::State& state) {
+  auto ctx = render::Context::create_headless();
+  if (!ctx) {
+    state.SkipWithError(ctx.error().message.c_str());
+    return;
+  }
+  const auto profiles = hand::load_hand_profiles(source("configs/hands.yaml"));
+  const auto* user = profiles.find("user");
+  const std::array<hand::HandModel, 2> truth{user->model(hand::Side::kLeft), user->model(hand::Side::kRight)};
+  const std::array<hand::HandModel, 2> models{hand::default_hand_model(hand::Side::kLeft),
+                                              hand::default_hand_model(hand::Side::kRight)};
+  const vision::Camera camera = vision::default_rig_camera();
+  auto world = physics::World::Load(source("scenes/rubiks_cube.xml")).value();
+  SceneSnapshot scene;
+  world->snapshot(scene, false);
+  sim::RubiksTaskParams tp;
+  sim::RubiksTask task(tp);
+  sim::UserHands hands(truth, task);
+  std::array<Vec3, 8> g;
+  task.goals(3.0, g);  // both hands holding the lifted cube
+  hands.update(3.0, g);
+  auto film = sim::SyntheticCamera::create(*ctx.value(), camera, truth).value();
+  sim::SyntheticFrame frame;
+  const auto& q = hands.params();
+  (void)film->film({&q[0], &q[1]}, &frame);
+  device::FingertipSample tips;
+  tips.finger_count = 8;
+  for (int f = 0; f < 8; ++f) tips.p_W[f] = {g[f].x(), g[f].y(), g[f].z()};
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  pipeline::FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  p.registration.silhouette_term = state.range(0) != 0;
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(3.0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  auto pipe = pipeline::FramePipeline::create(*ctx.value(), camera, models, p).value();
+  pipeline::FrameResult r;
+  for (int k = 0; k < 5; ++k) (void)pipe->process(frame.bgr, tips, scene, &r);  // settle
+  double reg = 0, render = 0, composite = 0;
+  for (auto _ : state) {
+    if (auto st = pipe->process(frame.bgr, tips, scene, &r); !st) {
+      state.SkipWithError(st.error().message.c_str());
+      break;
+    }
+    reg += r.timings.registration_ms;
+    render += r.timings.render_ms;
+    composite += r.timings.composite_ms;
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["registration_ms"] = reg / n;
+  state.counters["render_ms"] = render / n;
+  state.counters["composite_ms"] = composite / n;
+}
+BENCHMARK(FramePipeline640x480)->ArgName("silhouette")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
