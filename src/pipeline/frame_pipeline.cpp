@@ -124,9 +124,16 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
 
   // Bracelets, predicted from the previous frame's wrists.
   t0 = Clock::now();
+  // Predicted bracelets: where the previous fit puts each hand's bracelet (registration's
+  // bracelet_offset_m from the wrist toward the elbow).
   vision::BraceletPrediction prediction;
+  std::array<Vec2, 2> predicted{};
   if (s.have_previous) {
-    for (int h = 0; h < 2; ++h) prediction.wrist_px[h] = s.camera.project(s.previous[h].p_W_wrist());
+    for (int h = 0; h < 2; ++h) {
+      const Pose X_WH = hand::hand_pose(s.previous[h]);
+      predicted[h] = s.camera.project(X_WH * Vec3(0.0, -p.registration.bracelet_offset_m, 0.0));
+      prediction.wrist_px[h] = predicted[h];
+    }
   }
   auto bracelets = vision::detect_bracelets(bgr, p.bracelet, s.have_previous ? &prediction : nullptr,
                                             &s.bracelet_ws);
@@ -157,7 +164,11 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       obs.p_W_fingertip[f] = x;
       obs.fingertip_valid[f] = d < tips.finger_count && x.allFinite();
     }
-    if (out->bracelets[h].found) {
+    // A bracelet far from where the previous fit predicts it is more likely the other hand's or a
+    // broken detection than a jump of the hand: it is not used (gate scaled to the image width).
+    const double gate = p.bracelet_gate * s.camera.width();
+    if (out->bracelets[h].found &&
+        (gate <= 0 || !s.have_previous || (out->bracelets[h].wrist_px - predicted[h]).norm() <= gate)) {
       obs.wrist_px = out->bracelets[h].wrist_px;
       obs.wrist_confidence = out->bracelets[h].confidence;
     }

@@ -39,8 +39,8 @@ Contacts contacts(const RubiksTaskParams& p) {
 /// Where a contact's fingertip is with the hand open: out along the face normal, up a little.
 Vec3 opened(const Vec3& c, double half) {
   Vec3 out = c;
-  if (std::abs(c.y()) >= half - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.025;  // side faces
-  else out.z() += 0.025;                                                       // the top
+  if (std::abs(c.y()) >= half - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.035;  // side faces
+  else out.z() += 0.035;                                                       // the top
   return out + Vec3(0, 0, 0.01);
 }
 
@@ -141,7 +141,12 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal)
     const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
     const Vec3& contact = right ? c.right[f - 4] : c.left[f];
     const Vec3 open = opened(contact, p_.half);
-    const Vec3 away(right ? p_.withdraw * 0.6 : -p_.withdraw * 0.6, -p_.withdraw * 0.5, p_.withdraw * 0.5);
+    // Where the hand starts and ends: further out along the face's normal, up, and toward its
+    // own side. Both ends of the approach lie outside the face's plane, so the straight path
+    // between them never crosses the cube.
+    const Vec3 normal = std::abs(contact.y()) >= p_.half - 1e-9 ? Vec3(0, contact.y() > 0 ? 1 : -1, 0)
+                                                                 : Vec3::UnitZ();
+    const Vec3 away = p_.withdraw * (0.6 * normal + Vec3(right ? 0.5 : -0.5, 0, 0.4));
     const Vec3 far = open + away;
     Vec3 p = far + (open - far) * approach + (far - open) * withdraw;
     p += (contact - open) * (right ? close_right : close_left);

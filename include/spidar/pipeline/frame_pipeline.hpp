@@ -37,6 +37,10 @@ struct FramePipelineParams {
   bool other_composite = true;          ///< also compose in the other mode (for comparison)
   int silhouette_margin_px = 40;        ///< distance-transform margin (silhouette term only)
   int first_frame_rounds = 6;           ///< registration rounds on the first frame (cold start)
+  /// A bracelet farther than this share of the image width from where the previous fit predicts
+  /// it is ignored for that frame (e.g. 0.06 = 38 px at 640 px); 0 = off (default: tried on the
+  /// demo, it keeps a fit that has drifted from ever recovering).
+  double bracelet_gate = 0.0;
   /// How the fitted hands are drawn (their depth decides occlusion; their pixels give the IoU):
   /// a skin (tapered bones, rounded palm: render/hand_skin.hpp) or the model's capsules.
   bool skinned_hands = true;
