@@ -156,6 +156,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
 
   // Successive adjustment of both hands.
   t0 = Clock::now();
+  out->restarts = 0;
   for (int h = 0; h < 2; ++h) {
     registration::HandObservation obs;
     for (int f = 0; f < hand::kFingertipCount; ++f) {
@@ -172,20 +173,45 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       obs.wrist_px = out->bracelets[h].wrist_px;
       obs.wrist_confidence = out->bracelets[h].confidence;
     }
-    hand::HandParams q;
     const bool cold = !s.have_previous;
-    q = cold ? cold_start(s.models[h], p.initial_r_W_hand[h], obs) : s.previous[h];
-    const hand::HandParams prior = q;
-    const int rounds = cold ? p.first_frame_rounds : 1;
+    auto fit_from = [&](hand::HandParams q, const hand::HandParams* prior, int rounds,
+                        registration::FitReport* report) {
+      for (int r = 0; r < rounds; ++r) {
+        const registration::FitReport rr = s.solver.fit(s.models[h], obs, image, prior, &q);
+        if (r == 0) report->cost_initial = rr.cost_initial;
+        report->iterations += rr.iterations;
+        report->cost_final = rr.cost_final;
+        report->terms = rr.terms;
+        report->converged = rr.converged;
+      }
+      return q;
+    };
     registration::FitReport report;
-    for (int r = 0; r < rounds; ++r) {
-      const registration::FitReport rr =
-          s.solver.fit(s.models[h], obs, image, cold ? nullptr : &prior, &q);
-      if (r == 0) report.cost_initial = rr.cost_initial;
-      report.iterations += rr.iterations;
-      report.cost_final = rr.cost_final;
-      report.terms = rr.terms;
-      report.converged = rr.converged;
+    hand::HandParams q;
+    if (cold) {
+      q = fit_from(cold_start(s.models[h], p.initial_r_W_hand[h], obs), nullptr,
+                   p.first_frame_rounds, &report);
+    } else {
+      const hand::HandParams prior = s.previous[h];
+      q = fit_from(prior, &prior, 1, &report);
+      // A fit that cannot bring the fingertips to the strings has lost the hand (a wrong
+      // bracelet, a local minimum): start again from the fingertips, keeping the rotation, and
+      // keep whichever fit is cheaper.
+      int valid = 0;
+      for (bool v : obs.fingertip_valid) valid += v ? 1 : 0;
+      if (valid > 0 && report.terms.fingertip / valid > p.restart_fingertip_cost) {
+        registration::FitReport again;
+        const hand::HandParams q2 =
+            fit_from(cold_start(s.models[h], prior.r_W_hand(), obs), nullptr, p.first_frame_rounds, &again);
+        again.iterations += report.iterations;
+        if (again.cost_final < report.cost_final) {
+          q = q2;
+          report = again;
+        } else {
+          report.iterations = again.iterations;
+        }
+        ++out->restarts;
+      }
     }
     out->hands[h] = q;
     out->fits[h] = report;

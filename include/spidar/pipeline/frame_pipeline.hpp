@@ -41,6 +41,9 @@ struct FramePipelineParams {
   /// it is ignored for that frame (e.g. 0.06 = 38 px at 640 px); 0 = off (default: tried on the
   /// demo, it keeps a fit that has drifted from ever recovering).
   double bracelet_gate = 0.0;
+  /// Restart a warm-started fit from the fingertips when its fingertip cost per fingertip stays
+  /// above this (dimensionless: 25 = each fingertip 5 σ from the strings, ~7.5 mm at 1.5 mm).
+  double restart_fingertip_cost = 25.0;
   /// How the fitted hands are drawn (their depth decides occlusion; their pixels give the IoU):
   /// a skin (tapered bones, rounded palm: render/hand_skin.hpp) or the model's capsules.
   bool skinned_hands = true;
@@ -64,6 +67,7 @@ struct FrameTimings {
 struct FrameResult {
   std::array<hand::HandParams, 2> hands;                ///< fitted (left, right)
   std::array<registration::FitReport, 2> fits;
+  int restarts = 0;  ///< hands whose fit was restarted this frame
   std::array<vision::BraceletObservation, 2> bracelets;
   vision::ChromaKeyResult key;
   render::RenderTargets virt;   ///< the virtual scene with the fitted hands (hidden): colour,
