@@ -131,8 +131,22 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   if (s.have_previous) {
     for (int h = 0; h < 2; ++h) {
       const Pose X_WH = hand::hand_pose(s.previous[h]);
-      predicted[h] = s.camera.project(X_WH * Vec3(0.0, -p.registration.bracelet_offset_m, 0.0));
+      const Vec3 p_WB = X_WH * Vec3(0.0, -p.registration.bracelet_offset_m, 0.0);
+      predicted[h] = s.camera.project(p_WB);
       prediction.wrist_px[h] = predicted[h];
+      // The band's expected length: the forearm's projected diameter there (forearm radius ≈
+      // 0.31 × palm breadth, as the skin models it, plus the band's thickness).
+      const double depth = (s.camera.X_CW() * p_WB).z();
+      if (depth > 1e-3) {
+        const double radius = 0.31 * s.models[h].shape.dimensions.width + 0.002;
+        prediction.length_px[h] = 2.0 * radius * s.camera.intrinsics().fx / depth;
+      }
+      // The band's long axis in the image: across the forearm (hand y) and the line of sight.
+      const Vec3 across = (X_WH.R * Vec3::UnitY()).cross(p_WB - s.camera.X_WC().p);
+      if (across.norm() > 1e-9) {
+        const Vec2 a = s.camera.project(p_WB + 0.01 * across.normalized()) - predicted[h];
+        if (a.norm() > 1e-6) prediction.axis_px[h] = a.normalized();
+      }
     }
   }
   auto bracelets = vision::detect_bracelets(bgr, p.bracelet, s.have_previous ? &prediction : nullptr,

@@ -20,7 +20,7 @@ Status validate(const BraceletParams& p) {
   if (!(p.expected_aspect >= 1.0 && p.expected_aspect <= 20.0))
     return bad("expected_aspect: expected 1..20");
   if (!(p.max_prediction_distance_px > 0)) return bad("max_prediction_distance_px: expected > 0");
-  if (!(p.ambiguity_ratio > 0 && p.ambiguity_ratio < 1)) return bad("ambiguity_ratio: expected (0, 1)");
+  if (!(p.ambiguity_margin >= 0)) return bad("ambiguity_margin: expected >= 0");
   if (!(p.centre_margin_px >= 0)) return bad("centre_margin_px: expected >= 0");
   return Ok{};
 }
@@ -28,7 +28,7 @@ Status validate(const BraceletParams& p) {
 BraceletParams parse_bracelet_params(const core::ConfigNode& node) {
   node.expect_keys({"hue_low_max", "hue_high_min", "saturation_min", "value_min", "min_area_px",
                     "merge_gap_px", "expected_length_px", "expected_aspect",
-                    "max_prediction_distance_px", "ambiguity_ratio", "centre_margin_px",
+                    "max_prediction_distance_px", "ambiguity_margin", "centre_margin_px",
                     "left_hand_on_image_left"});
   BraceletParams p;
   auto i = [&](const char* k, int fallback) { return static_cast<int>(node.get_int(k, fallback)); };
@@ -42,7 +42,7 @@ BraceletParams parse_bracelet_params(const core::ConfigNode& node) {
   p.expected_aspect = node.get_double("expected_aspect", p.expected_aspect);
   p.max_prediction_distance_px =
       node.get_double("max_prediction_distance_px", p.max_prediction_distance_px);
-  p.ambiguity_ratio = node.get_double("ambiguity_ratio", p.ambiguity_ratio);
+  p.ambiguity_margin = node.get_double("ambiguity_margin", p.ambiguity_margin);
   p.centre_margin_px = node.get_double("centre_margin_px", p.centre_margin_px);
   if (auto v = node.find("left_hand_on_image_left")) p.left_hand_on_image_left = v->as_bool();
   if (auto s = validate(p); !s.ok()) node.fail(s.error().message);
@@ -86,6 +86,28 @@ struct Accum {
 int find_root(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
+}
+
+Accum merged(const Accum& a, const Accum& b) {
+  return {a.n + b.n, a.sx + b.sx, a.sy + b.sy, a.sxx + b.sxx, a.sxy + b.sxy, a.syy + b.syy};
+}
+
+/// Standard deviation of a pixel set across (sign −1) or along (+1) its principal axis [px].
+double principal_sd(const Accum& q, double sign) {
+  const double cx = q.sx / q.n, cy = q.sy / q.n;
+  const double cxx = q.sxx / q.n - cx * cx, cxy = q.sxy / q.n - cx * cy, cyy = q.syy / q.n - cy * cy;
+  const double half_trace = 0.5 * (cxx + cyy);
+  const double d = std::sqrt(std::max(0.0, 0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy));
+  return std::sqrt(std::max(0.0, half_trace + sign * d));
+}
+double minor_sd(const Accum& q) { return principal_sd(q, -1.0); }
+
+/// Unit direction of a pixel set's principal (long) axis.
+Vec2 major_axis(const Accum& q) {
+  const double cx = q.sx / q.n, cy = q.sy / q.n;
+  const double cxx = q.sxx / q.n - cx * cx, cxy = q.sxy / q.n - cx * cy, cyy = q.syy / q.n - cy * cy;
+  const double angle = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);
+  return {std::cos(angle), std::sin(angle)};
 }
 
 double box_gap(const cv::Rect& a, const cv::Rect& b) {
@@ -133,12 +155,66 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
                     ws->stats.at<int>(i, cv::CC_STAT_HEIGHT));
   };
   const int m = static_cast<int>(pieces.size());
+  // Each piece's pixel moments; a group's are the sums of its pieces'.
+  std::vector<Accum> acc_of(static_cast<std::size_t>(m));
+  for (int a = 0; a < m; ++a) {
+    const cv::Rect r = rect(pieces[a]);
+    Accum& q = acc_of[static_cast<std::size_t>(a)];
+    for (int y = r.y; y < r.y + r.height; ++y) {
+      const int* lab = ws->labels.ptr<int>(y);
+      for (int x = r.x; x < r.x + r.width; ++x) {
+        if (lab[x] != pieces[a]) continue;
+        q.n += 1;
+        q.sx += x;
+        q.sy += y;
+        q.sxx += static_cast<double>(x) * x;
+        q.sxy += static_cast<double>(x) * y;
+        q.syy += static_cast<double>(y) * y;
+      }
+    }
+  }
+  // Merging: pieces whose boxes are within merge_gap_px are one band only if together they are
+  // as thin as the thicker of them (a finger across a band splits it along its length; two hands'
+  // bands side by side would make a thick blob). Nearest pairs first.
   std::vector<int> parent(static_cast<std::size_t>(m));
   std::iota(parent.begin(), parent.end(), 0);
+  std::vector<std::array<double, 3>> pairs;  // gap, a, b
   for (int a = 0; a < m; ++a)
-    for (int b = a + 1; b < m; ++b)
-      if (box_gap(rect(pieces[a]), rect(pieces[b])) <= p.merge_gap_px)
-        parent[find_root(parent, a)] = find_root(parent, b);
+    for (int b = a + 1; b < m; ++b) {
+      const double gap = box_gap(rect(pieces[a]), rect(pieces[b]));
+      if (gap <= p.merge_gap_px) pairs.push_back({gap, static_cast<double>(a), static_cast<double>(b)});
+    }
+  std::sort(pairs.begin(), pairs.end());
+  for (const auto& pr : pairs) {
+    const int ra = find_root(parent, static_cast<int>(pr[1]));
+    const int rb = find_root(parent, static_cast<int>(pr[2]));
+    if (ra == rb) continue;
+    const Accum& A = acc_of[static_cast<std::size_t>(ra)];
+    const Accum& B = acc_of[static_cast<std::size_t>(rb)];
+    const Accum both = merged(A, B);
+    const double limit = 1.35 * std::max(minor_sd(A), minor_sd(B)) + 0.5;
+    if (minor_sd(both) > limit) continue;
+    // Nor longer than a band can be: the pieces' boxes, along the merged axis, span at most 1.5
+    // times the expected length (boxes overstate a tilted band's length a little).
+    const double expected = expected_length_px > 0 ? expected_length_px : p.expected_length_px;
+    if (expected > 0) {
+      const Vec2 axis = major_axis(both);
+      double lo = 1e300, hi = -1e300;
+      for (int k = 0; k < m; ++k) {
+        const int rk = find_root(parent, k);
+        if (rk != ra && rk != rb) continue;
+        const cv::Rect r = rect(pieces[k]);
+        for (const Vec2& corner : {Vec2(r.x, r.y), Vec2(r.x + r.width, r.y), Vec2(r.x, r.y + r.height),
+                                  Vec2(r.x + r.width, r.y + r.height)}) {
+          lo = std::min(lo, corner.dot(axis));
+          hi = std::max(hi, corner.dot(axis));
+        }
+      }
+      if (hi - lo > 1.5 * expected) continue;
+    }
+    parent[static_cast<std::size_t>(ra)] = rb;
+    acc_of[static_cast<std::size_t>(rb)] = both;
+  }
 
   for (int root = 0; root < m; ++root) {
     if (find_root(parent, root) != root) continue;
@@ -151,25 +227,12 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
       }
     }
     if (area < p.min_area_px) continue;
-    // Moments over the members' pixels.
-    Accum acc;
+    const Accum& acc = acc_of[static_cast<std::size_t>(root)];  // the group's moments
     bool border = false;
     for (int id : members) {
       const cv::Rect r = rect(id);
       border = border || r.x == 0 || r.y == 0 || r.x + r.width == mask.cols ||
                r.y + r.height == mask.rows;
-      for (int y = r.y; y < r.y + r.height; ++y) {
-        const int* lab = ws->labels.ptr<int>(y);
-        for (int x = r.x; x < r.x + r.width; ++x) {
-          if (lab[x] != id) continue;
-          acc.n += 1;
-          acc.sx += x;
-          acc.sy += y;
-          acc.sxx += static_cast<double>(x) * x;
-          acc.sxy += static_cast<double>(x) * y;
-          acc.syy += static_cast<double>(y) * y;
-        }
-      }
     }
     const Vec2 c(acc.sx / acc.n, acc.sy / acc.n);
     const double cxx = acc.sxx / acc.n - c.x() * c.x();
@@ -222,7 +285,10 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
                                                             BraceletWorkspace* ws) {
   if (auto s = validate(p); !s.ok()) return s.error();
   if (auto s = red_mask(bgr, p, &ws->mask); !s.ok()) return s.error();
-  find_bracelet_candidates(ws->mask, p, ws);
+  // The longest predicted band bounds how far pieces merge.
+  double predicted_length = 0;
+  if (pred) predicted_length = std::max(pred->length_px[0], pred->length_px[1]);
+  find_bracelet_candidates(ws->mask, p, ws, predicted_length);
   const auto& cands = ws->candidates;
   std::array<BraceletObservation, 2> out{};
   std::array<int, 2> chosen{-1, -1};
@@ -246,26 +312,63 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
     out[hand].confidence = bracelet_confidence(cands[idx], p, expected) * factor;
   };
 
-  // 1. Hands with a predicted wrist: nearest candidate, gated, unambiguous.
-  for (int h = 0; h < 2 && pred; ++h) {
-    if (!pred->wrist_px[h]) continue;
-    const auto& other = pred->wrist_px[1 - h];
-    int best = -1;
-    double best_d = 0;
-    for (int i = 0; i < static_cast<int>(cands.size()); ++i) {
-      const double d = (cands[i].observation.wrist_px - *pred->wrist_px[h]).norm();
-      if (d > p.max_prediction_distance_px) continue;
-      if (other && d > p.ambiguity_ratio * (cands[i].observation.wrist_px - *other).norm()) continue;
-      if (best < 0 || d < best_d) {
-        best = i;
-        best_d = d;
+  // 1. Hands with a predicted wrist: the joint assignment of candidates to both hands (each band
+  //    to at most one hand) that best matches the predictions. A match costs
+  //    (distance / (gate / 3))² + (band-axis angle / 0.35 rad)² (when an axis is predicted), no
+  //    match costs 9 (3 σ); matches beyond the gate or 60° off the predicted axis are not allowed.
+  //    The axis tells the hands apart where both wrists project close together (the left and the
+  //    right forearm cross the image at different angles). A hand whose best match is ambiguous
+  //    (another choice within ambiguity_margin of its cost, for a different band) gets none.
+  if (pred && (pred->wrist_px[0] || pred->wrist_px[1])) {
+    const int nc = std::min<int>(static_cast<int>(cands.size()), 6);
+    const double sigma_d = p.max_prediction_distance_px / 3.0;
+    constexpr double kSigmaAngle = 0.35, kMaxAngle = 1.05, kNone = 9.0;
+    auto match_cost = [&](int h, int i) {
+      if (i < 0 || !pred->wrist_px[h]) return kNone;
+      const auto& o = cands[i].observation;
+      const double d = (o.wrist_px - *pred->wrist_px[h]).norm();
+      if (d > p.max_prediction_distance_px) return 1e9;
+      double c = (d / sigma_d) * (d / sigma_d);
+      if (pred->axis_px[h] && o.length_px > 0) {
+        const Vec2 ax = (o.end_b_px - o.end_a_px).normalized();
+        const double ang = std::acos(std::clamp(std::abs(ax.dot(pred->axis_px[h]->normalized())), 0.0, 1.0));
+        if (ang > kMaxAngle) return 1e9;
+        c += (ang / kSigmaAngle) * (ang / kSigmaAngle);
+      }
+      return c;
+    };
+    double best = 1e18;
+    std::array<int, 2> best_pair{-1, -1};
+    std::array<double, 2> runner_up{1e18, 1e18};  // per hand: best cost with a different band
+    for (int i = -1; i < nc; ++i) {
+      for (int j = -1; j < nc; ++j) {
+        if (i >= 0 && i == j) continue;
+        const double c = match_cost(0, i) + match_cost(1, j);
+        if (c < best) {
+          best = c;
+          best_pair = {i, j};
+        }
       }
     }
-    if (best >= 0) finish(h, best, 1.0);
+    // Ambiguity: the same total within ambiguity_margin with a different band for a hand.
+    for (int i = -1; i < nc; ++i) {
+      for (int j = -1; j < nc; ++j) {
+        if (i >= 0 && i == j) continue;
+        const double c = match_cost(0, i) + match_cost(1, j);
+        if (i != best_pair[0]) runner_up[0] = std::min(runner_up[0], c);
+        if (j != best_pair[1]) runner_up[1] = std::min(runner_up[1], c);
+      }
+    }
+    for (int h = 0; h < 2; ++h) {
+      const int i = best_pair[h];
+      if (i < 0 || !pred->wrist_px[h] || best >= 1e8) continue;
+      if (runner_up[h] - best < p.ambiguity_margin) continue;  // ambiguous
+      finish(h, i, 1.0);
+    }
   }
 
-  // 2. Hands without a prediction: by image side, among candidates no predicted hand took and
-  //    that are not claimed by the other hand's prediction.
+  // 2. Hands still without a bracelet: by image side, among candidates no hand took and that no
+  //    prediction claims.
   const double mid = 0.5 * (bgr.cols - 1);
   auto hand_of_side = [&](double x) {
     const bool left_side = x < mid;
@@ -282,7 +385,11 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
     }
     if (!claimed) free.push_back(i);
   }
-  const bool need[2] = {!(pred && pred->wrist_px[0]), !(pred && pred->wrist_px[1])};
+  // A hand whose prediction found nothing (the previous fit lost it, or the band moved fast) may
+  // take an unclaimed band on its side, trusted a little less: a wrong prediction must not lock
+  // a visible bracelet out for good.
+  const bool need[2] = {chosen[0] < 0, chosen[1] < 0};
+  const double factor[2] = {pred && pred->wrist_px[0] ? 0.7 : 1.0, pred && pred->wrist_px[1] ? 0.7 : 1.0};
   if (need[0] && need[1] && free.size() == 2) {
     int a = free[0], b = free[1];
     const double xa = cands[a].centroid_px.x(), xb = cands[b].centroid_px.x();
@@ -290,18 +397,19 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
                                  (xa > mid + p.centre_margin_px && xb > mid + p.centre_margin_px);
     if (same_side_clear) {
       // Both clearly on one side: only the better one is trusted, for that side's hand.
-      finish(hand_of_side(xa), a, 0.5);
+      finish(hand_of_side(xa), a, 0.5 * factor[hand_of_side(xa)]);
     } else {
       if (xa > xb) std::swap(a, b);  // a is the leftmost
-      finish(p.left_hand_on_image_left ? 0 : 1, a, 1.0);
-      finish(p.left_hand_on_image_left ? 1 : 0, b, 1.0);
+      const int ha = p.left_hand_on_image_left ? 0 : 1;
+      finish(ha, a, factor[ha]);
+      finish(1 - ha, b, factor[1 - ha]);
     }
   } else {
     for (int i : free) {
       const double x = cands[i].centroid_px.x();
       if (std::abs(x - mid) <= p.centre_margin_px) continue;  // ambiguous side
       const int h = hand_of_side(x);
-      if (need[h] && chosen[h] < 0) finish(h, i, 1.0);
+      if (need[h] && chosen[h] < 0) finish(h, i, factor[h]);
     }
   }
   return out;

@@ -131,6 +131,58 @@ TEST(Bracelet, MissingBraceletIsNotTakenFromTheOtherHand) {
   EXPECT_TRUE(obs[1].found);
 }
 
+TEST(Bracelet, TwoHandsBandsInLineAreNotMergedIntoOne) {
+  // Both wrists side by side, bands in line with a 6 px gap: thin enough together to pass for one
+  // band split by a finger, but twice as long as a band can be.
+  const std::vector<DrawnHand> hands = {{{260, 420}, -M_PI / 2, 170}, {{340, 420}, -M_PI / 2, 170}};
+  const auto scene = test::draw_scene(hands);
+  BraceletPrediction pred;
+  pred.wrist_px = {Vec2(262, 418), Vec2(338, 422)};
+  pred.length_px = {0.44 * 170, 0.44 * 170};
+  const auto obs = detect(scene.bgr, &pred);
+  for (int h = 0; h < 2; ++h) {
+    ASSERT_TRUE(obs[h].found) << h;
+    EXPECT_EQ(obs[h].pieces, 1) << h;
+    EXPECT_LT((obs[h].wrist_px - *scene.wrist[h]).norm(), 1.0) << h;
+  }
+}
+
+TEST(Bracelet, HandWhosePredictionFailedFallsBackToItsImageSide) {
+  const std::vector<DrawnHand> hands = {{{190, 400}, -1.75, 170}, {{450, 390}, -1.35, 170}};
+  const auto scene = test::draw_scene(hands);
+  BraceletPrediction pred;
+  pred.wrist_px = {Vec2(195, 402), Vec2(260, 200)};  // the right hand's previous fit is lost
+  const auto obs = detect(scene.bgr, &pred);
+  ASSERT_TRUE(obs[0].found);
+  ASSERT_TRUE(obs[1].found);
+  EXPECT_LT((obs[1].wrist_px - *scene.wrist[1]).norm(), 1.0);
+  EXPECT_LE(obs[1].confidence, 0.7 + 1e-9);  // trusted a little less than a predicted match
+  EXPECT_GT(obs[0].confidence, 0.7);
+}
+
+TEST(Bracelet, BandDirectionsTellHandsApartWhenWristsProjectClose) {
+  // The forearms come from the two sides and cross the image at different angles; both
+  // predictions lie between the bands, useless by position alone.
+  const std::vector<DrawnHand> hands = {{{275, 420}, -0.9, 170}, {{365, 410}, -2.3, 170}};
+  const auto scene = test::draw_scene(hands);
+  BraceletPrediction pred;
+  pred.wrist_px = {Vec2(322, 414), Vec2(318, 416)};
+  for (int h = 0; h < 2; ++h) {
+    const double a = hands[static_cast<std::size_t>(h)].angle;
+    pred.axis_px[static_cast<std::size_t>(h)] = Vec2(-std::sin(a), std::cos(a));  // across the forearm
+  }
+  auto obs = detect(scene.bgr, &pred);
+  for (int h = 0; h < 2; ++h) {
+    ASSERT_TRUE(obs[h].found) << h;
+    EXPECT_LT((obs[h].wrist_px - *scene.wrist[h]).norm(), 1.0) << h;
+  }
+  // Swapped axes swap the assignment: the axis, not the position, decided it.
+  std::swap(pred.axis_px[0], pred.axis_px[1]);
+  obs = detect(scene.bgr, &pred);
+  ASSERT_TRUE(obs[0].found && obs[1].found);
+  EXPECT_LT((obs[0].wrist_px - *scene.wrist[1]).norm(), 1.0);
+}
+
 TEST(Bracelet, LoneBandNearTheMidlineIsAmbiguousWithoutPredictions) {
   const std::vector<DrawnHand> hands = {{{322, 400}, -1.57, 170}};
   const auto scene = test::draw_scene(hands);
@@ -199,7 +251,7 @@ TEST(Bracelet, BadInputIsAnError) {
   BraceletWorkspace ws;
   EXPECT_FALSE(detect_bracelets(cv::Mat(), BraceletParams{}, nullptr, &ws).ok());
   BraceletParams p;
-  p.ambiguity_ratio = 1.5;
+  p.ambiguity_margin = -1.0;
   EXPECT_FALSE(detect_bracelets(cv::Mat(10, 10, CV_8UC3), p, nullptr, &ws).ok());
 }
 

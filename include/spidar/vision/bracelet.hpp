@@ -6,13 +6,16 @@
 /// i.e. two hue ranges because red wraps around hue 0 (evaluated directly on BGR, same result as
 /// cv::cvtColor + cv::inRange up to rounding). Connected red pieces larger than min_area_px form
 /// candidates; pieces separated by less than merge_gap_px (a finger lying across the band) are
-/// merged. As in the paper, a candidate's projected wrist is the midpoint of the marker's two
+/// merged when together they are about as thin as the thicker piece (two hands' bands side by
+/// side are not one band). As in the paper, a candidate's projected wrist is the midpoint of the marker's two
 /// ends along its principal axis (the band's long axis across the wrist).
 ///
-/// Assignment to hands (index 0 = left, 1 = right): with a predicted wrist for a hand, the
-/// candidate nearest to it within max_prediction_distance_px, and only if it is clearly nearer
-/// to that prediction than to the other hand's (ambiguity_ratio); without predictions, by image
-/// side (the camera looks over the user's hands, so the left hand is on the image's left).
+/// Assignment to hands (index 0 = left, 1 = right): with predicted wrists, the joint assignment of
+/// bands to both hands that best matches the predicted positions (within
+/// max_prediction_distance_px) and band directions, leaving out a hand whose choice is ambiguous; without predictions, or when a
+/// hand's prediction found nothing, by image side among the bands no prediction claims (the
+/// camera looks over the user's hands, so the left hand is on the image's left; a fallback after
+/// a failed prediction has its confidence scaled by 0.7).
 /// Anything ambiguous is left unassigned (found = false): a hand may be reported missing, but
 /// never with the other hand's bracelet.
 ///
@@ -44,7 +47,9 @@ struct BraceletParams {
   double expected_length_px = 0;
   double expected_aspect = 2.5;
   double max_prediction_distance_px = 80;  ///< a candidate farther from the prediction is ignored
-  double ambiguity_ratio = 0.7;  ///< need d(own prediction) ≤ ratio · d(other prediction)
+  /// A hand is left without a band when another choice of band for it costs less than this more
+  /// (costs are squared σ-distances, see detect_bracelets).
+  double ambiguity_margin = 1.0;
   double centre_margin_px = 16;  ///< without predictions, a lone candidate this near the midline is ambiguous
   bool left_hand_on_image_left = true;
 };
@@ -80,6 +85,8 @@ double bracelet_confidence(const BraceletCandidate& c, const BraceletParams& par
 
 struct BraceletPrediction {
   std::array<std::optional<Vec2>, 2> wrist_px;  ///< predicted projected wrists (left, right)
+  /// Predicted direction of each band's long axis in the image (across the forearm; sign free).
+  std::array<std::optional<Vec2>, 2> axis_px;
   /// Predicted band length per hand [px] (e.g. the projected wrist width); 0 = use params.
   std::array<double, 2> length_px{0.0, 0.0};
 };
@@ -93,7 +100,8 @@ struct BraceletWorkspace {
 /// The red mask (CV_8UC1, 255 = red) of an 8-bit BGR frame.
 Status red_mask(const cv::Mat& bgr, const BraceletParams& params, cv::Mat* mask);
 
-/// Bracelet candidates in a red mask, best first.
+/// Bracelet candidates in a red mask, best first. With an expected band length (else
+/// params.expected_length_px), pieces do not merge into anything longer than 1.5 times it.
 void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& params,
                               BraceletWorkspace* ws, double expected_length_px = 0);
 
