@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "layer_locks.hpp"
 #include "spidar/core/units.hpp"
 
 namespace spidar::physics {
@@ -62,6 +63,7 @@ Result<RubiksCube> RubiksCube::Attach(World& world, const DetentParams& detent) 
           char face = x == 2 ? 'R' : x == 0 ? 'L' : y == 2 ? 'B' : y == 0 ? 'F' : z == 2 ? 'U' : 'D';
           cube.face_hinge_qpos_[face_index(face)] = c.qpos;
         }
+        c.name = name;
         cube.cubelets_.push_back(c);
       }
     }
@@ -79,6 +81,29 @@ Result<RubiksCube> RubiksCube::Attach(World& world, const DetentParams& detent) 
       d->qfrc_applied[dofs[f]] = -detent.stiffness * std::sin(4.0 * th) - detent.damping * d->qvel[dofs[f]];
     }
   });
+  // Layer locks, when the scene has them (a weld `lock_<cubelet>` per cubelet).
+  std::vector<LayerLocks::Piece> pieces;
+  for (const Cubelet& c : cube.cubelets_) {
+    LayerLocks::Piece p;
+    p.body = c.body;
+    p.eq = mj_name2id(m, mjOBJ_EQUALITY, ("lock_" + c.name).c_str());
+    if (c.hinge) {
+      const Vec3 p0(m->body_pos[3 * c.body], m->body_pos[3 * c.body + 1], m->body_pos[3 * c.body + 2]);
+      int axis = 0;
+      p0.cwiseAbs().maxCoeff(&axis);
+      for (int f = 0; f < 6; ++f)
+        if (face_axis(kFaces[f]) == std::pair<int, int>{axis, p0[axis] > 0 ? 1 : -1}) p.centre_of = f;
+    }
+    pieces.push_back(p);
+  }
+  cube.locks_ = LayerLocks::Create(m, cube.core_, pieces, detent, cube.pitch_);
+  if (cube.locks_) {
+    mj_forward(m, world.data());
+    cube.locks_->lock_all(world.mutable_model(), world.data());
+    World* w = &world;
+    auto locks = cube.locks_;
+    world.add_post_step_hook([w, locks](const mjModel_*, mjData_* d) { locks->after_step(w->mutable_model(), d); });
+  }
   return cube;
 }
 
@@ -94,6 +119,17 @@ double RubiksCube::face_misalignment(char face) const {
 }
 
 Pose RubiksCube::core_pose() const { return world_->body_pose(core_); }
+
+char RubiksCube::turning_face() const {
+  return locks_ && locks_->turning() >= 0 ? kFaces[locks_->turning()] : 0;
+}
+
+int RubiksCube::layer_unlocks() const { return locks_ ? locks_->unlocks() : 0; }
+
+double RubiksCube::layer_twist(char face) const {
+  const int f = face_index(face);
+  return locks_ && f >= 0 ? locks_->twist()[static_cast<std::size_t>(f)] : 0.0;
+}
 
 Vec3 RubiksCube::in_core(const Vec3& p_W) const {
   const Pose X = core_pose();
@@ -170,6 +206,7 @@ Status RubiksCube::turn(char face, int quarter_turns) {
     }
   }
   mj_forward(m, d);
+  if (locks_) locks_->lock_all(world_->mutable_model(), d);  // every cubelet locked where it now is
   return Ok{};
 }
 

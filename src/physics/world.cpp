@@ -166,6 +166,7 @@ void World::step(std::span<const Vec3> p_W_target, std::span<const Vec3> v_W_tar
   }
   for (auto& hook : hooks_) hook(model_, data_);
   mj_step2(model_, data_);
+  for (auto& hook : post_hooks_) hook(model_, data_);
   update_proxy_states();
 }
 

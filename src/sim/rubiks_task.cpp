@@ -25,24 +25,35 @@ Contacts contacts(const RubiksTaskParams& p) {
   const double hold = p.half + p.proxy_radius - p.hold_squeeze;
   const double a = p.pitch;
   Contacts c;
-  // Left hand on the two lower layers: thumb in front (−y), fingers behind (+y). Middle and ring
-  // press the bottom layer symmetrically about its axis: off-centre pushes there would twist it
-  // (|x|·F ≈ 0.04 N·m, ten times the detent) — a D turn nobody wanted.
-  c.left = {Vec3(-0.012, -hold, -0.45 * a), Vec3(-0.016, hold, -0.2 * a),
-            Vec3(-0.006, hold, -0.7 * a), Vec3(-0.020, hold, -0.9 * a)};
-  // Right hand on the top layer: thumb in front, index and ring behind, middle on top.
-  c.right = {Vec3(0.006, -face, a), Vec3(0.002, face, a), Vec3(0.004, 0.004, p.half + p.proxy_radius - 0.6 * p.squeeze),
-             Vec3(0.012, face, a)};
+  // Each hand's pushes balance layer by layer, so that a grasp twists no layer of the cube: the
+  // thumb presses at the mean position of the fingers opposite it, and every contact lies in the
+  // middle vertical slice, close to the plane x = 0, where no pull along a face twists the L or
+  // R layer and no push across a face twists U, D, F or B much.
+  // Left hand on the two lower layers, from the left: thumb in front (−y), fingers behind (+y),
+  // stacked down the back face.
+  c.left = {Vec3(-0.26 * a, -hold, -0.58 * a), Vec3(-0.2 * a, hold, -0.2 * a),
+            Vec3(-0.26 * a, hold, -0.58 * a), Vec3(-0.32 * a, hold, -0.95 * a)};
+  // Right hand on the top layer, from above: thumb in front, index and ring behind either side
+  // of the middle, which presses on the top. High on the layer: a fingertip on the middle layer
+  // would drag it along.
+  const double zr = 1.2 * a;
+  c.right = {Vec3(0.0, -face, zr), Vec3(-0.37 * a, face, zr),
+             Vec3(0.0, 0.2 * a, p.half + p.proxy_radius - 0.6 * p.squeeze), Vec3(0.37 * a, face, zr)};
   return c;
 }
 
-/// Where a contact's fingertip is with the hand open: out along the face normal, up a little.
-Vec3 opened(const Vec3& c, double half) {
-  Vec3 out = c;
-  if (std::abs(c.y()) >= half - 1e-9) out.y() += (c.y() > 0 ? 1 : -1) * 0.035;  // side faces
-  else out.z() += 0.035;                                                       // the top
-  return out + Vec3(0, 0, 0.01);
+/// True for a contact on the top face; the others press on the front or back face. (Goals lie
+/// `squeeze` inside the faces, so a side contact's |y| is less than half the cube: the face a
+/// contact belongs to is told by its height, which only a top contact has above the top.)
+bool on_top(const Vec3& c, double half) { return c.z() >= half - 1e-9; }
+
+/// Outward normal of a contact's face, cube frame.
+Vec3 face_normal(const Vec3& c, double half) {
+  return on_top(c, half) ? Vec3::UnitZ() : Vec3(0, c.y() > 0 ? 1 : -1, 0);
 }
+
+/// Where a contact's fingertip is with the hand open: out along the face normal, up a little.
+Vec3 opened(const Vec3& c, double half) { return c + 0.025 * face_normal(c, half) + Vec3(0, 0, 0.01); }
 
 // Nominal hand poses at the grasp, cube frame: wrist position [m], hand rotation, finger angles.
 struct Nominal {
@@ -141,12 +152,11 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal)
     const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
     const Vec3& contact = right ? c.right[f - 4] : c.left[f];
     const Vec3 open = opened(contact, p_.half);
-    // Where the hand starts and ends: further out along the face's normal, up, and toward its
-    // own side. Both ends of the approach lie outside the face's plane, so the straight path
-    // between them never crosses the cube.
-    const Vec3 normal = std::abs(contact.y()) >= p_.half - 1e-9 ? Vec3(0, contact.y() > 0 ? 1 : -1, 0)
-                                                                 : Vec3::UnitZ();
-    const Vec3 away = p_.withdraw * (0.6 * normal + Vec3(right ? 0.5 : -0.5, 0, 0.4));
+    // Where the hand starts and ends: the open hand moved as a whole toward its own side, the
+    // user and up. Both ends of the approach lie outside the faces' planes (the offset toward
+    // the user is less than the opening), so the straight path between them never crosses the
+    // cube.
+    const Vec3 away = p_.withdraw * (right ? Vec3(0.5, -0.3, 0.6) : Vec3(-0.6, -0.2, 0.3));
     const Vec3 far = open + away;
     Vec3 p = far + (open - far) * approach + (far - open) * withdraw;
     p += (contact - open) * (right ? close_right : close_left);

@@ -53,6 +53,41 @@ TEST(RubiksCube, FourQuarterTurnsOfEveryFaceAreIdentity) {
   }
 }
 
+TEST(RubiksCube, TwistsBelowTheBreakawayLeaveTheCubeRigid) {
+  auto w = cube_world();
+  auto cube = RubiksCube::Attach(*w).value();
+  const mjModel* m = w->model();
+  mjData* d = w->data();
+  std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
+  w->place_proxies(parked);
+  // Every layer twisted at once, each by less than the breakaway torque (a firm, off-centre grasp):
+  // 0.3 N tangential on each cubelet about each of its faces' axes, alternating sense by face:
+  // under 0.12 N·m of twist per layer, the breakaway (the detent alone gives way at 0.02 N·m).
+  const int core = w->body_id("cube");
+  for (int k = 0; k < 1000; ++k) {
+    const Vec3 c = w->body_pose(core).p;
+    for (int b = 0; b < m->nbody; ++b) {
+      const char* n = mj_id2name(m, mjOBJ_BODY, b);
+      const std::string name = n ? n : "";
+      if (name.rfind("cubelet_", 0) != 0) continue;
+      const int ix = name[8] - '1', iy = name[9] - '1', iz = name[10] - '1';
+      Vec3 f = Vec3::Zero();
+      const Vec3 r(d->xpos[3 * b] - c.x(), d->xpos[3 * b + 1] - c.y(), d->xpos[3 * b + 2] - c.z());
+      if (iz != 0) f += 0.3 * iz * Vec3::UnitZ().cross(r).normalized();
+      if (ix != 0) f -= 0.3 * ix * Vec3::UnitX().cross(r).normalized();
+      if (iy != 0) f += 0.3 * iy * Vec3::UnitY().cross(r).normalized();
+      for (int i = 0; i < 3; ++i) d->xfrc_applied[6 * b + i] = f.allFinite() ? f[i] : 0.0;
+    }
+    w->step(parked, v);
+  }
+  for (char face : std::string("UDFBRL")) {
+    EXPECT_LT(std::abs(cube.face_angle(face)), units::deg_to_rad(0.5)) << face;
+  }
+  EXPECT_EQ(cube.turning_face(), 0);
+  EXPECT_EQ(cube.layer_unlocks(), 0);
+  EXPECT_TRUE(cube.is_solved());
+}
+
 TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
   auto w = cube_world();
   auto cube = RubiksCube::Attach(*w).value();
@@ -60,8 +95,10 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
   mjData* d = w->data();
   std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
   w->place_proxies(parked);
-  // Like two hands: push the top layer's cubelets around +z, hold the two lower layers back,
-  // until the layer is past the detent's midpoint (55°); then let go.
+  // Like two hands: push the top layer's cubelets around +z, hold the bottom layer back, until
+  // the layer is past the detent's midpoint (55°); then let go. 1.2 N on each of the top 9
+  // cubelets and −0.1 N on the bottom 9 twist the top layer by ~0.15 N·m against the rest, above
+  // the locks' 0.12 N·m breakaway and 1.7 times the bottom layer's twist (the locks need 1.5).
   std::vector<int> top, rest;
   for (int b = 0; b < m->nbody; ++b) {
     const char* n = mj_id2name(m, mjOBJ_BODY, b);
@@ -80,9 +117,9 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
       const Vec3 t = r.norm() > 1e-4 ? Vec3(Vec3::UnitZ().cross(r) / r.norm()) : Vec3::Zero();
       for (int i = 0; i < 3; ++i) d->xfrc_applied[6 * b + i] = pushing ? f * t[i] : 0.0;
     };
-    for (int b : top) push(b, 0.05);
+    for (int b : top) push(b, 1.2);
     for (int b : rest)
-      if (std::string(mj_id2name(m, mjOBJ_BODY, b)).back() == '0') push(b, -0.05);
+      if (std::string(mj_id2name(m, mjOBJ_BODY, b)).back() == '0') push(b, -0.1);
     w->step(parked, v);
     peak = std::max(peak, cube.face_angle('U'));
   }
@@ -101,6 +138,9 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
   ASSERT_TRUE(reference.turn('D', ((qd % 4) + 4) % 4).ok());
   EXPECT_EQ(cube.facelets(), reference.facelets());
   EXPECT_FALSE(cube.is_solved());
+  // One layer broke away and locked again at the click.
+  EXPECT_EQ(cube.layer_unlocks(), 1);
+  EXPECT_EQ(cube.turning_face(), 0);
 }
 
 TEST(RubiksCube, SceneWithoutACubeIsAClearError) {

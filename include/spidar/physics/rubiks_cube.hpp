@@ -8,6 +8,7 @@
 /// face, each the letter of the face whose colour the sticker has.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,9 +17,25 @@
 
 namespace spidar::physics {
 
+class LayerLocks;
+
 struct DetentParams {
-  double stiffness = 0.004;  ///< peak detent torque [N·m]: τ = −k sin(4θ) on each face hinge
+  double stiffness = 0.02;   ///< peak detent torque [N·m]: τ = −k sin(4θ) on each face hinge
   double damping = 0.0;      ///< extra hinge damping [N·m·s/rad]
+  /// Layer locks (scenes whose cubelets have `lock_<cubelet>` welds, as scenes/rubiks_cube.xml):
+  /// the cube is rigid until the external torque twisting one layer against the rest exceeds
+  /// this for `breakaway_time_s`; that layer then turns on its hinge until it rests within
+  /// `lock_tolerance_rad` of a click for `settle_time_s` and locks again. Like a real cube's
+  /// internal friction, it keeps a firm grasp from twisting faces.
+  /// [N·m]: a stiff 57 mm cube; above what a firm two-finger pinch at off-centre points puts on a
+  /// layer (grasp transients up to ~0.1 N·m seen in the demo), below what a turning hand gives.
+  double breakaway_torque = 0.12;
+  double breakaway_time_s = 0.03;   ///< [s]: longer than the transients of a closing grasp
+  /// A layer breaks away only if twisted this many times harder than any other (one hand turning
+  /// one layer, not a jerky grasp twisting several).
+  double dominance = 1.5;
+  double lock_tolerance_rad = 0.035;  ///< [rad] (2°)
+  double settle_time_s = 0.02;      ///< [s]
 };
 
 class RubiksCube {
@@ -33,6 +50,14 @@ class RubiksCube {
   double face_misalignment(char face) const;
   /// Pose of the cube core in world.
   Pose core_pose() const;
+  /// The face whose layer is unlocked and turning now (U D F B R L), or 0 when the cube is locked
+  /// rigid (or the scene has no layer locks).
+  char turning_face() const;
+  /// How often a layer has broken away so far.
+  int layer_unlocks() const;
+  /// The external torque twisting a face's layer against the rest of the cube, measured in the
+  /// last step [N·m] about the face's outward axis (0 without layer locks).
+  double layer_twist(char face) const;
 
   /// 54 facelet colours, faces in order U R F D L B.
   std::string facelets() const;
@@ -50,11 +75,13 @@ class RubiksCube {
     int qpos = -1;   ///< joint qpos address
     bool hinge = false;
     std::vector<std::pair<int, char>> stickers;  ///< geom id, face letter of its colour
+    std::string name;
   };
   RubiksCube() = default;
   Vec3 in_core(const Vec3& p_W) const;
 
   World* world_ = nullptr;
+  std::shared_ptr<LayerLocks> locks_;  ///< shared with the world's post-step hook; may be null
   int core_ = -1;
   std::vector<Cubelet> cubelets_;
   std::array<int, 6> face_hinge_qpos_{};  ///< U D F B R L

@@ -56,6 +56,9 @@ class World {
   std::span<const ProxyState> proxies() const { return proxies_; }
 
   void add_step_hook(StepHook hook) { hooks_.push_back(std::move(hook)); }
+  /// A hook run after mj_step2, when the step's contacts and constraint forces are consistent
+  /// (mj_contactForce is valid); what it changes in the model takes effect in the next step.
+  void add_post_step_hook(StepHook hook) { post_hooks_.push_back(std::move(hook)); }
   double time() const;
   double timestep() const;
   int contact_count() const;
@@ -73,6 +76,8 @@ class World {
   Pose body_pose(int body) const;
   /// Raw MuJoCo access for code inside the physics module.
   const mjModel_* model() const { return model_; }
+  /// Mutable model, for mechanisms of the physics module that switch constraints at run time.
+  mjModel_* mutable_model() { return model_; }
   mjData_* data() { return data_; }
   const mjData_* data() const { return data_; }
 
@@ -88,7 +93,7 @@ class World {
   std::vector<Vec3> proxy_origin_;  ///< body position at qpos = 0 [m]
   std::vector<Vec3> coupling_force_;
   std::vector<ProxyState> proxies_;
-  std::vector<StepHook> hooks_;
+  std::vector<StepHook> hooks_, post_hooks_;
   std::shared_ptr<const std::vector<MeshData>> meshes_;
 };
 

@@ -1,0 +1,83 @@
+// The scripted Rubik's task on the real physics, in lockstep (no threads, no device): the user's
+// fingertips follow the script's goals through the fingertip impedance and feel the coupling
+// forces, one physics step at a time. Deterministic, so the script and the cube's layer locks
+// are checked without the timing of a busy machine.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include "spidar/core/units.hpp"
+#include "spidar/device/simulated_spidar.hpp"
+#include "spidar/physics/rubiks_cube.hpp"
+#include "spidar/physics/world.hpp"
+#include "spidar/sim/rubiks_task.hpp"
+
+namespace spidar::sim {
+namespace {
+
+std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
+
+struct TaskRun {
+  double lift_max_m = 0;
+  int quarter_turns_u = 0;  ///< U's final angle in quarter turns
+  int unlocks = 0;
+  std::array<double, 6> other_faces_max_rad{};  ///< D F B R L: largest |angle| seen
+  bool solved = true;
+};
+
+TaskRun run_task() {
+  auto world = physics::World::Load(source("scenes/rubiks_cube.xml")).value();
+  auto cube = physics::RubiksCube::Attach(*world).value();
+  RubiksTaskParams tp;
+  tp.proxy_radius = world->params().proxy.radius;
+  tp.p_W_cube = cube.core_pose().p;
+  const Pose X0 = cube.core_pose();
+  RubiksTask task(tp);
+  core::Latest<CubePoseSample> pose;
+  task.track(&pose);
+  std::vector<Vec3> x(8), v(8, Vec3::Zero()), goal(8);
+  task.goals(0.0, goal);
+  x = goal;
+  world->place_proxies(x);
+  const device::FingertipImpedance imp;  // the simulated device's human fingertip
+  const double dt = world->timestep();
+  TaskRun r;
+  for (int s = 0; s * dt < tp.duration; ++s) {
+    const Pose X = cube.core_pose();
+    pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+    task.goals(s * dt, goal);
+    const auto f_proxy = world->coupling_forces();  // the fingertip feels the opposite
+    for (int i = 0; i < 8; ++i) {
+      for (int k = 0; k < 4; ++k) {  // semi-implicit Euler at dt / 4
+        const Vec3 a = (imp.stiffness * (goal[i] - x[i]) - imp.damping * v[i] - f_proxy[i]) / imp.mass;
+        v[i] += a * dt / 4;
+        x[i] += v[i] * dt / 4;
+      }
+    }
+    world->step(x, v);
+    r.lift_max_m = std::max(r.lift_max_m, X.p.z() - X0.p.z());
+    for (int f = 1; f < 6; ++f)
+      r.other_faces_max_rad[f] = std::max(r.other_faces_max_rad[f], std::abs(cube.face_angle("UDFBRL"[f])));
+  }
+  r.quarter_turns_u = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+  r.unlocks = cube.layer_unlocks();
+  r.solved = cube.is_solved();
+  return r;
+}
+
+TEST(RubiksTask, LockstepPhysicsLiftsAndTurnsTheTopLayerTwice) {
+  const TaskRun r = run_task();
+  std::printf("lift %.1f mm, U %d quarter turns, %d unlocks, other faces within %.2f deg\n",
+              r.lift_max_m * 1e3, r.quarter_turns_u, r.unlocks,
+              *std::max_element(r.other_faces_max_rad.begin(), r.other_faces_max_rad.end()) * 180 / units::kPi);
+  EXPECT_GT(r.lift_max_m, 0.010);  // the left hand lifts the cube (script: 20 mm)
+  EXPECT_EQ(r.quarter_turns_u, 2);  // two turns of the top layer, each clicked into place
+  EXPECT_FALSE(r.solved);
+  // The grasps twist no other layer out of its click.
+  for (int f = 1; f < 6; ++f) EXPECT_LT(r.other_faces_max_rad[f], units::deg_to_rad(3)) << "UDFBRL"[f];
+}
+
+}  // namespace
+}  // namespace spidar::sim
