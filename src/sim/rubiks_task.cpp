@@ -152,11 +152,11 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal)
     const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
     const Vec3& contact = right ? c.right[f - 4] : c.left[f];
     const Vec3 open = opened(contact, p_.half);
-    // Where the hand starts and ends: the open hand moved as a whole toward its own side, the
-    // user and up. Both ends of the approach lie outside the faces' planes (the offset toward
+    // Where the hand starts and ends: the open hand moved as a whole toward its own side and up
+    // (not toward the user, where the camera is). Both ends of the approach lie outside the faces' planes (the offset toward
     // the user is less than the opening), so the straight path between them never crosses the
     // cube.
-    const Vec3 away = p_.withdraw * (right ? Vec3(0.5, -0.3, 0.6) : Vec3(-0.6, -0.2, 0.3));
+    const Vec3 away = p_.withdraw * (right ? Vec3(0.75, 0.1, 0.35) : Vec3(-0.75, 0.1, 0.3));
     const Vec3 far = open + away;
     Vec3 p = far + (open - far) * approach + (far - open) * withdraw;
     p += (contact - open) * (right ? close_right : close_left);
