@@ -4,6 +4,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -82,6 +83,32 @@ TEST(SerialPort, PtyCarriesRawBytesBothWays) {
   // Nothing more: a read times out.
   EXPECT_EQ(port.read_some(got, 0.01).status, IoStatus::kTimeout);
   ::close(pty->master_fd);
+}
+
+TEST(SerialPort, ReadReadyTakesWhatIsThereAndSeesTheHangUp) {
+  Result<PtyPair> pty = open_pty();
+  ASSERT_TRUE(pty.ok()) << pty.error().message;
+  Result<SerialPort> opened = SerialPort::open(pty->slave_path, 921600);
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  SerialPort port = std::move(opened).value();
+  std::array<std::uint8_t, 64> got{};
+  IoResult r = port.read_ready(got);  // nothing sent: returns at once, nothing read
+  EXPECT_EQ(r.status, IoStatus::kOk);
+  EXPECT_EQ(r.bytes, 0u);
+  const std::array<std::uint8_t, 5> hello{'h', 'e', 'l', 'l', 'o'};
+  ASSERT_EQ(write_all(pty->master_fd, hello, 1.0).status, IoStatus::kOk);
+  std::size_t n = 0;
+  ASSERT_TRUE(PtyLink::wait_until([&] {
+    r = port.read_ready(std::span(got).subspan(n));
+    n += r.bytes;
+    return r.status != IoStatus::kOk || n >= hello.size();
+  }));
+  ASSERT_EQ(r.status, IoStatus::kOk);
+  ASSERT_EQ(n, hello.size());
+  EXPECT_TRUE(std::equal(hello.begin(), hello.end(), got.begin()));
+  ::close(pty->master_fd);  // the device side goes away: the slave is hung up
+  r = port.read_ready(got);
+  EXPECT_EQ(r.status, IoStatus::kClosed);
 }
 
 TEST(SerialDevice, BadConfigurationIsAnErrorOnOpen) {
