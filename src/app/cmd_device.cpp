@@ -7,6 +7,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "device_backends.hpp"
+#include "spidar/device/serial_device.hpp"
 #include "spidar/device/servo_loop.hpp"
 
 namespace spidar::app {
@@ -73,6 +74,8 @@ Action add_device_test(CLI::App& app) {
                         {"jitter_p99_us", s.jitter_p99_us},
                         {"jitter_max_us", s.jitter_max_us},
                         {"overruns", s.overruns},
+                        {"repeated_readings", s.repeated_readings},
+                        {"longest_repeat", s.longest_repeat},
                         {"cycle_us_median", s.cycle_us_median},
                         {"cycle_us_p99", s.cycle_us_p99},
                         {"realtime_scheduling", s.realtime_scheduling},
@@ -80,6 +83,13 @@ Action add_device_test(CLI::App& app) {
                         {"faults", faults},
                         {"fault_message", s.fault_message},
                         {"fingertips", fingers}};
+    if (const auto* serial = dynamic_cast<const device::SerialDevice*>(dev.get())) {
+      const device::SerialLinkStats l = serial->link_stats();
+      j["serial_link"] = {{"frames_out", l.frames_out},     {"counts_in", l.counts_in},
+                          {"stale", l.stale},               {"behind", l.behind},
+                          {"repeated", l.repeated},         {"timeouts", l.timeouts},
+                          {"unexpected", l.unexpected},     {"decoder_errors", l.decoder.errors()}};
+    }
     std::cout << j.dump(2) << "\n";
     return s.faults ? 1 : 0;
   };

@@ -80,8 +80,8 @@ Action add_emulate_device(CLI::App& app) {
     const auto c = emulator.counters();
     std::cerr << "emulate-device: " << c.frames_in << " frames in, " << c.frames_out
               << " out, " << c.rejected << " rejected, " << c.watchdog_trips
-              << " watchdog trips, decoder errors: " << c.decoder.bad_crc << " CRC, "
-              << c.decoder.bad_length << " length\n";
+              << " watchdog trips, " << c.io_errors << " I/O errors, decoder errors: "
+              << c.decoder.bad_crc << " CRC, " << c.decoder.bad_length << " length\n";
     sim->close();
     ::close(pty->master_fd);
     return 0;

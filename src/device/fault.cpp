@@ -10,6 +10,7 @@ std::string fault_names(std::uint32_t faults) {
       {kFaultProtocol, "protocol"},           {kFaultOverCurrent, "over_current"},
       {kFaultEmergencyStop, "emergency_stop"}, {kFaultWatchdog, "watchdog"},
       {kFaultDeadlineMiss, "deadline_miss"},  {kFaultForceStall, "force_stall"},
+      {kFaultStaleCounts, "stale_counts"},
   };
   std::string out;
   for (const auto& [bit, name] : kNames) {

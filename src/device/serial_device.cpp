@@ -10,6 +10,11 @@
 namespace spidar::device {
 namespace {
 
+/// First and largest sleep between looks at the port while a read waits [ns]: short enough to
+/// take an answer soon after it lands, growing so that long waits cost few wake-ups.
+constexpr std::int64_t kFirstWaitSliceNs = 20'000;
+constexpr std::int64_t kMaxWaitSliceNs = 1'000'000;
+
 constexpr std::int32_t kInt16Min = std::numeric_limits<std::int16_t>::min();
 constexpr std::int32_t kInt16Max = std::numeric_limits<std::int16_t>::max();
 
@@ -106,21 +111,29 @@ Status SerialDevice::open() {
   decoder_.reset();
   stats_ = {};
   outstanding_ = false;
+  have_reading_ = false;
+  held_ = {};
   faults_.store(kFaultNone);
   open_.store(true);
 
-  std::size_t n = protocol::encode_set_limits(tx_, next_seq(), {wire_min_, wire_max_});
+  const std::size_t n = protocol::encode_set_limits(
+      tx_, static_cast<std::uint8_t>(next_index()), {wire_min_, wire_max_});
   if (Status s = send({tx_.data(), n}, "open: sending limits"); !s) {
     close();
     return s;
   }
-  const std::uint8_t hb = next_seq();
-  n = protocol::encode_heartbeat(tx_, hb);
-  if (Status s = send({tx_.data(), n}, "open: sending heartbeat"); !s) {
+  if (Status s = send_heartbeat("open: sending heartbeat"); !s) {
     close();
     return s;
   }
-  expected_seq_ = hb;
+  return Ok{};
+}
+
+Status SerialDevice::send_heartbeat(const char* what) {
+  const std::uint64_t index = next_index();
+  const std::size_t n = protocol::encode_heartbeat(tx_, static_cast<std::uint8_t>(index));
+  if (Status s = send({tx_.data(), n}, what); !s) return s;
+  latest_request_ = index;
   outstanding_ = true;
   return Ok{};
 }
@@ -131,7 +144,8 @@ void SerialDevice::close() {
     std::array<std::int16_t, kMaxDeviceStrings> mins{};
     mins.fill(wire_min_);
     const std::size_t n = protocol::encode_set_commands(
-        tx_, next_seq(), {mins.data(), static_cast<std::size_t>(config_.string_count)});
+        tx_, static_cast<std::uint8_t>(next_index()),
+        {mins.data(), static_cast<std::size_t>(config_.string_count)});
     (void)port_.write_all({tx_.data(), n}, config_.read_timeout_s);  // best effort
   }
   port_.close();
@@ -166,10 +180,11 @@ Status SerialDevice::write(std::span<const std::int32_t> commands) {
     wire[i] = safe ? wire_min_
                    : to_wire(std::clamp(commands[i], config_.command_min, config_.command_max));
   }
-  const std::uint8_t seq = next_seq();
-  const std::size_t n = protocol::encode_set_commands(tx_, seq, {wire.data(), commands.size()});
+  const std::uint64_t index = next_index();
+  const std::size_t n = protocol::encode_set_commands(tx_, static_cast<std::uint8_t>(index),
+                                                      {wire.data(), commands.size()});
   if (Status s = send({tx_.data(), n}, "write"); !s) return s;
-  expected_seq_ = seq;
+  latest_request_ = index;
   outstanding_ = true;
   return Ok{};
 }
@@ -178,55 +193,54 @@ Status SerialDevice::zero_counters(std::uint32_t mask) {
   if (!open_.load(std::memory_order_relaxed)) {
     return fail(kFaultDisconnected, "zero_counters", "device not open", 0);
   }
-  const std::size_t n = protocol::encode_zero_counters(tx_, next_seq(), {mask});
+  const std::size_t n =
+      protocol::encode_zero_counters(tx_, static_cast<std::uint8_t>(next_index()), {mask});
   return send({tx_.data(), n}, "zero_counters");
 }
 
-Status SerialDevice::read(EncoderReading& out) {
-  if (!open_.load(std::memory_order_relaxed)) {
-    return fail(kFaultDisconnected, "read", "device not open", 0);
-  }
-  if (!outstanding_) {
-    const std::uint8_t hb = next_seq();
-    const std::size_t n = protocol::encode_heartbeat(tx_, hb);
-    if (Status s = send({tx_.data(), n}, "read: sending heartbeat"); !s) return s;
-    expected_seq_ = hb;
-    outstanding_ = true;
-  }
-  const std::int64_t deadline =
-      core::monotonic_ns() + static_cast<std::int64_t>(config_.read_timeout_s * 1e9);
-  bool got = false;
-  int bad_count = -1;
-  protocol::Counts counts;
-  for (;;) {
-    const double remaining = static_cast<double>(deadline - core::monotonic_ns()) * 1e-9;
-    const IoResult r = port_.read_some(rx_, remaining > 0.0 ? remaining : 0.0);
-    if (r.status == IoStatus::kTimeout) {
-      ++stats_.timeouts;
-      outstanding_ = false;
-      return fail(kFaultReadTimeout, "read", "no Counts frame within the read timeout", 0);
-    }
+Status SerialDevice::drain(bool& fresh) {
+  for (int k = 0; k < kMaxDrainReads; ++k) {
+    const IoResult r = port_.read_ready(rx_);
     if (r.status == IoStatus::kClosed) {
       return fail(kFaultDisconnected, "read", "port closed by the device side", r.error_number);
     }
-    if (r.status == IoStatus::kError) {
+    if (r.status != IoStatus::kOk) {
       return fail(kFaultDisconnected, "read", "read failed", r.error_number);
     }
+    if (r.bytes == 0) return Ok{};
+    const std::int64_t arrived_ns = core::monotonic_ns();
+    int bad_count = -1;
     decoder_.feed({rx_.data(), r.bytes}, [&](const protocol::Frame& f) {
       if (f.type != protocol::FrameType::kCounts) {
         ++stats_.unexpected;
         return;
       }
-      if (f.seq != expected_seq_) {
+      // The request this answers: the newest one sent with this sequence number.
+      const auto back = static_cast<std::uint8_t>(static_cast<std::uint8_t>(latest_request_) - f.seq);
+      if (back > latest_request_ || (have_reading_ && latest_request_ - back <= held_request_)) {
         ++stats_.stale;
         return;
       }
+      protocol::Counts counts;
       if (!protocol::parse(f, counts)) return;  // cannot happen: the decoder checked the length
       if (counts.count != config_.string_count) {
         bad_count = counts.count;
         return;
       }
-      got = true;
+      ++stats_.counts_in;
+      held_request_ = latest_request_ - back;
+      have_reading_ = true;
+      fresh = true;
+      if (back == 0) outstanding_ = false;
+      held_.host_time_ns = arrived_ns;
+      held_.device_time_us = counts.device_time_us;
+      held_.status_flags = counts.status_flags;
+      held_.string_count = counts.count;
+      held_.repeats = 0;
+      std::copy_n(counts.counts.begin(), counts.count, held_.counts.begin());
+      const std::uint32_t latched =
+          counts.status_flags & ~static_cast<std::uint32_t>(kFaultWatchdog);
+      if (latched != 0) faults_.fetch_or(latched, std::memory_order_acq_rel);
     });
     if (bad_count >= 0) {
       outstanding_ = false;
@@ -236,17 +250,50 @@ Status SerialDevice::read(EncoderReading& out) {
       d += std::to_string(config_.string_count);
       return fail(kFaultProtocol, "read", d.c_str(), 0);
     }
-    if (got) break;
+    if (r.bytes < rx_.size()) return Ok{};  // took all there was
   }
-  outstanding_ = false;
-  ++stats_.counts_in;
-  out.host_time_ns = core::monotonic_ns();
-  out.device_time_us = counts.device_time_us;
-  out.status_flags = counts.status_flags;
-  out.string_count = counts.count;
-  std::copy_n(counts.counts.begin(), counts.count, out.counts.begin());
-  const std::uint32_t latched = counts.status_flags & ~static_cast<std::uint32_t>(kFaultWatchdog);
-  if (latched != 0) faults_.fetch_or(latched, std::memory_order_acq_rel);
+  return Ok{};
+}
+
+Status SerialDevice::read(EncoderReading& out) {
+  if (!open_.load(std::memory_order_relaxed)) {
+    return fail(kFaultDisconnected, "read", "device not open", 0);
+  }
+  if (!outstanding_) {
+    if (Status s = send_heartbeat("read: sending heartbeat"); !s) return s;
+  }
+  // Wait for the latest answer only as long as allowed; with nothing to fall back on (the first
+  // read after open), up to the read timeout.
+  const std::int64_t start = core::monotonic_ns();
+  const std::int64_t until =
+      start + core::s_to_ns(have_reading_ ? config_.reply_wait_s : config_.read_timeout_s);
+  std::int64_t slice = kFirstWaitSliceNs;
+  bool fresh = false;
+  for (;;) {
+    if (Status s = drain(fresh); !s) return s;
+    if (!outstanding_) break;
+    const std::int64_t now = core::monotonic_ns();
+    if (now >= until) break;
+    core::sleep_until_ns(std::min(now + slice, until));
+    slice = std::min(2 * slice, kMaxWaitSliceNs);
+  }
+  if (fresh) {
+    if (outstanding_) ++stats_.behind;
+    out = held_;
+    return Ok{};
+  }
+  const std::int64_t now = core::monotonic_ns();
+  if (!have_reading_ || now - held_.host_time_ns > core::s_to_ns(config_.read_timeout_s)) {
+    ++stats_.timeouts;
+    outstanding_ = false;  // the next read asks again
+    return fail(kFaultReadTimeout, "read",
+                have_reading_ ? "no new Counts frame within the read timeout"
+                              : "no Counts frame within the read timeout",
+                0);
+  }
+  ++stats_.repeated;
+  ++held_.repeats;
+  out = held_;
   return Ok{};
 }
 

@@ -2,9 +2,11 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -81,6 +83,26 @@ IoResult read_some(int fd, std::span<std::uint8_t> out, double timeout_s) {
       if (rev & (POLLHUP | POLLERR)) return {IoStatus::kClosed, 0, 0};
       return {IoStatus::kOk, 0, 0};  // spurious wake-up: nothing to read after all
     }
+    if (errno == EIO) return {IoStatus::kClosed, 0, EIO};
+    return {IoStatus::kError, 0, errno};
+  }
+}
+
+IoResult read_ready(int fd, std::span<std::uint8_t> out) {
+  int available = 0;
+  if (::ioctl(fd, FIONREAD, &available) != 0) {
+    // A hung-up tty answers EIO; a pty whose other side is gone may also say ENXIO.
+    if (errno == EIO || errno == ENXIO) return {IoStatus::kClosed, 0, errno};
+    return {IoStatus::kError, 0, errno};
+  }
+  if (available <= 0 || out.empty()) return {IoStatus::kOk, 0, 0};
+  const std::size_t want = std::min(out.size(), static_cast<std::size_t>(available));
+  for (;;) {
+    const ssize_t n = ::read(fd, out.data(), want);
+    if (n > 0) return {IoStatus::kOk, static_cast<std::size_t>(n), 0};
+    if (n == 0) return {IoStatus::kClosed, 0, 0};  // input was there: 0 means hung up
+    if (errno == EINTR) continue;
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return {IoStatus::kOk, 0, 0};  // flushed meanwhile
     if (errno == EIO) return {IoStatus::kClosed, 0, EIO};
     return {IoStatus::kError, 0, errno};
   }

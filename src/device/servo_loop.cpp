@@ -16,7 +16,8 @@ namespace spidar::device {
 namespace {
 
 constexpr std::uint32_t kSafeStateFaults =
-    kFaultDeadlineMiss | kFaultForceStall | kFaultEmergencyStop | kFaultWatchdog;
+    kFaultDeadlineMiss | kFaultForceStall | kFaultEmergencyStop | kFaultWatchdog |
+    kFaultStaleCounts;
 
 /// q-quantile [µs] of a histogram with 1 µs bins.
 double percentile(const std::vector<std::uint32_t>& hist, double q) {
@@ -62,6 +63,10 @@ ServoLoop::ServoLoop(Device& device, const strings::DeviceConfig& config, ServoC
   if (!(servo_.rate_hz >= 1.0 && servo_.rate_hz <= 100000.0)) {
     throw SpidarError("ServoLoop: rate " + std::to_string(servo_.rate_hz) +
                       " Hz; expected 1 to 100000 Hz");
+  }
+  if (servo_.max_repeated_readings < 0) {
+    throw SpidarError("ServoLoop: max_repeated_readings " +
+                      std::to_string(servo_.max_repeated_readings) + "; expected >= 0");
   }
 }
 
@@ -159,11 +164,20 @@ void ServoLoop::run() {
       latch(kFaultDeadlineMiss);
     }
 
+    reading.repeats = 0;  // backends that never repeat a reading do not touch it
     if (auto st = device_.read(reading); !st.ok()) {
       device_.request_safe_state();
       latch(device_.status().faults | kFaultDisconnected);
       fault_message_ = st.error().message;
       break;
+    }
+    if (reading.repeats > 0) {
+      ++repeated_readings_;
+      longest_repeat_ = std::max<std::uint64_t>(longest_repeat_, reading.repeats);
+      if (reading.repeats > static_cast<std::uint32_t>(servo_.max_repeated_readings)) {
+        device_.request_safe_state();
+        latch(kFaultStaleCounts);
+      }
     }
     sample_.cycle = cycle_.load(std::memory_order_relaxed);
     cycle_maths_.measure(reading, sample_);
@@ -188,7 +202,7 @@ void ServoLoop::run() {
       fault_message_ = st.error().message;
       break;
     }
-    ring_.push(sample_);
+    if (reading.repeats == 0) ring_.push(sample_);
 
     const std::int64_t end = core::monotonic_ns();
     if (prev_wake == wake && cycle_.load(std::memory_order_relaxed) == 0) {
@@ -228,6 +242,8 @@ ServoStats ServoLoop::stats() const {
   s.cycle_us_p99 = percentile(compute_hist_, 0.99);
   s.cycle_us_max = compute_max_us_;
   s.overruns = overruns_;
+  s.repeated_readings = repeated_readings_;
+  s.longest_repeat = longest_repeat_;
   s.inconsistent = cycle_maths_.inconsistent();
   s.fault_message = fault_message_;
   s.realtime_scheduling = realtime_granted_;

@@ -42,6 +42,7 @@ class PtyLink {
     c.port = slave_path;
     c.string_count = strings;
     c.read_timeout_s = kTestReadTimeout;
+    c.reply_wait_s = kTestReadTimeout;  // a strict exchange: a read returns the answer to the write
     return c;
   }
 

@@ -4,6 +4,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -82,6 +83,32 @@ TEST(SerialPort, PtyCarriesRawBytesBothWays) {
   // Nothing more: a read times out.
   EXPECT_EQ(port.read_some(got, 0.01).status, IoStatus::kTimeout);
   ::close(pty->master_fd);
+}
+
+TEST(SerialPort, ReadReadyTakesWhatIsThereAndSeesTheHangUp) {
+  Result<PtyPair> pty = open_pty();
+  ASSERT_TRUE(pty.ok()) << pty.error().message;
+  Result<SerialPort> opened = SerialPort::open(pty->slave_path, 921600);
+  ASSERT_TRUE(opened.ok()) << opened.error().message;
+  SerialPort port = std::move(opened).value();
+  std::array<std::uint8_t, 64> got{};
+  IoResult r = port.read_ready(got);  // nothing sent: returns at once, nothing read
+  EXPECT_EQ(r.status, IoStatus::kOk);
+  EXPECT_EQ(r.bytes, 0u);
+  const std::array<std::uint8_t, 5> hello{'h', 'e', 'l', 'l', 'o'};
+  ASSERT_EQ(write_all(pty->master_fd, hello, 1.0).status, IoStatus::kOk);
+  std::size_t n = 0;
+  ASSERT_TRUE(PtyLink::wait_until([&] {
+    r = port.read_ready(std::span(got).subspan(n));
+    n += r.bytes;
+    return r.status != IoStatus::kOk || n >= hello.size();
+  }));
+  ASSERT_EQ(r.status, IoStatus::kOk);
+  ASSERT_EQ(n, hello.size());
+  EXPECT_TRUE(std::equal(hello.begin(), hello.end(), got.begin()));
+  ::close(pty->master_fd);  // the device side goes away: the slave is hung up
+  r = port.read_ready(got);
+  EXPECT_EQ(r.status, IoStatus::kClosed);
 }
 
 TEST(SerialDevice, BadConfigurationIsAnErrorOnOpen) {
@@ -341,6 +368,108 @@ TEST(SerialDevice, SilentDeviceIsAReadTimeout) {
   // Once the device answers again, reads recover (the fault stays latched).
   link.start_emulator();
   EXPECT_TRUE(PtyLink::wait_until([&] { return dev.read(r).ok(); }));
+  EXPECT_NE(dev.status().faults & kFaultReadTimeout, 0u);
+}
+
+/// Sends a Counts frame with sequence number `seq` from the device side of `link` (its emulator
+/// stopped): a late or repeated answer the host did not expect.
+void inject_counts(PtyLink& link, std::uint8_t seq, std::int32_t value, int strings) {
+  protocol::Counts c;
+  c.count = strings;
+  for (int i = 0; i < strings; ++i) c.counts[i] = value;
+  std::array<std::uint8_t, protocol::kMaxFrameSize> buf{};
+  const std::size_t n = protocol::encode_counts(buf, seq, c);
+  ASSERT_EQ(write_all(link.master_fd, {buf.data(), n}, 1.0).status, IoStatus::kOk);
+}
+
+TEST(SerialDevice, LateAnswersRepeatTheLastReadingThenTheNewestIsTaken) {
+  PtyLink link(4);
+  std::array<std::int32_t, kMaxDeviceStrings> first{};
+  first.fill(111);
+  link.fake.set_counts(first);
+  link.start_emulator();
+  SerialDeviceConfig c = link.config(4);
+  c.reply_wait_s = 0.0;  // the servo setting: never wait for an answer
+  SerialDevice dev(c);
+  ASSERT_TRUE(dev.open().ok());
+  EncoderReading r;
+  ASSERT_TRUE(dev.read(r).ok());  // the first read waits for a reading
+  EXPECT_EQ(r.repeats, 0u);
+  EXPECT_EQ(r.counts[0], 111);
+  const std::int64_t first_time = r.host_time_ns;
+
+  // The device falls silent: reads return at once with the same reading, counted as repeats.
+  link.stop_emulator();
+  std::array<std::int32_t, kMaxDeviceStrings> second{};
+  second.fill(222);
+  link.fake.set_counts(second);
+  const std::array<std::int32_t, 4> cmd{1, 2, 3, 4};
+  for (std::uint32_t k = 1; k <= 3; ++k) {
+    ASSERT_TRUE(dev.write(cmd).ok());
+    ASSERT_TRUE(dev.read(r).ok());
+    EXPECT_EQ(r.repeats, k);
+    EXPECT_EQ(r.counts[0], 111);
+    EXPECT_EQ(r.host_time_ns, first_time);
+  }
+  EXPECT_EQ(dev.link_stats().repeated, 3u);
+
+  // It answers the three queued commands at once: reads take the newest answer that is there.
+  link.start_emulator();
+  ASSERT_TRUE(PtyLink::wait_until([&] {
+    EXPECT_TRUE(dev.read(r).ok());
+    return dev.link_stats().counts_in == 4;  // open()'s heartbeat and the three commands
+  }));
+  EXPECT_EQ(r.counts[0], 222);
+  EXPECT_GT(r.host_time_ns, first_time);
+  SerialLinkStats st = dev.link_stats();
+  EXPECT_LE(st.behind, 2u);  // answers that came while a newer one was still on its way
+  EXPECT_EQ(st.stale, 0u);
+  EXPECT_EQ(st.timeouts, 0u);
+  EXPECT_EQ(dev.status().faults, kFaultNone);
+
+  // An answer to an older request than the reading held is dropped as stale.
+  link.stop_emulator();
+  inject_counts(link, /*seq=*/1, 999, 4);  // open()'s heartbeat had sequence number 1
+  ASSERT_TRUE(dev.write(cmd).ok());
+  ASSERT_TRUE(PtyLink::wait_until([&] {
+    (void)dev.read(r);
+    return dev.link_stats().stale == 1;
+  }));
+  EXPECT_EQ(r.counts[0], 222);
+  EXPECT_GT(r.repeats, 0u);
+  EXPECT_EQ(dev.link_stats().counts_in, 4u);
+}
+
+TEST(SerialDevice, SilenceAfterAReadingBecomesAReadTimeout) {
+  PtyLink link(4);
+  link.start_emulator();
+  SerialDeviceConfig c = link.config(4);
+  c.reply_wait_s = 0.0;
+  c.read_timeout_s = 0.05;
+  SerialDevice dev(c);
+  ASSERT_TRUE(dev.open().ok());
+  EncoderReading r;
+  ASSERT_TRUE(dev.read(r).ok());
+  link.stop_emulator();
+  const std::array<std::int32_t, 4> cmd{};
+  std::uint32_t repeats = 0;
+  Status s = Ok{};
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (std::chrono::steady_clock::now() < end) {
+    ASSERT_TRUE(dev.write(cmd).ok());
+    s = dev.read(r);
+    if (!s.ok()) break;
+    repeats = r.repeats;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_FALSE(s.ok());
+  EXPECT_GE(repeats, 1u);  // late answers first, then the timeout
+  EXPECT_TRUE(contains(s.error().message, "no new Counts frame")) << s.error().message;
+  EXPECT_NE(dev.status().faults & kFaultReadTimeout, 0u);
+  EXPECT_EQ(dev.link_stats().timeouts, 1u);
+  // The device answers again: reads recover (the fault stays latched).
+  link.start_emulator();
+  EXPECT_TRUE(PtyLink::wait_until([&] { return dev.read(r).ok() && r.repeats == 0; }));
   EXPECT_NE(dev.status().faults & kFaultReadTimeout, 0u);
 }
 

@@ -256,12 +256,110 @@ TEST(ServoLoop, EmergencyStopHoldsMinimumTensionUntilReset) {
   loop.stop();
 }
 
+/// Wraps a device; from cycle `from` on, `count` reads in a row return the previous reading again
+/// (repeats 1 … count), as the serial backend does while the device's answer is late.
+class LateAnswers final : public Device {
+ public:
+  LateAnswers(Device& inner, std::uint64_t from, std::uint32_t count)
+      : inner_(inner), from_(from), count_(count) {}
+  Status open() override { return inner_.open(); }
+  void close() override { inner_.close(); }
+  const DeviceInfo& info() const override { return inner_.info(); }
+  Status read(EncoderReading& out) override {
+    const std::uint64_t k = reads_++;
+    if (k >= from_ && k < from_ + count_) {
+      ++last_.repeats;
+      out = last_;
+      return Ok{};
+    }
+    Status s = inner_.read(out);
+    last_ = out;
+    return s;
+  }
+  Status write(std::span<const std::int32_t> c) override { return inner_.write(c); }
+  void request_safe_state() override { inner_.request_safe_state(); }
+  void clear_safe_state() override { inner_.clear_safe_state(); }
+  DeviceStatus status() const override { return inner_.status(); }
+
+ private:
+  Device& inner_;
+  std::uint64_t from_;
+  std::uint32_t count_;
+  std::uint64_t reads_ = 0;  // servo thread only
+  EncoderReading last_;
+};
+
+TEST(ServoLoop, LateReadingsAreCountedAndNotPublished) {
+  Rig rig;
+  LateAnswers late(rig.rec, 100, 7);  // cycles 100 … 106 run on cycle 99's reading
+  ServoConfig cfg;
+  cfg.rate_hz = 1000;
+  cfg.max_repeated_readings = 7;
+  cfg.force_timeout_s = 1.0;  // this test is about the readings, not the forces' age
+  ServoLoop loop(late, spidar8(), cfg, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 140);
+  loop.stop();
+  const auto s = loop.stats();
+  EXPECT_EQ(s.faults & (kFaultStaleCounts | kFaultDisconnected | kFaultReadTimeout), 0u)
+      << fault_names(s.faults);
+  EXPECT_EQ(s.repeated_readings, 7u);
+  EXPECT_EQ(s.longest_repeat, 7u);
+  EXPECT_EQ(static_cast<std::uint64_t>(rig.rec.writes()), s.cycles);  // commands every cycle
+  // Samples are measurements: none for the repeated cycles, times strictly increasing.
+  FingertipSample samples[128];
+  const std::size_t n = loop.newest_samples(samples, 128);
+  ASSERT_GT(n, 40u);
+  bool gap_seen = false;
+  for (std::size_t k = 1; k < n; ++k) {
+    EXPECT_GT(samples[k - 1].t_ns, samples[k].t_ns);
+    EXPECT_GT(samples[k - 1].cycle, samples[k].cycle);
+    EXPECT_TRUE(samples[k].cycle < 100 || samples[k].cycle > 106) << samples[k].cycle;
+    if (samples[k - 1].cycle == 107 && samples[k].cycle == 99) gap_seen = true;
+  }
+  EXPECT_TRUE(gap_seen);
+}
+
+TEST(ServoLoop, TooManyLateReadingsInARowTripTheSafeState) {
+  Rig rig;
+  LateAnswers late(rig.rec, 100, 8);  // one more than allowed
+  ServoConfig cfg;
+  cfg.rate_hz = 1000;
+  cfg.max_repeated_readings = 7;
+  cfg.force_timeout_s = 1.0;
+  struct Pushing final : ForceSource {
+    void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
+      out.t_ns = in.t_ns;
+      for (int f = 0; f < 8; ++f) out.set_force(f, Vec3(0, 0, 2.0));
+    }
+  };
+  ServoLoop loop(late, spidar8(), cfg, std::make_shared<Pushing>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 130);
+  const int safe_requests = rig.rec.safe_requests();
+  loop.stop();
+  EXPECT_TRUE(loop.faults() & kFaultStaleCounts) << fault_names(loop.faults());
+  EXPECT_GE(safe_requests, 1);
+  EXPECT_EQ(loop.stats().longest_repeat, 8u);
+  // Latched: the samples after the fault (fresh readings again) display no force.
+  FingertipSample s;
+  ASSERT_EQ(loop.newest_samples(&s, 1), 1u);
+  EXPECT_GT(s.cycle, 107u);
+  EXPECT_TRUE(s.faults & kFaultStaleCounts);
+  for (int f = 0; f < 8; ++f) EXPECT_EQ(s.f_W[f][2], 0.0);
+  loop.reset_faults();
+  EXPECT_FALSE(loop.faults() & kFaultStaleCounts);
+}
+
 TEST(ServoLoop, BadSetupIsAnError) {
   Rig rig;
   ServoConfig bad;
   bad.rate_hz = 0;
   EXPECT_THROW(ServoLoop(rig.rec, spidar8(), bad, std::make_shared<ZeroForce>()), SpidarError);
   EXPECT_THROW(ServoLoop(rig.rec, spidar8(), ServoConfig{}, nullptr), SpidarError);
+  ServoConfig negative;
+  negative.max_repeated_readings = -1;
+  EXPECT_THROW(ServoLoop(rig.rec, spidar8(), negative, std::make_shared<ZeroForce>()), SpidarError);
   rig.sim.close();
   ServoLoop loop(rig.rec, spidar8(), ServoConfig{}, std::make_shared<ZeroForce>());
   auto st = loop.start();

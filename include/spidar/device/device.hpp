@@ -30,6 +30,7 @@ enum Fault : std::uint32_t {
   kFaultWatchdog = 1u << 5,       ///< the device or the loop's watchdog tripped
   kFaultDeadlineMiss = 1u << 6,   ///< the servo loop missed its deadline by too much
   kFaultForceStall = 1u << 7,     ///< the force producer stopped delivering
+  kFaultStaleCounts = 1u << 8,    ///< the device gave no new reading for too many cycles in a row
 };
 
 /// Names of the set fault bits, e.g. "disconnected,read_timeout".
@@ -51,6 +52,10 @@ struct EncoderReading {
   std::uint32_t status_flags = 0;   ///< device status bits (Fault values)
   int string_count = 0;
   std::array<std::int32_t, kMaxDeviceStrings> counts{};  ///< raw signed counter values
+  /// 0: a new reading. k > 0: the device had nothing newer (its answer is late), so this is the
+  /// previous reading again, returned for the k-th time in a row (same counts, same times).
+  /// Backends that never repeat leave it as it is: callers set it to 0 before `read`.
+  std::uint32_t repeats = 0;
 };
 
 struct DeviceStatus {
@@ -69,7 +74,9 @@ class Device {
   virtual const DeviceInfo& info() const = 0;
 
   /// Reads all encoder counts. Returns an error (and latches a fault) on disconnect or timeout;
-  /// must not block much longer than one servo period on a healthy device.
+  /// must not block much longer than one servo period on a healthy device. A backend whose
+  /// readings arrive asynchronously may return its last reading again with `repeats` > 0 rather
+  /// than wait; the servo loop counts those and faults when there are too many in a row.
   virtual Status read(EncoderReading& out) = 0;
   /// Writes one command per string (DAC counts). The backend clamps to
   /// [command_min, command_max] and never drives a motor beyond it.

@@ -28,6 +28,14 @@ struct IoResult {
 /// Waits up to `timeout_s` [s] for input on `fd`, then reads what is available (at most
 /// out.size() bytes). Never allocates.
 IoResult read_some(int fd, std::span<std::uint8_t> out, double timeout_s);
+/// Reads the bytes a tty already holds (at most out.size()) and returns at once: kOk with 0 bytes
+/// when there are none. Unlike read_some, it never waits for the kernel: poll() and read() on a
+/// tty with no input first wait for the tty's pending flip-buffer work (`tty_buffer_flush_work`,
+/// i.e. for a kworker to move bytes in flight into the line discipline), which takes milliseconds
+/// on a loaded machine even with a zero timeout. This asks FIONREAD how many bytes are there and
+/// calls read() only if some are. kClosed: the tty was hung up (the other side of a pty closed,
+/// a USB device vanished). Never allocates.
+IoResult read_ready(int fd, std::span<std::uint8_t> out);
 /// Writes all of `data` to `fd`, waiting up to `timeout_s` [s] in total for room. Never allocates.
 IoResult write_all(int fd, std::span<const std::uint8_t> data, double timeout_s);
 
@@ -55,6 +63,7 @@ class SerialPort {
   IoResult read_some(std::span<std::uint8_t> out, double timeout_s) {
     return device::read_some(fd_, out, timeout_s);
   }
+  IoResult read_ready(std::span<std::uint8_t> out) { return device::read_ready(fd_, out); }
   IoResult write_all(std::span<const std::uint8_t> data, double timeout_s) {
     return device::write_all(fd_, data, timeout_s);
   }

@@ -13,6 +13,12 @@
 /// force source's data goes stale, on emergency stop, or — from a monitor thread — if the servo
 /// thread itself stops cycling. A device error (disconnect, timeout) puts the device in its safe
 /// state and ends the loop with the fault reported.
+///
+/// Late readings: a device may return its previous reading again (`EncoderReading::repeats` > 0;
+/// the serial backend does when the answer to the last commands has not arrived yet). The loop
+/// then runs the cycle on the last counts, as drivers of USB SPIDARs do, counts it, and does not
+/// publish a fingertip sample for it (samples are measurements: their times strictly increase).
+/// More than `max_repeated_readings` repeats in a row latch kFaultStaleCounts (safe state).
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -37,6 +43,9 @@ struct ServoConfig {
   int cpu = -1;                   ///< CPU to pin to; -1: the last CPU
   double deadline_periods = 5.0;  ///< waking this many periods late trips the safe state
   double force_timeout_s = 0.02;  ///< forces older than this trip the safe state
+  /// Consecutive cycles that may run on a repeated (late) device reading; one more trips the
+  /// safe state (kFaultStaleCounts). 20 cycles = 5 ms at 4 kHz, 20 ms at 1 kHz.
+  int max_repeated_readings = 20;
   double max_seconds = 0.0;       ///< > 0: stop by itself after this long
   /// Runs in the servo thread before the first cycle (tests: allocation counters).
   std::function<void()> on_thread_start;
@@ -49,6 +58,8 @@ struct ServoStats {
   double jitter_p50_us = 0, jitter_p99_us = 0, jitter_max_us = 0;  ///< |period − nominal|
   double cycle_us_median = 0, cycle_us_p99 = 0, cycle_us_max = 0;  ///< compute time per cycle
   std::uint64_t overruns = 0;       ///< cycles that ended after the next deadline
+  std::uint64_t repeated_readings = 0;  ///< cycles that ran on a repeated (late) device reading
+  std::uint64_t longest_repeat = 0;     ///< longest run of consecutive cycles on repeated readings
   std::uint64_t inconsistent = 0;   ///< finger solves flagged inconsistent
   std::uint32_t faults = 0;         ///< latched Fault bits
   std::string fault_message;        ///< the error that ended the loop, if any
@@ -110,6 +121,7 @@ class ServoLoop {
   std::int64_t first_wake_ns_ = 0, last_wake_ns_ = 0;
   std::uint64_t first_timed_cycle_ = 0;  ///< the first cycle is untimed (device handshake)
   std::uint64_t overruns_ = 0;
+  std::uint64_t repeated_readings_ = 0, longest_repeat_ = 0;
   std::string fault_message_;
   bool realtime_granted_ = false;
 
