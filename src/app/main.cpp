@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   add(add_emulate_device);
   add(add_calibrate_camera);
   add(add_render_test);
+  add(add_run);
+  add(add_replay);
 
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;
