@@ -212,6 +212,68 @@ TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {
   EXPECT_NE(bad.err.find("no session.json"), std::string::npos) << bad.err;
 }
 
+TEST(CalibrateStrings, PoleCalibrationOnTheSimulatedDeviceFixesWrongOffsets) {
+  // A device config whose left_index and right_ring offsets are centimetres off (as if the counters
+  // had been zeroed elsewhere); the simulated device's counters were zeroed at the centre.
+  const fs::path d = temp_dir("pole");
+  std::string text = slurp("configs/spidar8.yaml");
+  for (const std::string finger : {"left_index", "right_ring"}) {
+    const auto at = text.find("- name: " + finger);
+    ASSERT_NE(at, std::string::npos);
+    const auto eol = text.find('\n', at);
+    text.insert(eol + 1, "    length_at_zero: [0.44, 0.45, 0.43]\n");
+  }
+  const fs::path cfg = d / "dev.yaml";
+  std::ofstream(cfg) << text;
+  auto r = run("calibrate-strings --backend sim --config " + cfg.string() + " --fingers left_index,right_ring");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  EXPECT_NE(r.err.find("left_index: touch the pole tip"), std::string::npos) << r.err;  // guidance
+  EXPECT_NE(r.err.find("holding"), std::string::npos) << r.err;
+  auto j = parse(r.out);
+  ASSERT_EQ(j["fingers"].size(), 2u);
+  for (const auto& f : j["fingers"]) {
+    // Held by hand at the pole, the strings' minimum tension pulls the fingertip ~3 mm off it.
+    EXPECT_GT(f["sim_position_error_before_mm"].get<double>(), 50.0) << f.dump();
+    EXPECT_LT(f["sim_position_error_after_mm"].get<double>(), 5.0) << f.dump();
+    EXPECT_LT(f["pole_error_after_mm"].get<double>(), 0.1) << f.dump();  // by construction
+  }
+  // Written back, previous version kept, and the new file is a valid config.
+  const std::string backup = j["backup"];
+  EXPECT_EQ(slurp(backup), text);
+  EXPECT_NE(backup.find("dev.yaml.bak-"), std::string::npos);
+  auto check = run("check-config " + cfg.string());
+  EXPECT_EQ(check.code, 0) << check.err;
+  EXPECT_EQ(slurp(cfg).find("[0.44, 0.45, 0.43]"), std::string::npos);
+}
+
+TEST(CalibrateStrings, MultiPointJigFitsScaleAndOffset) {
+  const fs::path d = temp_dir("jig");
+  const fs::path cfg = d / "dev.yaml";
+  fs::copy_file("configs/spidar8.yaml", cfg);
+  auto r = run("calibrate-strings --backend sim --config " + cfg.string() +
+               " --fingers right_thumb --jig 2 --jig-spacing 0.04 --hold 0.3 --dry-run");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  auto j = parse(r.out);
+  EXPECT_EQ(j["method"], "multi-point jig");
+  EXPECT_EQ(j["written"], false);
+  const auto& f = j["fingers"][0];
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(f["residual_rms_mm"][i].get<double>(), 0.1) << f.dump();
+    EXPECT_NEAR(f["metres_per_count"][i].get<double>(), 2.924e-5, 0.005 * 2.924e-5) << f.dump();
+  }
+  EXPECT_LT(f["sim_position_error_after_mm"].get<double>(), 0.5) << f.dump();  // clamped in the jig
+  EXPECT_EQ(slurp(cfg), slurp("configs/spidar8.yaml"));  // dry run: untouched
+  // A finger that does not exist, a bad jig size: code 2 with a message.
+  auto bad = run("calibrate-strings --config " + cfg.string() + " --fingers left_pinky");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("left_pinky"), std::string::npos) << bad.err;
+  auto jig1 = run("calibrate-strings --config " + cfg.string() + " --jig 1");
+  EXPECT_EQ(jig1.code, 2);
+  auto noport = run("calibrate-strings --backend serial --config " + cfg.string());
+  EXPECT_EQ(noport.code, 2);
+  EXPECT_NE(noport.err.find("--port"), std::string::npos) << noport.err;
+}
+
 TEST(LiveGui, WindowScreenshotUnderXvfbIsNotBlank) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps installs xvfb): GUI not tested";
