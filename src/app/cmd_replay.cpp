@@ -228,7 +228,7 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
   cv::Mat scratch;
   std::vector<double> t, iou, iters, ms;
   std::array<std::vector<double>, 5> terms;
-  double max_dq = 0, max_dcost = 0, max_resample_mm = 0;
+  double max_dq = 0, max_dcost = 0, max_resample_mm = 0, sum_dq = 0;
   int compared = 0;
   const std::int64_t t0 = frames.front().t_ns;
   for (const RecordedFrame& f : frames) {
@@ -262,7 +262,9 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
     if (auto it = recorded.find(f.index); it != recorded.end()) {
       ++compared;
       for (int h = 0; h < 2; ++h) {
-        max_dq = std::max(max_dq, (result.hands[h].q - it->second.hands[h].q).cwiseAbs().maxCoeff());
+        const double dq = (result.hands[h].q - it->second.hands[h].q).cwiseAbs().maxCoeff();
+        max_dq = std::max(max_dq, dq);
+        sum_dq += dq / 2;
         max_dcost = std::max(max_dcost, std::abs(result.fits[h].cost_final - it->second.cost[h]));
       }
     }
@@ -297,9 +299,11 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
                                           {"prior", mean(terms[4])}}}};
   j["reproduction"] = {{"frames_compared", compared},
                        {"max_param_diff", max_dq},
+                       {"mean_param_diff", compared > 0 ? sum_dq / compared : 0.0},
                        {"max_cost_diff", max_dcost},
                        {"fingertip_resample_max_mm", max_resample_mm},
-                       {"frames_store", png ? "png (lossless)" : "video (lossy: fits differ from the live ones)"}};
+                       {"frames_store", png ? "png (lossless)"
+                                        : meta.value("frames_codec", "mp4") + " (lossy: the fits differ from the live ones)"}};
   j["outputs"] = {{"video", video ? video->path() : ""}};
 
   // Plots.

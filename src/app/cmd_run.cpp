@@ -95,8 +95,9 @@ Action add_run(CLI::App& app) {
   cmd->add_flag("--headless", a->headless, "no window: process frames and print a summary");
   cmd->add_option("--record", a->record, "record the session into this new folder (docs/recording.md)");
   cmd->add_option("--record-frames", a->record_frames,
-                  "video: camera.mp4 (small, lossy); png: frames/NNNNNN.png (lossless, exact replay)")
-      ->check(CLI::IsMember({"video", "png"}))
+                  "video: camera.mp4 (H.264: small, lossy); mjpg: camera.avi (Motion-JPEG: larger, "
+                  "nearly lossless); png: frames/NNNNNN.png (lossless: replay reproduces the fits exactly)")
+      ->check(CLI::IsMember({"video", "mjpg", "png"}))
       ->capture_default_str();
   cmd->add_option("--screenshot", a->screenshot,
                   "window: save the window's pixels to this PNG just before exiting (tests)");
@@ -105,7 +106,9 @@ Action add_run(CLI::App& app) {
     const LiveConfig cfg = load_live_config(a->config);
     LiveSessionOptions opt;
     opt.record_dir = a->record;
-    opt.record_frames = a->record_frames == "png" ? FrameStore::kPng : FrameStore::kVideo;
+    opt.record_frames = a->record_frames == "png"    ? FrameStore::kPng
+                        : a->record_frames == "mjpg" ? FrameStore::kMjpg
+                                                     : FrameStore::kVideo;
 
     if (!a->headless) {
       SignalScope signals;
@@ -131,7 +134,7 @@ Action add_run(CLI::App& app) {
       }
       if (a->seconds > 0 && session->seconds() >= a->seconds) break;
       if (!session->running()) {
-        ended_by = session->error().empty() ? "camera ended" : "error";
+        ended_by = session->camera_ended() ? "camera ended" : "device stopped";
         break;
       }
       if (!session->step()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -147,7 +150,7 @@ Action add_run(CLI::App& app) {
     const auto j = summary_json(*session, ended_by, wall);
     std::cout << j.dump(2) << "\n";
     if (session->servo().stats().faults != 0) return 1;
-    if (ended_by == "error") return 1;
+    if (ended_by == "device stopped" || !session->error().empty()) return 1;
     return 0;
   };
 }

@@ -323,7 +323,7 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
     }
     if (seconds > 0 && session->seconds() >= seconds) break;
     if (!session->running()) {
-      ended_by = session->error().empty() ? "camera ended" : "error: " + session->error();
+      ended_by = session->camera_ended() ? "camera ended" : "device stopped";
       break;
     }
     context->poll_events();
@@ -396,7 +396,8 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   std::cout << "{\"ended_by\": \"" << ended_by << "\", \"frames\": " << session->frames()
             << ", \"servo_rate_hz\": " << st.rate_hz << ", \"faults\": \"" << device::fault_names(st.faults)
             << "\"}\n";
-  return st.faults != 0 || ended_by.rfind("error", 0) == 0 ? 1 : 0;
+  if (!session->error().empty()) std::cerr << "spidar-mr run: " << session->error() << "\n";
+  return st.faults != 0 || ended_by == "device stopped" || !session->error().empty() ? 1 : 0;
 }
 
 }  // namespace spidar::app

@@ -315,6 +315,8 @@ bool LiveSession::running() const {
   return started_ && !stopped_ && loop_->running() && !source_->ended();
 }
 
+bool LiveSession::camera_ended() const { return source_ && source_->ended(); }
+
 std::string LiveSession::error() const {
   std::string e;
   if (loop_ && loop_->faults() != 0) e = "servo loop fault: " + device::fault_names(loop_->faults());

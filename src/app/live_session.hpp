@@ -66,6 +66,8 @@ class LiveSession {
   /// failed (error() says why).
   bool running() const;
   std::string error() const;
+  /// True once the camera has ended (end of a file) or failed.
+  bool camera_ended() const;
   /// Stops every thread (device left in its safe state) and finishes the recording. Idempotent.
   void stop();
 

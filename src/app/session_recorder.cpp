@@ -82,6 +82,7 @@ SessionRecorder::SessionRecorder(const std::string& dir, FrameStore store, const
   j["finger_count"] = meta.finger_count;
   j["device"] = meta.device_name;
   j["frames"] = store_ == FrameStore::kPng ? "png" : "video";
+  j["frames_codec"] = store_ == FrameStore::kPng ? "png" : store_ == FrameStore::kMjpg ? "avi/mjpg" : "mp4";
   for (int h = 0; h < 2; ++h)
     j["initial_r_W_hand"].push_back({meta.initial_r_W_hand[h].x(), meta.initial_r_W_hand[h].y(),
                                      meta.initial_r_W_hand[h].z()});
@@ -106,8 +107,10 @@ SessionRecorder::SessionRecorder(const std::string& dir, FrameStore store, const
                "silhouette,prior";
   for (int i = 0; i < hand::kParamCount; ++i) fits_csv_ << ",q" << i;
   fits_csv_ << "\n";
-  if (store_ == FrameStore::kVideo) {
-    auto v = render::VideoOutput::open((d / "camera.mp4").string(), meta.width, meta.height, meta.fps);
+  if (store_ != FrameStore::kPng) {
+    const render::VideoFormat mjpg = render::VideoFormat::kAviMjpg;
+    auto v = render::VideoOutput::open((d / "camera.mp4").string(), meta.width, meta.height, meta.fps,
+                                       store_ == FrameStore::kMjpg ? &mjpg : nullptr);
     if (!v) throw UsageError("--record: " + v.error().message);
     video_ = std::move(v).value();
   }

@@ -84,7 +84,9 @@ struct FrameRecord {
   std::array<registration::FitReport, 2> fits;
 };
 
-enum class FrameStore { kVideo, kPng };
+/// How camera frames are stored: H.264 video (small, lossy), Motion-JPEG (larger, nearly lossless)
+/// or PNG files (lossless: replay reproduces the live fits exactly).
+enum class FrameStore { kVideo, kMjpg, kPng };
 
 class SessionRecorder {
  public:

@@ -1,0 +1,75 @@
+// The session pieces shared by run, replay and the demo: the cube monitor's scramble and reset
+// (the GUI's scene panel), the turn counter, the camera scaling.
+#include <gtest/gtest.h>
+
+#include "session_parts.hpp"
+#include "spidar/physics/world.hpp"
+
+namespace spidar::app {
+namespace {
+
+TEST(CubeMonitor, ScrambleAndResetRunInThePhysicsStepAndAreNotCountedAsTurns) {
+  physics::WorldParams wp;
+  auto world = physics::World::Load("scenes/rubiks_cube.xml", wp).value();
+  auto cube_r = physics::RubiksCube::Attach(*world);
+  ASSERT_TRUE(cube_r);
+  std::optional<physics::RubiksCube> cube = std::move(cube_r).value();
+  CubeMonitor monitor(&cube, cube->core_pose());
+  monitor.before_step(*world);
+  ASSERT_TRUE(monitor.status().read());
+  EXPECT_TRUE(monitor.status().read()->solved);
+
+  monitor.request_scramble(7);
+  EXPECT_TRUE(cube->is_solved());  // nothing happens outside the physics step
+  monitor.before_step(*world);
+  auto s = monitor.status().read();
+  ASSERT_TRUE(s);
+  EXPECT_FALSE(s->solved);
+  EXPECT_EQ(s->turns, 0);
+  const std::string scrambled = cube->facelets();
+
+  monitor.request_reset();
+  monitor.before_step(*world);
+  s = monitor.status().read();
+  EXPECT_TRUE(s->solved);
+  EXPECT_TRUE(cube->is_solved());
+  EXPECT_NE(cube->facelets(), scrambled);
+  EXPECT_EQ(s->turns, 0);
+  EXPECT_NEAR(s->lift, 0.0, 1e-9);
+  const auto p = monitor.pose().read();
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(p->p_W[2], cube->core_pose().p.z(), 1e-12);
+}
+
+TEST(TurnCounter, CountsSettledQuarterTurnsOfTheUser) {
+  physics::WorldParams wp;
+  auto world = physics::World::Load("scenes/rubiks_cube.xml", wp).value();
+  auto cube = physics::RubiksCube::Attach(*world).value();
+  TurnCounter turns;
+  turns.update(cube);
+  EXPECT_EQ(turns.turns(), 0);
+  ASSERT_TRUE(cube.turn('U', 1));
+  turns.update(cube);
+  EXPECT_EQ(turns.turns(), 1);
+  ASSERT_TRUE(cube.turn('R', 2));
+  turns.rebase(cube);  // e.g. a scramble: not the user's
+  turns.update(cube);
+  EXPECT_EQ(turns.turns(), 1);
+}
+
+TEST(ScaledCamera, KeepsTheFieldOfViewAndPixelCentres) {
+  vision::Intrinsics k;
+  k.width = 640;
+  k.height = 480;
+  k.fx = k.fy = 554.256;
+  k.cx = 319.5;
+  k.cy = 239.5;
+  const vision::Camera c(k, Pose());
+  const vision::Camera h = scaled_camera(c, 1280, 960);
+  EXPECT_DOUBLE_EQ(h.intrinsics().fx, 2 * k.fx);
+  EXPECT_DOUBLE_EQ(h.intrinsics().cx, 639.5);
+  EXPECT_EQ(h.intrinsics().width, 1280);
+}
+
+}  // namespace
+}  // namespace spidar::app
