@@ -103,6 +103,7 @@ Action add_run(CLI::App& app) {
                   "window: save the window's pixels to this PNG just before exiting (tests)");
   return [a] {
     if (!(a->seconds >= 0 && a->seconds <= 86400)) throw UsageError("--seconds: expected 0 to 86400");
+    SignalScope signals;  // from the start: a signal during start-up ends the session once it runs
     const LiveConfig cfg = load_live_config(a->config);
     LiveSessionOptions opt;
     opt.record_dir = a->record;
@@ -110,16 +111,12 @@ Action add_run(CLI::App& app) {
                         : a->record_frames == "mjpg" ? FrameStore::kMjpg
                                                      : FrameStore::kVideo;
 
-    if (!a->headless) {
-      SignalScope signals;
-      return run_gui(cfg, opt, a->seconds, a->screenshot, g_signal);
-    }
+    if (!a->headless) return run_gui(cfg, opt, a->seconds, a->screenshot, g_signal);
 
     auto ctx_r = render::Context::create_headless();
     if (!ctx_r) throw SpidarError("OpenGL: " + ctx_r.error().message);
     auto context = std::move(ctx_r).value();
     auto session = LiveSession::create(cfg, *context, opt);
-    SignalScope signals;
     std::cerr << "spidar-mr run: " << cfg.source << ": device " << cfg.backend << ", camera "
               << cfg.camera_source << " " << cfg.width << "x" << cfg.height << ", compositor "
               << cfg.compositor << (a->record.empty() ? "" : ", recording to " + a->record)
