@@ -257,6 +257,47 @@ void scene_panel(LiveSession& s) {
   ImGui::Text("session %.1f s", s.seconds());
 }
 
+/// The simulated user's hands under interactive control: keys move and close them, sliders too.
+void hands_panel(InteractiveHands& ih, GLFWwindow* window, double dt) {
+  HandControls c = ih.controls();
+  struct Keys {
+    int away, toward, left, right, up, down, yaw_left, yaw_right, close, open;
+  };
+  static constexpr Keys kKeys[2] = {
+      {GLFW_KEY_W, GLFW_KEY_S, GLFW_KEY_A, GLFW_KEY_D, GLFW_KEY_R, GLFW_KEY_F, GLFW_KEY_Q, GLFW_KEY_E,
+       GLFW_KEY_Z, GLFW_KEY_X},
+      {GLFW_KEY_UP, GLFW_KEY_DOWN, GLFW_KEY_LEFT, GLFW_KEY_RIGHT, GLFW_KEY_PAGE_UP, GLFW_KEY_PAGE_DOWN,
+       GLFW_KEY_COMMA, GLFW_KEY_PERIOD, GLFW_KEY_N, GLFW_KEY_M}};
+  if (!ImGui::GetIO().WantCaptureKeyboard) {
+    auto key = [&](int k) { return glfwGetKey(window, k) == GLFW_PRESS ? 1.0 : 0.0; };
+    const double speed = 0.08 * dt, turn = 1.0 * dt, grip = 1.5 * dt;  // m/s, rad/s, 1/s
+    for (int h = 0; h < 2; ++h) {
+      const Keys& k = kKeys[h];
+      c[h].offset_W[0] += speed * (key(k.right) - key(k.left));
+      c[h].offset_W[1] += speed * (key(k.away) - key(k.toward));
+      c[h].offset_W[2] += speed * (key(k.up) - key(k.down));
+      c[h].yaw += turn * (key(k.yaw_left) - key(k.yaw_right));
+      c[h].closeness += grip * (key(k.close) - key(k.open));
+    }
+  }
+  ImGui::TextUnformatted("left:  W/S away/toward, A/D left/right, R/F up/down, Q/E turn, Z close, X open");
+  ImGui::TextUnformatted("right: arrows, PageUp/PageDown up/down, comma/period turn, N close, M open");
+  const char* names[2] = {"left", "right"};
+  for (int h = 0; h < 2; ++h) {
+    ImGui::PushID(h);
+    float off[3] = {static_cast<float>(c[h].offset_W[0]), static_cast<float>(c[h].offset_W[1]),
+                    static_cast<float>(c[h].offset_W[2])};
+    float yaw = static_cast<float>(c[h].yaw * 180 / M_PI), close = static_cast<float>(c[h].closeness);
+    ImGui::Text("%s hand", names[h]);
+    if (ImGui::SliderFloat3("offset x y z [m]", off, -0.25f, 0.25f, "%.3f"))
+      for (int i = 0; i < 3; ++i) c[h].offset_W[i] = off[i];
+    if (ImGui::SliderFloat("turn [deg]", &yaw, -180.f, 180.f, "%.0f")) c[h].yaw = yaw * M_PI / 180;
+    if (ImGui::SliderFloat("closed", &close, 0.f, 1.f, "%.2f")) c[h].closeness = close;
+    ImGui::PopID();
+  }
+  ih.set(c);
+}
+
 cv::Mat read_default_framebuffer(const Gl& gl, int w, int h) {
   cv::Mat img(h, w, CV_8UC3);
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -310,6 +351,7 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   View view = View::kComposite;
   bool new_frame = false;
   cv::Mat shot;
+  double last_ui_s = 0;
   std::string ended_by = "seconds";
   session->start();
   while (true) {
@@ -374,6 +416,16 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
     ImGui::Begin("Scene");
     scene_panel(*session);
     ImGui::End();
+
+    if (InteractiveHands* ih = session->interactive()) {
+      ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 268), ImGuiCond_FirstUseEver);
+      ImGui::SetNextWindowSize(ImVec2(std::max(300.0f, W - vw - 24), 260), ImGuiCond_FirstUseEver);
+      ImGui::Begin("Hands (interactive)");
+      const double now = session->seconds();
+      hands_panel(*ih, window, std::clamp(now - last_ui_s, 0.0, 0.1));
+      last_ui_s = now;
+      ImGui::End();
+    }
 
     ImGui::Render();
     const int fw = context->framebuffer_width(), fh = context->framebuffer_height();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <future>
 #include <mutex>
 #include <thread>
 
@@ -156,6 +157,88 @@ class CaptureSource final : public LiveSession::FrameSource {
   std::thread thread_;
 };
 
+/// The synthetic camera filming the interactively controlled hands (their commanded posture).
+class InteractiveSource final : public LiveSession::FrameSource {
+ public:
+  InteractiveSource(const vision::Camera& camera, const InteractiveHands& hands, double fps, std::uint64_t seed)
+      : camera_(camera), hands_(hands), fps_(fps), seed_(seed) {}
+  ~InteractiveSource() override { stop(); }
+  Status start(std::int64_t t0_ns) override {
+    std::promise<Status> ready;
+    auto done = ready.get_future();
+    thread_ = std::thread([this, t0_ns, &ready] { run(t0_ns, ready); });
+    Status st = done.get();
+    if (!st) stop();
+    return st;
+  }
+  bool take(cv::Mat* bgr, std::int64_t* t) override {
+    std::lock_guard lock(mutex_);
+    if (!fresh_) return false;
+    fresh_ = false;
+    latest_.copyTo(*bgr);
+    *t = latest_t_;
+    return true;
+  }
+  bool ended() const override { return done_.load(std::memory_order_acquire); }
+  std::string error() const override {
+    std::lock_guard lock(mutex_);
+    return error_;
+  }
+  std::uint64_t delivered() const override { return delivered_.load(std::memory_order_acquire); }
+  void stop() override {
+    stop_.store(true, std::memory_order_release);
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void run(std::int64_t t0_ns, std::promise<Status>& ready) {
+    auto ctx = render::Context::create_headless();
+    if (!ctx) return ready.set_value(Error{"interactive camera: OpenGL: " + ctx.error().message});
+    sim::SyntheticCameraParams cp;
+    cp.seed = seed_;
+    auto film = sim::SyntheticCamera::create(*ctx.value(), camera_, hands_.models(), cp);
+    if (!film) return ready.set_value(Error{"interactive camera: " + film.error().message});
+    ready.set_value(Ok{});
+    const auto period_ns = static_cast<std::int64_t>(1e9 / fps_);
+    std::int64_t t_exp = t0_ns;
+    sim::SyntheticFrame frame;
+    while (!stop_.load(std::memory_order_acquire)) {
+      core::sleep_until_ns(t_exp);
+      if (stop_.load(std::memory_order_acquire)) break;
+      const auto q = hands_.pose(hands_.controls());
+      const sim::HandPoses poses{&q[0], &q[1]};
+      if (auto st = film.value()->film(poses, &frame); !st) {
+        std::lock_guard lock(mutex_);
+        error_ = st.error().message;
+        break;
+      }
+      {
+        std::lock_guard lock(mutex_);
+        frame.bgr.copyTo(latest_);
+        latest_t_ = t_exp;
+        fresh_ = true;
+      }
+      delivered_.fetch_add(1, std::memory_order_acq_rel);
+      t_exp += period_ns;
+      while (t_exp < core::monotonic_ns()) t_exp += period_ns;  // a slow frame drops exposures
+    }
+    done_.store(true, std::memory_order_release);
+  }
+
+  vision::Camera camera_;
+  const InteractiveHands& hands_;
+  double fps_;
+  std::uint64_t seed_;
+  mutable std::mutex mutex_;
+  cv::Mat latest_;
+  std::int64_t latest_t_ = 0;
+  bool fresh_ = false;
+  std::string error_;
+  std::atomic<bool> stop_{false}, done_{false};
+  std::atomic<std::uint64_t> delivered_{0};
+  std::thread thread_;
+};
+
 }  // namespace
 
 double silhouette_iou(const pipeline::FrameResult& r, cv::Mat* scratch) {
@@ -220,10 +303,22 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
 
   // --- device and servo loop ---
   device::SimulatedSpidar* simulated = nullptr;
+  if (c.user_mode == "interactive") {
+    // Open: the script's start (withdrawn, relaxed); closed: its grip on the cube.
+    std::array<hand::HandParams, 2> open, closed;
+    for (int h = 0; h < 2; ++h) {
+      const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
+      open[h] = s->task_->nominal(0.0, side);
+      closed[h] = s->task_->nominal(2.0, side);
+    }
+    s->interactive_ = std::make_shared<InteractiveHands>(s->user_models_, open, closed);
+  }
   if (c.backend == "sim") {
     device::SimulatedSpidarParams dp;
     dp.seed = c.seed;
-    auto dev = std::make_unique<device::SimulatedSpidar>(s->device_config_, dp, s->task_);
+    std::shared_ptr<device::FingertipSource> user = s->task_;
+    if (s->interactive_) user = s->interactive_;
+    auto dev = std::make_unique<device::SimulatedSpidar>(s->device_config_, dp, user);
     simulated = dev.get();
     s->device_ = std::move(dev);
   } else {
@@ -250,7 +345,9 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   s->loop_ = std::make_unique<device::ServoLoop>(*dev, s->device_config_, servo, s->bridge_);
 
   // --- camera ---
-  if (c.camera_source == "synthetic") {
+  if (c.camera_source == "synthetic" && s->interactive_) {
+    s->source_ = std::make_unique<InteractiveSource>(s->camera_, *s->interactive_, c.fps, c.seed);
+  } else if (c.camera_source == "synthetic") {
     s->source_ = std::make_unique<SyntheticSource>(s->camera_, s->user_models_, *s->task_, *simulated,
                                                    c.fps, c.seed);
   } else {

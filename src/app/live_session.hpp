@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "interactive_hands.hpp"
 #include "live_config.hpp"
 #include "session_parts.hpp"
 #include "session_recorder.hpp"
@@ -89,6 +90,9 @@ class LiveSession {
   CubeMonitor& cube() { return *cube_monitor_; }
   sim::PhysicsThreadStats physics_stats() const;
   const SessionRecorder* recorder() const { return recorder_.get(); }
+  /// The simulated user's hands under interactive control; null unless hands.control is
+  /// interactive.
+  InteractiveHands* interactive() { return interactive_.get(); }
   double seconds() const;  ///< since start()
 
   struct FrameSource;
@@ -104,6 +108,7 @@ class LiveSession {
   std::optional<physics::RubiksCube> cube_;
   std::unique_ptr<CubeMonitor> cube_monitor_;
   std::shared_ptr<sim::RubiksTask> task_;
+  std::shared_ptr<InteractiveHands> interactive_;
   std::unique_ptr<device::Device> device_;
   std::unique_ptr<RecordingDevice> recording_device_;
   std::shared_ptr<sim::HapticForces> bridge_;

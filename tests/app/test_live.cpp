@@ -154,6 +154,8 @@ TEST(LiveRun, BadConfigsSayWhereAndWhat) {
       {"file", "config: spidar8.yaml", "config: nope.yaml", "device.config: no such file 'nope.yaml'"},
       {"rate", "rate_hz: 1000", "rate_hz: 5", "device.rate_hz:"},
       {"mode", "mode: depth", "mode: stencil", "compositor.mode: expected paper | depth, got 'stencil'"},
+      {"synthetic", "backend: sim ", "backend: serial\n  port: /dev/null\n ",
+       "camera.source: the synthetic camera films the simulated user: it needs device.backend: sim"},
   };
   for (const Case& c : cases) {
     const std::string cfg = variant(c.name, c.from, c.to);
@@ -165,6 +167,17 @@ TEST(LiveRun, BadConfigsSayWhereAndWhat) {
   auto missing = run("run --headless --config /nonexistent/lab.yaml");
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("/nonexistent/lab.yaml: cannot open file"), std::string::npos) << missing.err;
+}
+
+TEST(LiveRun, InteractiveHandsRunHeadless) {
+  // hands.control: interactive replaces the script by the GUI-driven hands (here left at rest).
+  const std::string cfg = variant("interactive", "control: scripted", "control: interactive");
+  auto r = run("run --headless --seconds 2 --config " + cfg);
+  auto j = parse(r.out);
+  ASSERT_TRUE(j.contains("servo")) << r.err << r.out;
+  expect_clean_exit(r, j["servo"]["faults"]);
+  EXPECT_GT(j["frames"].get<int>(), 3) << r.out;
+  EXPECT_GT(j["registration"]["iou_vs_silhouette_mean"].get<double>(), 0.3) << r.out;
 }
 
 TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {

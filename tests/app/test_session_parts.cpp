@@ -2,7 +2,10 @@
 // (the GUI's scene panel), the turn counter, the camera scaling.
 #include <gtest/gtest.h>
 
+#include "interactive_hands.hpp"
 #include "session_parts.hpp"
+#include "spidar/hand/hand_config.hpp"
+#include "spidar/hand/kinematics.hpp"
 #include "spidar/physics/world.hpp"
 
 namespace spidar::app {
@@ -69,6 +72,46 @@ TEST(ScaledCamera, KeepsTheFieldOfViewAndPixelCentres) {
   EXPECT_DOUBLE_EQ(h.intrinsics().fx, 2 * k.fx);
   EXPECT_DOUBLE_EQ(h.intrinsics().cx, 639.5);
   EXPECT_EQ(h.intrinsics().width, 1280);
+}
+
+TEST(InteractiveHands, ControlsMoveAndCloseTheHandsAndTheirCapsAreTheDeviceGoals) {
+  const auto models = hand_models("configs/hands.yaml", "user", true);
+  sim::RubiksTask task({});
+  std::array<hand::HandParams, 2> open, closed;
+  for (int h = 0; h < 2; ++h) {
+    const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
+    open[h] = task.nominal(0.0, side);
+    closed[h] = task.nominal(2.0, side);
+  }
+  InteractiveHands hands(models, open, closed);
+  std::array<Vec3, 8> g0, g1;
+  hands.goals(0, g0);
+  for (int h = 0; h < 2; ++h) {  // at rest: the open posture's caps
+    const auto pts = hand::forward_kinematics(models[h], open[h]);
+    for (int f = 0; f < 4; ++f) EXPECT_NEAR((g0[4 * h + f] - pts.p_W_fingertip[f]).norm(), 0.0, 1e-12);
+  }
+  HandControls c;
+  c[1].offset_W = {0.02, -0.01, 0.03};
+  hands.set(c);
+  hands.goals(0, g1);
+  for (int f = 0; f < 4; ++f) {
+    EXPECT_NEAR((g1[f] - g0[f]).norm(), 0.0, 1e-12);                                 // left stays
+    EXPECT_NEAR((g1[4 + f] - g0[4 + f] - Vec3(0.02, -0.01, 0.03)).norm(), 0.0, 1e-12);  // right moves
+  }
+  // Closing brings the thumb and index caps together; yaw turns the hand about the vertical.
+  c = {};
+  c[0].closeness = 1.0;
+  hands.set(c);
+  hands.goals(0, g1);
+  EXPECT_LT((g1[0] - g1[1]).norm(), (g0[0] - g0[1]).norm());
+  c = {};
+  c[0].yaw = 0.5;
+  c[0].closeness = 7.0;  // clamped to 1
+  hands.set(c);
+  EXPECT_EQ(hands.controls()[0].closeness, 1.0);
+  const auto q = hands.pose(hands.controls());
+  EXPECT_NEAR((q[0].p_W_wrist() - open[0].p_W_wrist()).norm(), 0.0, 1e-12);
+  EXPECT_GT((q[0].r_W_hand() - open[0].r_W_hand()).norm(), 0.1);
 }
 
 }  // namespace
