@@ -179,9 +179,9 @@ std::string with_finger_channels(const std::string& yaml, const std::string& sou
   return out;
 }
 
-std::string write_config_with_backup(const std::string& path, const std::string& text) {
+std::string keep_previous_version(const std::string& path) {
   namespace fs = std::filesystem;
-  (void)strings::parse_device_config(core::ConfigNode::Parse(text, path));  // throws ConfigError
+  if (!fs::exists(path)) return "";
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm tm{};
   localtime_r(&now, &tm);
@@ -192,6 +192,14 @@ std::string write_config_with_backup(const std::string& path, const std::string&
   std::error_code ec;
   fs::copy_file(path, backup, ec);
   if (ec) throw UsageError(path + ": cannot keep the previous version as " + backup + ": " + ec.message());
+  return backup;
+}
+
+std::string write_config_with_backup(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  (void)strings::parse_device_config(core::ConfigNode::Parse(text, path));  // throws ConfigError
+  const std::string backup = keep_previous_version(path);
+  std::error_code ec;
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp);

@@ -70,6 +70,10 @@ std::string with_finger_channels(const std::string& yaml, const std::string& sou
                                  std::span<const strings::EncoderChannel> channels, bool full,
                                  const std::string& note);
 
+/// Copies an existing file to `path.bak-YYYYmmdd-HHMMSS` (unique) and returns that path; empty if
+/// `path` does not exist. Throws UsageError if the copy fails.
+std::string keep_previous_version(const std::string& path);
+
 /// Writes `text` to `path`, keeping the previous file as `path.bak-YYYYmmdd-HHMMSS` (returned).
 /// The text must parse as a device config first. Throws UsageError / core::ConfigError.
 std::string write_config_with_backup(const std::string& path, const std::string& text);
