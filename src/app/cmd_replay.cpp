@@ -126,18 +126,25 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
   } catch (const std::exception& e) {
     throw UsageError((d / "session.json").string() + ": not valid JSON: " + e.what());
   }
-  if (meta.value("format", "") != "spidar-mr recording" || meta.value("version", 0) != 1)
-    throw UsageError((d / "session.json").string() + ": expected format 'spidar-mr recording' version 1");
+  const std::string meta_file = (d / "session.json").string();
   const LiveConfig cfg = load_live_config((d / "config.yaml").string(), false);
-  const int width = meta.at("width"), height = meta.at("height");
-  if (width != cfg.width || height != cfg.height)
-    throw UsageError((d / "session.json").string() + ": size differs from config.yaml");
   std::array<Vec3, 2> r0;
-  for (int h = 0; h < 2; ++h) {
-    const auto& v = meta.at("initial_r_W_hand").at(h);
-    r0[h] = Vec3(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>());
+  bool png = false;
+  std::string codec;
+  try {
+    if (meta.value("format", "") != "spidar-mr recording" || meta.value("version", 0) != 1)
+      throw UsageError(meta_file + ": expected format 'spidar-mr recording' version 1");
+    const int width = meta.at("width"), height = meta.at("height");
+    if (width != cfg.width || height != cfg.height) throw UsageError(meta_file + ": size differs from config.yaml");
+    for (int h = 0; h < 2; ++h) {
+      const auto& v = meta.at("initial_r_W_hand").at(h);
+      r0[h] = Vec3(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>());
+    }
+    png = meta.value("frames", "video") == "png";
+    codec = meta.value("frames_codec", "mp4");
+  } catch (const nlohmann::json::exception& e) {
+    throw UsageError(meta_file + ": " + e.what() + " (docs/recording.md lists its keys)");
   }
-  const bool png = meta.value("frames", "video") == "png";
 
   auto ctx_r = render::Context::create_headless();
   if (!ctx_r) throw SpidarError("OpenGL: " + ctx_r.error().message);
@@ -303,7 +310,7 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
                        {"max_cost_diff", max_dcost},
                        {"fingertip_resample_max_mm", max_resample_mm},
                        {"frames_store", png ? "png (lossless)"
-                                        : meta.value("frames_codec", "mp4") + " (lossy: the fits differ from the live ones)"}};
+                                        : codec + " (lossy: the fits differ from the live ones)"}};
   j["outputs"] = {{"video", video ? video->path() : ""}};
 
   // Plots.

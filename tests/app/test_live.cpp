@@ -223,6 +223,12 @@ TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {
   auto bad = run("replay " + temp_dir("notrec").string());
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("no session.json"), std::string::npos) << bad.err;
+  // A damaged recording: a clear error naming the file (and line), never a crash.
+  std::ofstream(d / "session.json") << "{\"format\": 3}";
+  auto damaged = run("replay " + d.string());
+  EXPECT_EQ(damaged.code, 2);
+  EXPECT_NE(damaged.err.find("session.json:"), std::string::npos) << damaged.err;
+  EXPECT_EQ(damaged.err.find("internal error"), std::string::npos) << damaged.err;
 }
 
 TEST(CalibrateStrings, PoleCalibrationOnTheSimulatedDeviceFixesWrongOffsets) {
