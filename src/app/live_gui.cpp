@@ -10,15 +10,20 @@
 #include <chrono>
 #include <csignal>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
 #include "cli_support.hpp"
+#include "spidar/core/clock.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/render/overlay.hpp"
 #include "spidar/render/video_output.hpp"
+#include "spidar/strings/calibration.hpp"
 #include "spidar/strings/tension.hpp"
+#include "string_calibration.hpp"
 
 #ifndef GL_BGR
 #define GL_BGR 0x80E0
@@ -298,6 +303,78 @@ void hands_panel(InteractiveHands& ih, GLFWwindow* window, double dt) {
   ih.set(c);
 }
 
+/// Pole calibration in the window, finger by finger: the fingertip's counts must hold still for a
+/// moment (StabilityCheck), then the offsets are computed and may be written into the device
+/// config (the previous version kept). The running session keeps its calibration until restarted.
+class CalibrationPanel {
+ public:
+  void draw(LiveSession& s) {
+    const strings::DeviceConfig& cfg = s.device_config();
+    std::vector<const char*> names;
+    for (const auto& f : cfg.fingers) names.push_back(f.name.c_str());
+    ImGui::Combo("finger", &finger_, names.data(), static_cast<int>(names.size()));
+    const strings::FingerConfig& fc = cfg.fingers[finger_];
+    if (ImGui::Button("Start pole sample")) {
+      StabilityParams p;
+      p.hold_s = 1.0;
+      p.near_m = 1e9;  // before a first calibration the counters may be zeroed anywhere
+      check_ = std::make_unique<StabilityCheck>(fc, cfg.p_W_centre, p);
+      check_finger_ = finger_;
+      result_.clear();
+      message_.clear();
+    }
+    if (check_ && !check_->ready()) {
+      if (const auto rec = s.newest_device_cycle()) {
+        int first = 0;
+        for (int f = 0; f < check_finger_; ++f) first += cfg.fingers[f].geometry.n;
+        std::vector<std::int64_t> counts(cfg.fingers[check_finger_].geometry.n);
+        for (std::size_t i = 0; i < counts.size(); ++i) counts[i] = rec->reading.counts[first + static_cast<int>(i)];
+        check_->update(core::ns_to_s(rec->reading.host_time_ns), counts);
+        if (check_->ready()) {
+          sample_ = check_->sample();
+          auto ch = strings::pole_calibrate(cfg.fingers[check_finger_].geometry, cfg.fingers[check_finger_].channels,
+                                            sample_, cfg.p_W_centre);
+          if (ch) result_ = *ch;
+          else message_ = ch.error().message;
+        }
+      }
+      ImGui::Text("%s: touch the pole tip with the fingertip cap and hold still",
+                  cfg.fingers[check_finger_].name.c_str());
+      ImGui::ProgressBar(static_cast<float>(check_->held_s() / 1.0), ImVec2(-1, 0), "holding still");
+      ImGui::Text("strings moving %.2f mm", check_->spread_m() * 1e3);
+    }
+    if (!result_.empty()) {
+      const auto& old = cfg.fingers[check_finger_].channels;
+      ImGui::Text("%s sampled: length at zero [m]", cfg.fingers[check_finger_].name.c_str());
+      for (std::size_t i = 0; i < result_.size(); ++i)
+        ImGui::Text("  string %zu: %.4f -> %.4f", i + 1, old[i].length_at_zero, result_[i].length_at_zero);
+      if (ImGui::Button("Write to the device config")) {
+        try {
+          std::ifstream in(cfg.source);
+          std::stringstream text;
+          text << in.rdbuf();
+          const std::string out = with_finger_channels(text.str(), cfg.source, cfg.fingers[check_finger_].name,
+                                                       result_, false, "pole calibration (GUI)");
+          const std::string backup = write_config_with_backup(cfg.source, out);
+          message_ = "wrote " + cfg.source + " (previous: " + backup + "); restart run to use it";
+        } catch (const std::exception& e) {
+          message_ = e.what();
+        }
+        result_.clear();
+        check_.reset();
+      }
+    }
+    if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
+  }
+
+ private:
+  int finger_ = 0, check_finger_ = 0;
+  std::unique_ptr<StabilityCheck> check_;
+  std::vector<std::int64_t> sample_;
+  std::vector<strings::EncoderChannel> result_;
+  std::string message_;
+};
+
 cv::Mat read_default_framebuffer(const Gl& gl, int w, int h) {
   cv::Mat img(h, w, CV_8UC3);
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -352,6 +429,7 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   bool new_frame = false;
   cv::Mat shot;
   double last_ui_s = 0;
+  CalibrationPanel calibration;
   std::string ended_by = "seconds";
   session->start();
   while (true) {
@@ -417,9 +495,16 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
     scene_panel(*session);
     ImGui::End();
 
+    ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 268), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(std::max(300.0f, W - vw - 24), 200), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+    ImGui::Begin("Strings calibration");
+    calibration.draw(*session);
+    ImGui::End();
+
     if (InteractiveHands* ih = session->interactive()) {
-      ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 268), ImGuiCond_FirstUseEver);
-      ImGui::SetNextWindowSize(ImVec2(std::max(300.0f, W - vw - 24), 260), ImGuiCond_FirstUseEver);
+      ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 290), ImGuiCond_FirstUseEver);
+      ImGui::SetNextWindowSize(ImVec2(std::max(300.0f, W - vw - 24), 190), ImGuiCond_FirstUseEver);
       ImGui::Begin("Hands (interactive)");
       const double now = session->seconds();
       hands_panel(*ih, window, std::clamp(now - last_ui_s, 0.0, 0.1));

@@ -328,11 +328,10 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
     a.baud = c.baud;
     s->device_ = make_backend(a, s->device_config_);
   }
-  device::Device* dev = s->device_.get();
-  if (!options.record_dir.empty()) {
-    s->recording_device_ = std::make_unique<RecordingDevice>(*s->device_);
-    dev = s->recording_device_.get();
-  }
+  // Every cycle's counts and commands pass through a lock-free ring: the recorder drains it, the
+  // GUI's string calibration reads the newest counts from it.
+  s->recording_device_ = std::make_unique<RecordingDevice>(*s->device_);
+  device::Device* dev = s->recording_device_.get();
   device::ServoConfig servo;
   servo.rate_hz = c.rate_hz;
   servo.force_timeout_s = 0.05;
@@ -424,6 +423,12 @@ std::string LiveSession::error() const {
 
 double LiveSession::seconds() const {
   return started_ ? core::ns_to_s(core::monotonic_ns() - t_open_ns_) : 0.0;
+}
+
+std::optional<DeviceCycleRecord> LiveSession::newest_device_cycle() const {
+  DeviceCycleRecord r;
+  if (recording_device_->ring().newest(&r, 1) == 1) return r;
+  return std::nullopt;
 }
 
 std::uint64_t LiveSession::camera_frames() const { return source_ ? source_->delivered() : 0; }

@@ -90,6 +90,8 @@ class LiveSession {
   CubeMonitor& cube() { return *cube_monitor_; }
   sim::PhysicsThreadStats physics_stats() const;
   const SessionRecorder* recorder() const { return recorder_.get(); }
+  /// The newest servo cycle at the device boundary (raw counts, commands); any thread.
+  std::optional<DeviceCycleRecord> newest_device_cycle() const;
   /// The simulated user's hands under interactive control; null unless hands.control is
   /// interactive.
   InteractiveHands* interactive() { return interactive_.get(); }
