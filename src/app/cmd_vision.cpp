@@ -6,6 +6,7 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "string_calibration.hpp"
 #include "spidar/vision/camera_config.hpp"
 #include "spidar/vision/chessboard.hpp"
 #include "spidar/vision/markers.hpp"
@@ -75,6 +76,7 @@ Action add_calibrate_camera(CLI::App& app) {
       notes.method = "chessboard";
     }
     const vision::Camera camera(cal.intrinsics, X_CW);
+    const std::string backup = keep_previous_version(a->out);  // the previous calibration stays
     if (auto s = vision::save_camera_file(a->out, camera, notes); !s.ok()) {
       throw UsageError("--out " + s.error().message);
     }
@@ -83,6 +85,7 @@ Action add_calibrate_camera(CLI::App& app) {
     const Vec3 p_WC = camera.X_WC().p;
     nlohmann::json j = {
         {"out", a->out},
+        {"backup", backup},
         {"images", folder->used.size() + folder->rejected.size()},
         {"boards_found", folder->used.size()},
         {"rejected", folder->rejected},

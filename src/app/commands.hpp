@@ -16,5 +16,9 @@ Action add_device_test(CLI::App& app);
 Action add_emulate_device(CLI::App& app);
 Action add_calibrate_camera(CLI::App& app);
 Action add_render_test(CLI::App& app);
+// The live application (cmd_run.cpp, cmd_replay.cpp, cmd_calibrate_strings.cpp).
+Action add_run(CLI::App& app);
+Action add_replay(CLI::App& app);
+Action add_calibrate_strings(CLI::App& app);
 
 }  // namespace spidar::app

@@ -23,6 +23,9 @@ int main(int argc, char** argv) {
   add(add_emulate_device);
   add(add_calibrate_camera);
   add(add_render_test);
+  add(add_run);
+  add(add_replay);
+  add(add_calibrate_strings);
 
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;

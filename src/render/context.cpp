@@ -164,6 +164,8 @@ Status Context::make_current() {
 const std::string& Context::gl_renderer() const { return impl_->renderer; }
 const std::string& Context::gl_version() const { return impl_->version; }
 
+void* Context::native_window() const { return impl_->window; }
+
 bool Context::should_close() const {
   return impl_->window != nullptr && glfwWindowShouldClose(impl_->window);
 }

@@ -376,6 +376,20 @@ TEST(CalibrateCameraCli, CalibratesFromRenderedBoardsAndMarkers) {
   EXPECT_LT(e.position_m, 0.005);
   EXPECT_LT(e.angle_deg, 0.5);
 
+  // Calibrating again keeps the previous camera file beside the new one.
+  std::ifstream first_in(out);
+  const std::string first((std::istreambuf_iterator<char>(first_in)), {});
+  const auto again = run("calibrate-camera --images " + dir + " --pattern 9x6 --square 0.025 --markers " +
+                         markers + " --out " + out);
+  ASSERT_EQ(again.code, 0) << again.err;
+  const auto at = again.out.find("\"backup\":\"");
+  ASSERT_NE(at, std::string::npos) << again.out;
+  const std::string backup = again.out.substr(at + 10, again.out.find('"', at + 10) - (at + 10));
+  EXPECT_NE(backup.find(".bak-"), std::string::npos) << backup;
+  std::ifstream backup_in(backup);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(backup_in)), {}), first);
+  fs::remove(backup);
+
   // Bad input: exit code 2 and a message naming the problem.
   auto bad = run("calibrate-camera --images " + dir + " --pattern 9x9 --out " + out);
   EXPECT_EQ(bad.code, 2);

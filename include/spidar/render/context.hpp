@@ -45,6 +45,9 @@ class Context {
   bool should_close() const;
   void poll_events();
   void swap_buffers();
+  /// The window's GLFWwindow* (for GUI toolkits such as Dear ImGui's GLFW backend); null when
+  /// headless.
+  void* native_window() const;
   /// Size of the window's default framebuffer [px].
   int framebuffer_width() const;
   int framebuffer_height() const;

@@ -1,0 +1,155 @@
+// spidar-mr run: the live mixed-reality session from one YAML file (live_config.hpp), headless or
+// in a window with the GUI (live_gui.hpp), optionally recorded (session_recorder.hpp).
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <thread>
+
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "live_gui.hpp"
+#include "live_session.hpp"
+#include "spidar/core/config.hpp"
+
+namespace spidar::app {
+namespace {
+
+std::atomic<int> g_signal{0};
+
+extern "C" void on_signal(int sig) { g_signal.store(sig); }
+
+/// SIGINT and SIGTERM end the session cleanly (the previous handlers come back afterwards).
+class SignalScope {
+ public:
+  SignalScope() {
+    g_signal.store(0);
+    struct sigaction sa {};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~SignalScope() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+nlohmann::json summary_json(const LiveSession& s, const std::string& ended_by, double wall_s) {
+  nlohmann::json j;
+  j["ended_by"] = ended_by;
+  j["seconds"] = wall_s;
+  j["frames"] = s.frames();
+  j["camera_frames"] = s.camera_frames();
+  const auto st = s.servo().stats();
+  j["servo"] = {{"rate_hz", st.rate_hz},         {"cycles", st.cycles},
+                {"jitter_p99_us", st.jitter_p99_us}, {"overruns", st.overruns},
+                {"faults", device::fault_names(st.faults)},
+                {"realtime_scheduling", st.realtime_scheduling}};
+  const auto& h = s.history();
+  double iou = 0, reg = 0;
+  for (const auto& m : h) {
+    iou += m.iou;
+    reg += m.registration_ms;
+  }
+  j["registration"] = {{"iou_vs_silhouette_mean", h.empty() ? 0.0 : iou / static_cast<double>(h.size())},
+                       {"ms_mean", h.empty() ? 0.0 : reg / static_cast<double>(h.size())}};
+  if (auto c = s.cube_status())
+    j["cube"] = {{"turns", c->turns}, {"solved", c->solved}, {"lift_mm", c->lift * 1e3}};
+  if (const SessionRecorder* r = s.recorder()) {
+    j["recording"] = {{"dir", r->dir()},
+                      {"device_cycles", r->device_records()},
+                      {"fingertip_samples", r->fingertip_records()},
+                      {"frames", r->frames()},
+                      {"lost", r->lost()}};
+    if (!r->error().empty()) j["recording"]["error"] = r->error();
+  }
+  if (const std::string e = s.error(); !e.empty()) j["error"] = e;
+  return j;
+}
+
+}  // namespace
+
+Action add_run(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "run", "The live mixed-reality session (device, camera, physics, registration, compositing) "
+             "from one YAML file; simulated hardware in configs/lab-example.yaml");
+  struct Args {
+    std::string config;
+    double seconds = 0;
+    bool headless = false;
+    std::string record;
+    std::string record_frames = "video";
+    std::string screenshot;
+  };
+  auto a = std::make_shared<Args>();
+  cmd->add_option("--config", a->config, "live session YAML (see configs/lab-example.yaml)")->required();
+  cmd->add_option("--seconds", a->seconds, "stop after this long [s] (0: until closed, Ctrl-C or SIGTERM)");
+  cmd->add_flag("--headless", a->headless, "no window: process frames and print a summary");
+  cmd->add_option("--record", a->record, "record the session into this new folder (docs/recording.md)");
+  cmd->add_option("--record-frames", a->record_frames,
+                  "video: camera.mp4 (H.264: small, lossy); mjpg: camera.avi (Motion-JPEG: larger, "
+                  "nearly lossless); png: frames/NNNNNN.png (lossless: replay reproduces the fits exactly)")
+      ->check(CLI::IsMember({"video", "mjpg", "png"}))
+      ->capture_default_str();
+  cmd->add_option("--screenshot", a->screenshot,
+                  "window: save the window's pixels to this PNG just before exiting (tests)");
+  return [a] {
+    if (!(a->seconds >= 0 && a->seconds <= 86400)) throw UsageError("--seconds: expected 0 to 86400");
+    SignalScope signals;  // from the start: a signal during start-up ends the session once it runs
+    const LiveConfig cfg = load_live_config(a->config);
+    LiveSessionOptions opt;
+    opt.record_dir = a->record;
+    opt.record_frames = a->record_frames == "png"    ? FrameStore::kPng
+                        : a->record_frames == "mjpg" ? FrameStore::kMjpg
+                                                     : FrameStore::kVideo;
+
+    if (!a->headless) return run_gui(cfg, opt, a->seconds, a->screenshot, g_signal);
+
+    auto ctx_r = render::Context::create_headless();
+    if (!ctx_r) throw SpidarError("OpenGL: " + ctx_r.error().message);
+    auto context = std::move(ctx_r).value();
+    auto session = LiveSession::create(cfg, *context, opt);
+    std::cerr << "spidar-mr run: " << cfg.source << ": device " << cfg.backend << ", camera "
+              << cfg.camera_source << " " << cfg.width << "x" << cfg.height << ", compositor "
+              << cfg.compositor << (a->record.empty() ? "" : ", recording to " + a->record)
+              << " (headless; Ctrl-C stops)\n";
+    session->start();
+    std::string ended_by = "seconds";
+    double next_report = 1.0;
+    while (true) {
+      if (g_signal.load() != 0) {
+        ended_by = g_signal.load() == SIGINT ? "SIGINT" : "SIGTERM";
+        break;
+      }
+      if (a->seconds > 0 && session->seconds() >= a->seconds) break;
+      if (!session->running()) {
+        ended_by = session->camera_ended() ? "camera ended" : "device stopped";
+        break;
+      }
+      if (!session->step()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      if (session->seconds() >= next_report) {
+        next_report += 1.0;
+        const auto& h = session->history();
+        std::cerr << "  t " << static_cast<int>(session->seconds()) << " s  frames " << session->frames()
+                  << "  IoU " << (h.empty() ? 0.0 : h.back().iou) << "\n";
+      }
+    }
+    const double wall = session->seconds();
+    session->stop();
+    const auto j = summary_json(*session, ended_by, wall);
+    std::cout << j.dump(2) << "\n";
+    if (session->servo().stats().faults != 0) return 1;
+    if (ended_by == "device stopped" || !session->error().empty()) return 1;
+    return 0;
+  };
+}
+
+}  // namespace spidar::app

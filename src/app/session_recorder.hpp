@@ -1,0 +1,137 @@
+#pragma once
+/// Recording a live session (`spidar-mr run --record DIR`; the format is docs/recording.md):
+///
+///   RecordingDevice  wraps the device: every servo cycle's encoder reading and the motor commands
+///                    written after it go into a lock-free ring (no allocation, no lock in the
+///                    servo thread);
+///   SessionRecorder  a writer thread drains that ring and the servo loop's fingertip samples into
+///                    CSV files, and writes each processed camera frame (video or PNG), the scene
+///                    poses, the fingertip sample the frame was registered with and the fit.
+#include <array>
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <opencv2/core/mat.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "spidar/core/scene_snapshot.hpp"
+#include "spidar/core/seqlock.hpp"
+#include "spidar/device/device.hpp"
+#include "spidar/device/servo_loop.hpp"
+#include "spidar/hand/parameters.hpp"
+#include "spidar/registration/successive_adjustment.hpp"
+#include "spidar/render/video_output.hpp"
+
+namespace spidar::app {
+
+/// One servo cycle at the device boundary.
+struct DeviceCycleRecord {
+  std::uint64_t seq = 0;  ///< 1, 2, 3, ... per write
+  device::EncoderReading reading;
+  int command_count = 0;
+  std::array<std::int32_t, device::kMaxDeviceStrings> commands{};
+};
+
+/// A Device that forwards everything to another and records reads and writes.
+class RecordingDevice final : public device::Device {
+ public:
+  explicit RecordingDevice(device::Device& inner) : inner_(inner), ring_(std::make_unique<Ring>()) {}
+  Status open() override { return inner_.open(); }
+  void close() override { inner_.close(); }
+  const device::DeviceInfo& info() const override { return inner_.info(); }
+  Status read(device::EncoderReading& out) override;
+  Status write(std::span<const std::int32_t> commands) override;
+  void request_safe_state() override { inner_.request_safe_state(); }
+  void clear_safe_state() override { inner_.clear_safe_state(); }
+  device::DeviceStatus status() const override { return inner_.status(); }
+
+  static constexpr std::size_t kRing = 4096;
+  using Ring = core::SampleRing<DeviceCycleRecord, kRing>;
+  const Ring& ring() const { return *ring_; }
+
+ private:
+  device::Device& inner_;
+  std::unique_ptr<Ring> ring_;
+  DeviceCycleRecord pending_;
+  std::uint64_t seq_ = 0;
+};
+
+/// What a recording needs to know once, at the start (session.json).
+struct RecordingMeta {
+  std::string config_yaml;           ///< the resolved live config (config.yaml)
+  int width = 0, height = 0;
+  double fps = 30;
+  int string_count = 0;
+  int finger_count = 0;
+  std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};
+  std::string device_name;
+};
+
+/// One processed camera frame.
+struct FrameRecord {
+  std::int64_t index = 0;           ///< processed-frame number (0, 1, 2, ...)
+  std::int64_t t_exposure_ns = 0;   ///< host monotonic [ns]
+  cv::Mat bgr;                      ///< owned copy
+  device::FingertipSample measured; ///< the sample registration used (interpolated at exposure)
+  std::vector<Pose> scene_poses;    ///< SceneSnapshot shape poses, in snapshot order
+  std::array<hand::HandParams, 2> hands;
+  std::array<registration::FitReport, 2> fits;
+};
+
+/// How camera frames are stored: H.264 video (small, lossy), Motion-JPEG (larger, nearly lossless)
+/// or PNG files (lossless: replay reproduces the live fits exactly).
+enum class FrameStore { kVideo, kMjpg, kPng };
+
+class SessionRecorder {
+ public:
+  /// Creates DIR (it must not hold a recording already) and writes config.yaml and session.json.
+  /// Throws UsageError naming the folder on failure.
+  SessionRecorder(const std::string& dir, FrameStore store, const RecordingMeta& meta);
+  ~SessionRecorder();
+  /// Starts the writer thread polling `device` and `servo` (both must outlive stop()).
+  void start(const RecordingDevice* device, const device::ServoLoop* servo);
+  /// Frame thread: queues a frame for writing (blocks while 16 frames wait).
+  void add_frame(FrameRecord frame);
+  /// Drains everything and closes the files. Call after the servo loop has stopped.
+  void stop();
+  const std::string& dir() const { return dir_; }
+  std::uint64_t device_records() const { return device_written_; }
+  std::uint64_t fingertip_records() const { return samples_written_; }
+  std::uint64_t frames() const { return frames_written_; }
+  std::uint64_t lost() const { return lost_; }  ///< ring entries overwritten before written
+  const std::string& error() const { return error_; }
+
+ private:
+  void run();
+  void drain();
+  void write_frame(FrameRecord& f);
+
+  std::string dir_;
+  FrameStore store_;
+  RecordingMeta meta_;
+  const RecordingDevice* device_ = nullptr;
+  const device::ServoLoop* servo_ = nullptr;
+  std::ofstream device_csv_, fingertip_csv_, frames_csv_, scene_csv_, fits_csv_;
+  std::unique_ptr<render::VideoOutput> video_;
+  std::vector<DeviceCycleRecord> dev_buf_;
+  std::vector<device::FingertipSample> sample_buf_;
+  std::uint64_t last_dev_seq_ = 0, last_cycle_ = 0;
+  bool have_cycle_ = false;
+  std::uint64_t device_written_ = 0, samples_written_ = 0, frames_written_ = 0, lost_ = 0;
+  std::string error_;
+
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<FrameRecord> queue_;
+  bool stop_ = false;
+  bool stopped_ = false;
+  std::thread thread_;
+};
+
+}  // namespace spidar::app

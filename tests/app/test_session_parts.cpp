@@ -1,0 +1,118 @@
+// The session pieces shared by run, replay and the demo: the cube monitor's scramble and reset
+// (the GUI's scene panel), the turn counter, the camera scaling.
+#include <gtest/gtest.h>
+
+#include "interactive_hands.hpp"
+#include "session_parts.hpp"
+#include "spidar/hand/hand_config.hpp"
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/physics/world.hpp"
+
+namespace spidar::app {
+namespace {
+
+TEST(CubeMonitor, ScrambleAndResetRunInThePhysicsStepAndAreNotCountedAsTurns) {
+  physics::WorldParams wp;
+  auto world = physics::World::Load("scenes/rubiks_cube.xml", wp).value();
+  auto cube_r = physics::RubiksCube::Attach(*world);
+  ASSERT_TRUE(cube_r);
+  std::optional<physics::RubiksCube> cube = std::move(cube_r).value();
+  CubeMonitor monitor(&cube, cube->core_pose());
+  monitor.before_step(*world);
+  ASSERT_TRUE(monitor.status().read());
+  EXPECT_TRUE(monitor.status().read()->solved);
+
+  monitor.request_scramble(7);
+  EXPECT_TRUE(cube->is_solved());  // nothing happens outside the physics step
+  monitor.before_step(*world);
+  auto s = monitor.status().read();
+  ASSERT_TRUE(s);
+  EXPECT_FALSE(s->solved);
+  EXPECT_EQ(s->turns, 0);
+  const std::string scrambled = cube->facelets();
+
+  monitor.request_reset();
+  monitor.before_step(*world);
+  s = monitor.status().read();
+  EXPECT_TRUE(s->solved);
+  EXPECT_TRUE(cube->is_solved());
+  EXPECT_NE(cube->facelets(), scrambled);
+  EXPECT_EQ(s->turns, 0);
+  EXPECT_NEAR(s->lift, 0.0, 1e-9);
+  const auto p = monitor.pose().read();
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(p->p_W[2], cube->core_pose().p.z(), 1e-12);
+}
+
+TEST(TurnCounter, CountsSettledQuarterTurnsOfTheUser) {
+  physics::WorldParams wp;
+  auto world = physics::World::Load("scenes/rubiks_cube.xml", wp).value();
+  auto cube = physics::RubiksCube::Attach(*world).value();
+  TurnCounter turns;
+  turns.update(cube);
+  EXPECT_EQ(turns.turns(), 0);
+  ASSERT_TRUE(cube.turn('U', 1));
+  turns.update(cube);
+  EXPECT_EQ(turns.turns(), 1);
+  ASSERT_TRUE(cube.turn('R', 2));
+  turns.rebase(cube);  // e.g. a scramble: not the user's
+  turns.update(cube);
+  EXPECT_EQ(turns.turns(), 1);
+}
+
+TEST(ScaledCamera, KeepsTheFieldOfViewAndPixelCentres) {
+  vision::Intrinsics k;
+  k.width = 640;
+  k.height = 480;
+  k.fx = k.fy = 554.256;
+  k.cx = 319.5;
+  k.cy = 239.5;
+  const vision::Camera c(k, Pose());
+  const vision::Camera h = scaled_camera(c, 1280, 960);
+  EXPECT_DOUBLE_EQ(h.intrinsics().fx, 2 * k.fx);
+  EXPECT_DOUBLE_EQ(h.intrinsics().cx, 639.5);
+  EXPECT_EQ(h.intrinsics().width, 1280);
+}
+
+TEST(InteractiveHands, ControlsMoveAndCloseTheHandsAndTheirCapsAreTheDeviceGoals) {
+  const auto models = hand_models("configs/hands.yaml", "user", true);
+  sim::RubiksTask task({});
+  std::array<hand::HandParams, 2> open, closed;
+  for (int h = 0; h < 2; ++h) {
+    const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
+    open[h] = task.nominal(0.0, side);
+    closed[h] = task.nominal(2.0, side);
+  }
+  InteractiveHands hands(models, open, closed);
+  std::array<Vec3, 8> g0, g1;
+  hands.goals(0, g0);
+  for (int h = 0; h < 2; ++h) {  // at rest: the open posture's caps
+    const auto pts = hand::forward_kinematics(models[h], open[h]);
+    for (int f = 0; f < 4; ++f) EXPECT_NEAR((g0[4 * h + f] - pts.p_W_fingertip[f]).norm(), 0.0, 1e-12);
+  }
+  HandControls c;
+  c[1].offset_W = {0.02, -0.01, 0.03};
+  hands.set(c);
+  hands.goals(0, g1);
+  for (int f = 0; f < 4; ++f) {
+    EXPECT_NEAR((g1[f] - g0[f]).norm(), 0.0, 1e-12);                                 // left stays
+    EXPECT_NEAR((g1[4 + f] - g0[4 + f] - Vec3(0.02, -0.01, 0.03)).norm(), 0.0, 1e-12);  // right moves
+  }
+  // Closing brings the thumb and index caps together; yaw turns the hand about the vertical.
+  c = {};
+  c[0].closeness = 1.0;
+  hands.set(c);
+  hands.goals(0, g1);
+  EXPECT_LT((g1[0] - g1[1]).norm(), (g0[0] - g0[1]).norm());
+  c = {};
+  c[0].yaw = 0.5;
+  c[0].closeness = 7.0;  // clamped to 1
+  hands.set(c);
+  EXPECT_EQ(hands.controls()[0].closeness, 1.0);
+  const auto q = hands.pose(hands.controls());
+  EXPECT_NEAR((q[0].p_W_wrist() - open[0].p_W_wrist()).norm(), 0.0, 1e-12);
+  EXPECT_GT((q[0].r_W_hand() - open[0].r_W_hand()).norm(), 0.1);
+}
+
+}  // namespace
+}  // namespace spidar::app
