@@ -18,6 +18,7 @@
 #include "demo.hpp"
 #include "demo_mr_report.hpp"
 #include "progress.hpp"
+#include "session_parts.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/device/sample_interpolation.hpp"
 #include "spidar/device/servo_loop.hpp"
@@ -37,83 +38,8 @@
 #include "spidar/vision/vision_config.hpp"
 
 namespace spidar::app {
-namespace {
 
 namespace fs = std::filesystem;
-
-/// The cube (or, in another scene, the object the user reaches for) as the physics thread sees it.
-struct CubeStatus {
-  double t_s = 0;
-  double lift = 0;
-  double u_angle = 0, d_angle = 0;
-  int turns = 0;
-  bool solved = true;
-  int contacts = 0;
-};
-
-/// Counts completed quarter turns of any face: a layer that settles (within 3°) at another
-/// quarter than before.
-class TurnCounter {
- public:
-  void update(const physics::RubiksCube& cube) {
-    static constexpr char kFaces[6] = {'U', 'D', 'F', 'B', 'R', 'L'};
-    for (int f = 0; f < 6; ++f) {
-      const double a = cube.face_angle(kFaces[f]);
-      if (std::abs(cube.face_misalignment(kFaces[f])) > 0.05) continue;
-      const int q = static_cast<int>(std::lround(a / (M_PI / 2)));
-      if (q != quarter_[f]) {
-        turns_ += std::abs(q - quarter_[f]);
-        quarter_[f] = q;
-      }
-    }
-  }
-  int turns() const { return turns_; }
-
- private:
-  std::array<int, 6> quarter_{};
-  int turns_ = 0;
-};
-
-vision::Camera scaled_camera(const vision::Camera& c, int w, int h) {
-  vision::Intrinsics k = c.intrinsics();
-  const double sx = static_cast<double>(w) / k.width, sy = static_cast<double>(h) / k.height;
-  k.fx *= sx;
-  k.fy *= sy;
-  k.cx = (k.cx + 0.5) * sx - 0.5;
-  k.cy = (k.cy + 0.5) * sy - 0.5;
-  k.width = w;
-  k.height = h;
-  return vision::Camera(k, c.X_CW());
-}
-
-std::array<hand::HandModel, 2> user_models(const std::string& path, const std::string& profile) {
-  const hand::HandProfiles profiles = hand::load_hand_profiles(path);  // throws ConfigError
-  const hand::HandProfile* p = profiles.find(profile);
-  if (p == nullptr) {
-    if (profiles.profiles.empty()) throw UsageError("--user-hand " + path + ": no hand profiles");
-    p = &profiles.profiles.front();
-  }
-  return {p->model(hand::Side::kLeft), p->model(hand::Side::kRight)};
-}
-
-/// Where the scripted user reaches in a scene without a cube: the non-static object nearest the
-/// frame centre (its centre and half size), else the centre itself.
-void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
-  double best = 1e9;
-  for (const Shape& s : scene.shapes) {
-    if (s.body <= 0 || s.hand >= 0) continue;
-    const double d = s.X_WS.p.norm();
-    if (d < best) {
-      best = d;
-      tp->p_W_cube = s.X_WS.p;
-      tp->half = std::clamp(s.size.maxCoeff(), 0.01, 0.05);
-      tp->pitch = tp->half * 2.0 / 3.0;
-    }
-  }
-}
-
-
-}  // namespace
 
 int run_mr_demo(const DemoOptions& o) {
   // --- inputs (all checked before anything starts) ---
@@ -121,13 +47,8 @@ int run_mr_demo(const DemoOptions& o) {
   if (cfg.fingers.size() != 8) throw UsageError("--config: the rubiks demo needs 8 fingers");
   const std::string scene_path = resolve_data_path(o.scene);
   const std::string hand_path = resolve_data_path(o.user_hand);
-  const auto truth_models = user_models(hand_path, o.user_profile);
-  const auto models = [&] {
-    const auto profiles = hand::load_hand_profiles(resolve_data_path("configs/hands.yaml"));
-    const hand::HandProfile* p = profiles.find(o.model_profile);
-    if (p == nullptr) throw UsageError("--model-hand: no profile '" + o.model_profile + "' in " + profiles.source);
-    return std::array<hand::HandModel, 2>{p->model(hand::Side::kLeft), p->model(hand::Side::kRight)};
-  }();
+  const auto truth_models = hand_models(hand_path, o.user_profile, true);
+  const auto models = hand_models(resolve_data_path("configs/hands.yaml"), o.model_profile, false);
   const vision::Camera camera = scaled_camera(
       vision::load_camera_file(resolve_data_path(o.camera)).camera, o.width, o.height);
   const auto vision_cfg = vision::load_vision_config(resolve_data_path("configs/vision.yaml"));
@@ -178,26 +99,9 @@ int run_mr_demo(const DemoOptions& o) {
   sim::PhysicsThread physics(*world, *bridge);
   physics.set_snapshot_proxies(false);
   physics.set_realtime_priority(60);  // above the rendering threads, below the servo loop
-  core::Latest<CubeStatus> cube_status;
-  core::Latest<sim::CubePoseSample> cube_pose;  // the user watches the cube
-  if (cube) task->track(&cube_pose);
-  TurnCounter turns;
-  physics.set_before_step([&](physics::World& w) {
-    CubeStatus s;
-    s.t_s = w.time();
-    s.contacts = w.contact_count();
-    if (cube) {
-      const Pose X = cube->core_pose();
-      cube_pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
-      s.lift = X.p.z() - X_cube0.p.z();
-      s.u_angle = cube->face_angle('U');
-      s.d_angle = cube->face_angle('D');
-      turns.update(*cube);
-      s.turns = turns.turns();
-      s.solved = cube->is_solved();
-    }
-    cube_status.publish(s);
-  });
+  CubeMonitor monitor(&cube, X_cube0);
+  if (cube) task->track(&monitor.pose());  // the user watches the cube
+  physics.set_before_step([&monitor](physics::World& w) { monitor.before_step(w); });
   device::ServoLoop loop(dev, cfg, servo, bridge);
 
   // --- the frame side: GL, synthetic camera, user hands, pipeline ---
@@ -331,7 +235,7 @@ int run_mr_demo(const DemoOptions& o) {
       m.iterations[h] = result.fits[h].iterations;
       m.truth_cap_residual_mm[h] = filmed.cap_residual_m[h] * 1e3;
     }
-    if (auto s = cube_status.read()) {
+    if (auto s = monitor.status().read()) {
       m.lift_mm = s->lift * 1e3;
       m.u_angle_deg = s->u_angle * 180 / M_PI;
       m.d_angle_deg = s->d_angle * 180 / M_PI;
@@ -405,7 +309,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.dropped = dropped;
   summary.servo = loop.stats();
   summary.physics = physics.stats();
-  if (auto s = cube_status.read()) {
+  if (auto s = monitor.status().read()) {
     summary.turns = s->turns;
     summary.solved = s->solved;
   }

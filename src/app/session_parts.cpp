@@ -74,7 +74,10 @@ CubeMonitor::CubeMonitor(std::optional<physics::RubiksCube>* cube, const Pose& X
 void CubeMonitor::before_step(physics::World& w) {
   if (reset_.exchange(false, std::memory_order_acq_rel)) {
     physics::reset_world(w);
-    if (cube_->has_value()) turns_.rebase(**cube_);
+    if (cube_->has_value()) {
+      (*cube_)->lock_in_place();  // the layer locks were set for the cubelets' old places
+      turns_.rebase(**cube_);
+    }
   }
   if (const int n = scramble_.exchange(0, std::memory_order_acq_rel); n > 0 && cube_->has_value()) {
     (void)(*cube_)->scramble(n, scramble_seed_++);

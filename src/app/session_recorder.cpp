@@ -92,7 +92,7 @@ SessionRecorder::SessionRecorder(const std::string& dir, FrameStore store, const
     s << j.dump(2) << "\n";
   }
   device_csv_ = open_csv(d / "device.csv");
-  device_csv_ << "seq,host_time_ns,device_time_us,status";
+  device_csv_ << "seq,host_time_ns,device_time_us,status,repeats";
   for (int i = 0; i < meta.string_count; ++i) device_csv_ << ",count" << i;
   for (int i = 0; i < meta.string_count; ++i) device_csv_ << ",command" << i;
   device_csv_ << "\n";
@@ -163,7 +163,7 @@ void SessionRecorder::drain() {
       if (r.seq != last_dev_seq_ + 1) lost_ += r.seq - last_dev_seq_ - 1;
       last_dev_seq_ = r.seq;
       device_csv_ << r.seq << ',' << r.reading.host_time_ns << ',' << r.reading.device_time_us << ','
-                  << r.reading.status_flags;
+                  << r.reading.status_flags << ',' << r.reading.repeats;
       for (int i = 0; i < meta_.string_count; ++i) device_csv_ << ',' << r.reading.counts[i];
       for (int i = 0; i < meta_.string_count; ++i) device_csv_ << ',' << (i < r.command_count ? r.commands[i] : 0);
       device_csv_ << '\n';

@@ -126,6 +126,10 @@ char RubiksCube::turning_face() const {
 
 int RubiksCube::layer_unlocks() const { return locks_ ? locks_->unlocks() : 0; }
 
+void RubiksCube::lock_in_place() {
+  if (locks_) locks_->lock_all(world_->mutable_model(), world_->data());
+}
+
 double RubiksCube::layer_twist(char face) const {
   const int f = face_index(face);
   return locks_ && f >= 0 ? locks_->twist()[static_cast<std::size_t>(f)] : 0.0;

@@ -195,14 +195,14 @@ TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {
   for (const char* f : {"session.json", "config.yaml", "device.csv", "fingertips.csv", "frames.csv",
                         "scene.csv", "fits.csv", "frames/000000.png"})
     EXPECT_TRUE(fs::exists(d / f)) << f;
-  // device.csv: a header and one row per cycle with 4 + 2·24 fields.
+  // device.csv: a header and one row per cycle with 5 + 2·24 fields.
   {
     std::ifstream f(d / "device.csv");
     std::string header, row;
     std::getline(f, header);
     std::getline(f, row);
-    EXPECT_EQ(std::count(header.begin(), header.end(), ','), 3 + 48) << header;
-    EXPECT_EQ(std::count(row.begin(), row.end(), ','), 3 + 48) << row;
+    EXPECT_EQ(std::count(header.begin(), header.end(), ','), 4 + 48) << header;
+    EXPECT_EQ(std::count(row.begin(), row.end(), ','), 4 + 48) << row;
   }
   auto rp = run("replay " + d.string() + " --out " + (d / "replay").string());
   ASSERT_EQ(rp.code, 0) << rp.err << rp.out;

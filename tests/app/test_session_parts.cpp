@@ -42,6 +42,12 @@ TEST(CubeMonitor, ScrambleAndResetRunInThePhysicsStepAndAreNotCountedAsTurns) {
   const auto p = monitor.pose().read();
   ASSERT_TRUE(p);
   EXPECT_NEAR(p->p_W[2], cube->core_pose().p.z(), 1e-12);
+  // The layer locks follow the reset (they were set for the scrambled places): stepping on, the
+  // cube stays solved and every face at its click.
+  std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
+  for (int k = 0; k < 300; ++k) world->step(parked, v);
+  EXPECT_TRUE(cube->is_solved());
+  for (char f : std::string("UDFBRL")) EXPECT_LT(std::abs(cube->face_angle(f)), 0.02) << f;
 }
 
 TEST(TurnCounter, CountsSettledQuarterTurnsOfTheUser) {

@@ -66,6 +66,9 @@ class RubiksCube {
   /// Turns a face layer by quarter turns at once (positive: counter-clockwise seen from outside
   /// the face), as a scramble does; the world is re-evaluated.
   Status turn(char face, int quarter_turns);
+  /// Locks every cubelet where it is now, at the nearest click (after the world's state was
+  /// reset or set from outside; turn() and scramble() do it themselves).
+  void lock_in_place();
   /// n random quarter turns; returns them in Singmaster notation (e.g. "U R' F2 …").
   std::string scramble(int n, std::uint64_t seed);
 
