@@ -153,11 +153,12 @@ void LayerLocks::after_step(mjModel* m, mjData* d) {
   measure(m, d);
   const double dt = m->opt.timestep;
   const double brk = params_.breakaway_torque;
+  double misalignment = 0;  // of the turning layer
   if (turning_ >= 0) {
     const int f = turning_;
     const double q = units::kPi / 2;
     const double a = d->qpos[hinge_qpos_[f]];
-    const double misalignment = a - q * std::round(a / q);
+    misalignment = a - q * std::round(a / q);
     const bool resting = std::abs(misalignment) < params_.lock_tolerance_rad && std::abs(twist_[f]) < brk;
     settle_s_ = resting ? settle_s_ + dt : 0.0;
     if (settle_s_ + 1e-12 >= params_.settle_time_s) {
@@ -165,8 +166,10 @@ void LayerLocks::after_step(mjModel* m, mjData* d) {
       return;
     }
   }
-  // The layer twisted hardest (other than the one turning, which must itself be left alone to
-  // give way: a layer held off its click by a grasp would otherwise block every other turn).
+  // The layer twisted hardest, other than the one turning. It may take over from the turning
+  // layer only while that one lies near a click (a layer held a little off its click by a grasp
+  // would otherwise block every other turn; one half-way through a turn is being turned: a
+  // free layer feels little twist however hard it is pushed, so its twist cannot tell).
   // It must clearly dominate the others: a jerky grasp twists several layers at once, a turning
   // hand one.
   int best = -1;
@@ -181,7 +184,7 @@ void LayerLocks::after_step(mjModel* m, mjData* d) {
     }
   }
   const bool wants = std::abs(twist_[best]) > brk && std::abs(twist_[best]) >= params_.dominance * second &&
-                     (turning_ < 0 || std::abs(twist_[turning_]) < brk);
+                     (turning_ < 0 || std::abs(misalignment) < params_.switch_tolerance_rad);
   if (!wants) {
     candidate_ = -1;
     candidate_s_ = 0;

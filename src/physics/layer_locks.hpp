@@ -14,8 +14,8 @@
 /// (the centre turns on its hinge, with the detent) and the other eight cubelets of the layer are
 /// welded to the centre instead of the core. When the layer rests near a click, twisted less than
 /// the breakaway torque, for the settle time, all nine lock to the core again at the exact click.
-/// Only one layer turns at a time: while one is unlocked but no longer twisted past the breakaway
-/// (say a grasp holds it a little off its click), another layer twisted past it for the breakaway
+/// Only one layer turns at a time: while one is unlocked but lies within 10° of a click (say a
+/// grasp holds it a little off it), another layer twisted past the breakaway for the breakaway
 /// time takes over, and the first locks at its nearest click.
 #include <array>
 #include <memory>

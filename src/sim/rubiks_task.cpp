@@ -76,11 +76,11 @@ const char* RubiksTask::phase(double t) {
   if (t < 2.0) return "grasp";
   if (t < 3.0) return "lift";
   if (t < 5.0) return "turn 1 (top layer)";
-  if (t < 5.7) return "let go, set the cube down";
+  if (t < 5.7) return "right hand lets go";
   if (t < 6.5) return "right hand goes back";
   if (t < 7.2) return "right hand grasps";
-  if (t < 9.2) return "turn 2 (top layer back)";
-  if (t < 9.9) return "right hand lets go";
+  if (t < 9.2) return "turn 2 (top layer)";
+  if (t < 9.9) return "let go, set the cube down";
   if (t < 10.6) return "left hand lets go";
   if (t < 11.3) return "right hand turns back";
   if (t < 12.0) return "withdraw";
@@ -101,9 +101,11 @@ double RubiksTask::closeness(double t, hand::Side side) {
 
 RubiksTask::HandState RubiksTask::state(double t, hand::Side side, int /*finger*/) const {
   HandState s;
-  // Set down while the right hand lets go after turn 1 (to just above the table: the cube may
-  // have slipped a little in the hand); turn 2 is made on the table.
-  s.lift = p_.lift * (ramp(t, 2.0, 3.0) - 0.75 * ramp(t, 5.0, 5.7));
+  // Held up through both turns (on the table, its friction on the bottom layer and the holding
+  // hand's on the lower layers twist the cube about as much as the turning hand: no layer stands
+  // out to break away); set down while the right hand lets go after turn 2, to just above the
+  // table (the cube may have slipped a little in the hand).
+  s.lift = p_.lift * (ramp(t, 2.0, 3.0) - 0.75 * ramp(t, 9.2, 9.9));
   if (side == hand::Side::kRight) {
     s.yaw = p_.turn * (ramp(t, 3.0, 5.0) - ramp(t, 5.7, 6.5) + ramp(t, 7.2, 9.2) - ramp(t, 10.6, 11.3));
   }

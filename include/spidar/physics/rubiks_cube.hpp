@@ -34,6 +34,9 @@ struct DetentParams {
   /// A layer breaks away only if twisted this many times harder than any other (one hand turning
   /// one layer, not a jerky grasp twisting several).
   double dominance = 1.5;
+  /// Another layer may break away while one is unlocked only if that one lies this near a click
+  /// (it then locks there) [rad] (10°).
+  double switch_tolerance_rad = 0.17;
   double lock_tolerance_rad = 0.035;  ///< [rad] (2°)
   double settle_time_s = 0.02;      ///< [s]
 };

@@ -4,11 +4,12 @@
 ///   0.0 – 1.0  hands approach           1.0 – 2.0  both hands close on the cube
 ///   2.0 – 3.0  lift: the left hand holds the two lower layers, the right hand the top layer
 ///   3.0 – 5.0  turn 1: the right hand turns the top layer by +turn about +z (past 90°, clicks)
-///   5.0 – 5.7  the right hand lets go, the left hand sets the cube down (to a quarter of the
-///              lift: the cube may have slipped a little in the hand)
+///   5.0 – 5.7  the right hand lets go, the left hand holds the cube up
 ///   5.7 – 6.5  the right hand goes back  6.5 – 7.2  it grasps the top layer again
-///   7.2 – 9.2  turn 2: the top layer by +turn again, the cube on the table (U2 in all)
-///   9.2 – 9.9  the right hand lets go    9.9 – 10.6 the left hand lets go
+///   7.2 – 9.2  turn 2: the top layer by +turn again (U2 in all)
+///   9.2 – 9.9  the right hand lets go, the left hand sets the cube down (to a quarter of the
+///              lift: the cube may have slipped a little in the hand)
+///   9.9 – 10.6 the left hand lets go
 ///  10.6 – 11.3 the right hand turns back 11.3 – 12.0 both hands withdraw
 ///
 /// It gives the eight fingertip goals (left thumb, index, middle, ring, then right; the simulated
