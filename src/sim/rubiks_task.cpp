@@ -30,9 +30,12 @@ Contacts contacts(const RubiksTaskParams& p) {
   // middle vertical slice, close to the plane x = 0, where no pull along a face twists the L or
   // R layer and no push across a face twists U, D, F or B much.
   // Left hand on the two lower layers, from the left: thumb in front (−y), fingers behind (+y),
-  // stacked down the back face.
-  c.left = {Vec3(-0.26 * a, -hold, -0.58 * a), Vec3(-0.2 * a, hold, -0.2 * a),
-            Vec3(-0.26 * a, hold, -0.58 * a), Vec3(-0.32 * a, hold, -0.95 * a)};
+  // stacked down the back face. Three of the four press on the middle layer, so that it is the
+  // middle layer that holds against the turning hand: the bottom layer then feels a third of the
+  // holding torque and the top layer's twist clearly stands out (held by the bottom layer alone,
+  // a top-layer turn and a bottom-layer turn would be the same twist).
+  c.left = {Vec3(-0.26 * a, -hold, -0.47 * a), Vec3(-0.2 * a, hold, -0.15 * a),
+            Vec3(-0.26 * a, hold, -0.45 * a), Vec3(-0.32 * a, hold, -0.8 * a)};
   // Right hand on the top layer, from above: thumb in front, index and ring behind either side
   // of the middle, which presses on the top. High on the layer: a fingertip on the middle layer
   // would drag it along.
