@@ -244,19 +244,10 @@ int run_mr_demo(const DemoOptions& o) {
     for (int f = 0; f < 8; ++f) {
       m.force_n[f] = Vec3(measured->f_W[f][0], measured->f_W[f][1], measured->f_W[f][2]).norm();
     }
-    // Servo timing since the last frame, from the published samples (newest first).
-    {
-      int cycles = 0;
-      double worst = 0;
-      const double nominal_us = 1e6 / servo.rate_hz;
-      for (std::size_t k = 0; k + 1 < ns && servo_buf[k].t_ns > last_servo_t; ++k) {
-        ++cycles;
-        worst = std::max(worst, std::abs(core::ns_to_s(servo_buf[k].t_ns - servo_buf[k + 1].t_ns) * 1e6 - nominal_us));
-      }
-      if (ns > 0 && last_servo_t > 0 && cycles > 0)
-        m.servo_rate_hz = cycles / core::ns_to_s(servo_buf[0].t_ns - last_servo_t);
-      m.servo_jitter_max_us = worst;
-      if (ns > 0) last_servo_t = servo_buf[0].t_ns;
+    {  // servo timing since the last frame, from the published samples
+      const ServoTiming st = servo_timing_since({servo_buf.data(), ns}, servo.rate_hz, &last_servo_t);
+      m.servo_rate_hz = st.rate_hz;
+      m.servo_jitter_max_us = st.jitter_max_us;
     }
     m.truth_ms = core::ns_to_s(core::monotonic_ns() - done) * 1e3;
     trace.frames.push_back(m);

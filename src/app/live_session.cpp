@@ -88,17 +88,11 @@ class SyntheticSource final : public LiveSession::FrameSource {
   bool stopped_ = false;
 };
 
-/// A real camera (V4L2 device) or a video file, read in its own thread. A device's frames carry
-/// the host time they were grabbed at; a file's frame k is shown at start + k / fps.
-class CaptureSource final : public LiveSession::FrameSource {
+/// A frame source whose own thread produces frames: the newest one waits in a slot for the frame
+/// thread (older ones are dropped, as a camera's are). Derived classes start `thread_` and call
+/// stop() in their destructor, before their own members go.
+class ThreadedSource : public LiveSession::FrameSource {
  public:
-  explicit CaptureSource(vision::Capture capture) : capture_(std::move(capture)) {}
-  ~CaptureSource() override { stop(); }
-  Status start(std::int64_t t0_ns) override {
-    t0_ns_ = t0_ns;
-    thread_ = std::thread([this] { run(); });
-    return Ok{};
-  }
   bool take(cv::Mat* bgr, std::int64_t* t) override {
     std::lock_guard lock(mutex_);
     if (!fresh_) return false;
@@ -117,36 +111,26 @@ class CaptureSource final : public LiveSession::FrameSource {
     stop_.store(true, std::memory_order_release);
     if (thread_.joinable()) thread_.join();
   }
+ protected:
+  /// The producing thread: hands over a frame (copied) with its exposure time [ns, monotonic].
+  void publish(const cv::Mat& bgr, std::int64_t t_ns) {
+    {
+      std::lock_guard lock(mutex_);
+      bgr.copyTo(latest_);
+      latest_t_ = t_ns;
+      fresh_ = true;
+    }
+    delivered_.fetch_add(1, std::memory_order_acq_rel);
+  }
+  void fail(const std::string& message) {
+    std::lock_guard lock(mutex_);
+    error_ = message;
+  }
+  void finish() { done_.store(true, std::memory_order_release); }
+  bool stopping() const { return stop_.load(std::memory_order_acquire); }
+  std::thread thread_;
 
  private:
-  void run() {
-    const bool file = capture_.kind() != vision::SourceKind::kDevice;
-    while (!stop_.load(std::memory_order_acquire)) {
-      auto f = capture_.read();
-      if (!f) {
-        std::lock_guard lock(mutex_);
-        if (!capture_.at_end()) error_ = f.error().message;  // end of file is not an error
-        break;
-      }
-      std::int64_t t = file ? t0_ns_ + static_cast<std::int64_t>(f->t_s * 1e9)
-                            : static_cast<std::int64_t>(f->t_s * 1e9);
-      if (file) {  // play at the file's rate
-        while (core::monotonic_ns() < t && !stop_.load(std::memory_order_acquire))
-          std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      }
-      {
-        std::lock_guard lock(mutex_);
-        latest_ = f->image;
-        latest_t_ = t;
-        fresh_ = true;
-      }
-      delivered_.fetch_add(1, std::memory_order_acq_rel);
-    }
-    done_.store(true, std::memory_order_release);
-  }
-
-  vision::Capture capture_;
-  std::int64_t t0_ns_ = 0;
   mutable std::mutex mutex_;
   cv::Mat latest_;
   std::int64_t latest_t_ = 0;
@@ -154,11 +138,46 @@ class CaptureSource final : public LiveSession::FrameSource {
   std::string error_;
   std::atomic<bool> stop_{false}, done_{false};
   std::atomic<std::uint64_t> delivered_{0};
-  std::thread thread_;
+};
+
+/// A real camera (V4L2 device) or a video file, read in its own thread. A device's frames carry
+/// the host time they were grabbed at; a file's frame k is shown at start + k / fps.
+class CaptureSource final : public ThreadedSource {
+ public:
+  explicit CaptureSource(vision::Capture capture) : capture_(std::move(capture)) {}
+  ~CaptureSource() override { stop(); }
+  Status start(std::int64_t t0_ns) override {
+    t0_ns_ = t0_ns;
+    thread_ = std::thread([this] { run(); });
+    return Ok{};
+  }
+
+ private:
+  void run() {
+    const bool file = capture_.kind() != vision::SourceKind::kDevice;
+    while (!stopping()) {
+      auto f = capture_.read();
+      if (!f) {
+        if (!capture_.at_end()) fail(f.error().message);  // end of file is not an error
+        break;
+      }
+      std::int64_t t = file ? t0_ns_ + static_cast<std::int64_t>(f->t_s * 1e9)
+                            : static_cast<std::int64_t>(f->t_s * 1e9);
+      if (file) {  // play at the file's rate
+        while (core::monotonic_ns() < t && !stopping())
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+      publish(f->image, t);
+    }
+    finish();
+  }
+
+  vision::Capture capture_;
+  std::int64_t t0_ns_ = 0;
 };
 
 /// The synthetic camera filming the interactively controlled hands (their commanded posture).
-class InteractiveSource final : public LiveSession::FrameSource {
+class InteractiveSource final : public ThreadedSource {
  public:
   InteractiveSource(const vision::Camera& camera, const InteractiveHands& hands, double fps, std::uint64_t seed)
       : camera_(camera), hands_(hands), fps_(fps), seed_(seed) {}
@@ -170,24 +189,6 @@ class InteractiveSource final : public LiveSession::FrameSource {
     Status st = done.get();
     if (!st) stop();
     return st;
-  }
-  bool take(cv::Mat* bgr, std::int64_t* t) override {
-    std::lock_guard lock(mutex_);
-    if (!fresh_) return false;
-    fresh_ = false;
-    latest_.copyTo(*bgr);
-    *t = latest_t_;
-    return true;
-  }
-  bool ended() const override { return done_.load(std::memory_order_acquire); }
-  std::string error() const override {
-    std::lock_guard lock(mutex_);
-    return error_;
-  }
-  std::uint64_t delivered() const override { return delivered_.load(std::memory_order_acquire); }
-  void stop() override {
-    stop_.store(true, std::memory_order_release);
-    if (thread_.joinable()) thread_.join();
   }
 
  private:
@@ -202,41 +203,26 @@ class InteractiveSource final : public LiveSession::FrameSource {
     const auto period_ns = static_cast<std::int64_t>(1e9 / fps_);
     std::int64_t t_exp = t0_ns;
     sim::SyntheticFrame frame;
-    while (!stop_.load(std::memory_order_acquire)) {
+    while (!stopping()) {
       core::sleep_until_ns(t_exp);
-      if (stop_.load(std::memory_order_acquire)) break;
+      if (stopping()) break;
       const auto q = hands_.pose(hands_.controls());
       const sim::HandPoses poses{&q[0], &q[1]};
       if (auto st = film.value()->film(poses, &frame); !st) {
-        std::lock_guard lock(mutex_);
-        error_ = st.error().message;
+        fail(st.error().message);
         break;
       }
-      {
-        std::lock_guard lock(mutex_);
-        frame.bgr.copyTo(latest_);
-        latest_t_ = t_exp;
-        fresh_ = true;
-      }
-      delivered_.fetch_add(1, std::memory_order_acq_rel);
+      publish(frame.bgr, t_exp);
       t_exp += period_ns;
       while (t_exp < core::monotonic_ns()) t_exp += period_ns;  // a slow frame drops exposures
     }
-    done_.store(true, std::memory_order_release);
+    finish();
   }
 
   vision::Camera camera_;
   const InteractiveHands& hands_;
   double fps_;
   std::uint64_t seed_;
-  mutable std::mutex mutex_;
-  cv::Mat latest_;
-  std::int64_t latest_t_ = 0;
-  bool fresh_ = false;
-  std::string error_;
-  std::atomic<bool> stop_{false}, done_{false};
-  std::atomic<std::uint64_t> delivered_{0};
-  std::thread thread_;
 };
 
 }  // namespace
@@ -465,18 +451,10 @@ bool LiveSession::step() {
   m.latency_ms = core::ns_to_s(done - t_exp) * 1e3;
   m.pipeline_ms = result_.timings.total_ms;
   m.registration_ms = result_.timings.registration_ms;
-  {  // servo timing since the last frame, from the published samples (newest first)
-    int cycles = 0;
-    double worst = 0;
-    const double nominal_us = 1e6 / config_.rate_hz;
-    for (std::size_t k = 0; k + 1 < ns && servo_buf_[k].t_ns > last_servo_t_; ++k) {
-      ++cycles;
-      worst = std::max(worst, std::abs(core::ns_to_s(servo_buf_[k].t_ns - servo_buf_[k + 1].t_ns) * 1e6 - nominal_us));
-    }
-    if (ns > 0 && last_servo_t_ > 0 && cycles > 0)
-      m.servo_rate_hz = cycles / core::ns_to_s(servo_buf_[0].t_ns - last_servo_t_);
-    m.servo_jitter_max_us = worst;
-    if (ns > 0) last_servo_t_ = servo_buf_[0].t_ns;
+  {  // servo timing since the last frame, from the published samples
+    const ServoTiming st = servo_timing_since({servo_buf_.data(), ns}, config_.rate_hz, &last_servo_t_);
+    m.servo_rate_hz = st.rate_hz;
+    m.servo_jitter_max_us = st.jitter_max_us;
   }
   history_.push_back(m);
 

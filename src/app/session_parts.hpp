@@ -5,11 +5,13 @@
 #include <array>
 #include <atomic>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "spidar/core/pose.hpp"
 #include "spidar/core/scene_snapshot.hpp"
 #include "spidar/core/seqlock.hpp"
+#include "spidar/device/servo_types.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/sim/rubiks_task.hpp"
@@ -28,6 +30,16 @@ std::array<hand::HandModel, 2> hand_models(const std::string& path, const std::s
 /// Where the scripted user reaches in a scene without a cube: the non-static object nearest the
 /// frame centre (its centre and half size), else the centre itself.
 void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp);
+
+/// The servo loop's timing between two camera frames.
+struct ServoTiming {
+  double rate_hz = 0;        ///< cycles per second since the previous frame (0: not known yet)
+  double jitter_max_us = 0;  ///< largest deviation of a period from the nominal one [µs]
+};
+/// From the loop's published samples, newest first (ServoLoop::newest_samples), those newer than
+/// `*last_t_ns` (the newest seen at the previous frame; updated). `rate_hz`: nominal rate.
+ServoTiming servo_timing_since(std::span<const device::FingertipSample> newest_first, double rate_hz,
+                               std::int64_t* last_t_ns);
 
 /// The cube (or, in another scene, the object the user reaches for) as the physics thread sees it.
 struct CubeStatus {
