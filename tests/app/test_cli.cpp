@@ -10,36 +10,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "run_cli.hpp"
+
 #include <chrono>
 #include <cstdlib>
 #include <thread>
 
 namespace {
 
-struct Run {
-  int code;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
-
-Run run(const std::string& args) {
-  // One file per process: ctest runs the tests of this binary in parallel processes.
-  const std::string err_file =
-      ::testing::TempDir() + "spidar_cli_stderr_" + std::to_string(getpid()) + ".txt";
-  const std::string cmd = std::string(SPIDAR_MR) + " " + args + " 2>" + err_file;
-  Run r{-1, "", ""};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (FILE* e = fopen(err_file.c_str(), "r")) {
-    while (fgets(buf.data(), buf.size(), e)) r.err += buf.data();
-    fclose(e);
-  }
-  return r;
-}
+using spidar::test::Run;
+Run run(const std::string& args) { return spidar::test::run_cli(args); }
 
 TEST(Cli, CheckConfigSummarisesOrFailsWithCode2) {
   auto ok = run("check-config configs/spidar8.yaml");

@@ -16,14 +16,13 @@
 #include <thread>
 #include <unistd.h>
 
+#include "run_cli.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
-  int code;
-  std::string out, err;
-};
+using spidar::test::Run;
 
 std::string slurp(const fs::path& p) {
   std::ifstream f(p);
@@ -37,19 +36,7 @@ fs::path temp_dir(const std::string& name) {
   return d;
 }
 
-Run run(const std::string& args, const std::string& prefix = "") {
-  const fs::path err = fs::path(::testing::TempDir()) / ("spidar_live_err_" + std::to_string(getpid()));
-  const std::string cmd = prefix + std::string(SPIDAR_MR) + " " + args + " 2>" + err.string();
-  Run r{-1, "", ""};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err = slurp(err);
-  return r;
-}
+Run run(const std::string& args, const std::string& prefix = "") { return spidar::test::run_cli(args, prefix); }
 
 nlohmann::json parse(const std::string& s) {
   try {
