@@ -25,10 +25,8 @@ namespace {
 
 double pole_error_mm(const strings::FingerConfig& f, std::span<const strings::EncoderChannel> ch,
                      std::span<const std::int64_t> counts, const Vec3& p_W_pole) {
-  std::vector<double> l(f.geometry.n);
-  for (int i = 0; i < f.geometry.n; ++i) l[i] = strings::counts_to_length(ch[i], counts[i]);
-  const auto est = strings::solve_position(f.geometry, l);
-  return est ? (est->p_WF - p_W_pole).norm() * 1e3 : NAN;
+  const auto p_W = fingertip_from_counts(f, ch, counts);
+  return p_W ? (*p_W - p_W_pole).norm() * 1e3 : NAN;
 }
 
 }  // namespace
@@ -111,9 +109,6 @@ Action add_calibrate_strings(CLI::App& app) {
     if (auto st = dev->open(); !st) throw UsageError("device: " + st.error().message);
     dev->clear_safe_state();
     std::vector<std::int32_t> commands(cfg.string_count(), cfg.command_range().min);  // taut strings
-    std::vector<int> first_string(cfg.fingers.size(), 0);
-    for (std::size_t f = 1; f < cfg.fingers.size(); ++f)
-      first_string[f] = first_string[f - 1] + cfg.fingers[f - 1].geometry.n;
     const std::int64_t t0 = core::monotonic_ns();
     std::uint64_t cycle = 0;
     auto now_s = [&] { return sim ? static_cast<double>(cycle) * 1e-3 : core::ns_to_s(core::monotonic_ns() - t0); };
@@ -155,9 +150,7 @@ Action add_calibrate_strings(CLI::App& app) {
           (void)dev->write(commands);
           ++cycle;
           const double t = now_s();
-          std::vector<std::int64_t> counts(fc.geometry.n);
-          for (int i = 0; i < fc.geometry.n; ++i) counts[i] = reading.counts[first_string[f] + i];
-          check.update(t, counts);
+          check.update(t, finger_counts(cfg, f, reading));
           if (t >= next_note) {
             next_note += 0.25;
             std::cerr << "  " << (check.distance_m() > sp.near_m ? "not at the target yet" : check.held_s() > 0 ? "holding" : "moving")

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "cli_support.hpp"
+#include "gui_camera_calibration.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/render/overlay.hpp"
@@ -325,11 +326,7 @@ class CalibrationPanel {
     }
     if (check_ && !check_->ready()) {
       if (const auto rec = s.newest_device_cycle()) {
-        int first = 0;
-        for (int f = 0; f < check_finger_; ++f) first += cfg.fingers[f].geometry.n;
-        std::vector<std::int64_t> counts(cfg.fingers[check_finger_].geometry.n);
-        for (std::size_t i = 0; i < counts.size(); ++i) counts[i] = rec->reading.counts[first + static_cast<int>(i)];
-        check_->update(core::ns_to_s(rec->reading.host_time_ns), counts);
+        check_->update(core::ns_to_s(rec->reading.host_time_ns), finger_counts(cfg, check_finger_, rec->reading));
         if (check_->ready()) {
           sample_ = check_->sample();
           auto ch = strings::pole_calibrate(cfg.fingers[check_finger_].geometry, cfg.fingers[check_finger_].channels,
@@ -430,6 +427,7 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   cv::Mat shot;
   double last_ui_s = 0;
   CalibrationPanel calibration;
+  CameraCalibrationPanel camera_calibration;
   std::string ended_by = "seconds";
   session->start();
   while (true) {
@@ -471,7 +469,9 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
       const ImVec2 avail = ImGui::GetContentRegionAvail();
       const float tw = static_cast<float>(tex.width()), th = static_cast<float>(tex.height());
       const float scale = std::max(0.1f, std::min(avail.x / tw, avail.y / th));
+      const ImVec2 image_min = ImGui::GetCursorScreenPos();
       ImGui::Image(tex.id(), ImVec2(tw * scale, th * scale));
+      camera_calibration.on_view(*session, image_min, scale * tw / vw);
     } else {
       ImGui::TextUnformatted("waiting for the camera");
     }
@@ -502,8 +502,15 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
     calibration.draw(*session);
     ImGui::End();
 
+    ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 288), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(std::max(300.0f, W - vw - 24), 260), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+    ImGui::Begin("Camera calibration");
+    camera_calibration.draw(*session);
+    ImGui::End();
+
     if (InteractiveHands* ih = session->interactive()) {
-      ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 290), ImGuiCond_FirstUseEver);
+      ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 312), ImGuiCond_FirstUseEver);
       ImGui::SetNextWindowSize(ImVec2(std::max(300.0f, W - vw - 24), 190), ImGuiCond_FirstUseEver);
       ImGui::Begin("Hands (interactive)");
       const double now = session->seconds();

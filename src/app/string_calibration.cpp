@@ -16,6 +16,27 @@
 
 namespace spidar::app {
 
+std::vector<std::int64_t> finger_counts(const strings::DeviceConfig& config, int finger,
+                                        const device::EncoderReading& reading) {
+  int first = 0;
+  for (int f = 0; f < finger; ++f) first += config.fingers[f].geometry.n;
+  const int n = config.fingers[finger].geometry.n;
+  std::vector<std::int64_t> counts(n);
+  for (int i = 0; i < n; ++i) counts[i] = reading.counts[first + i];
+  return counts;
+}
+
+std::optional<Vec3> fingertip_from_counts(const strings::FingerConfig& finger,
+                                          std::span<const strings::EncoderChannel> channels,
+                                          std::span<const std::int64_t> counts) {
+  const int n = finger.geometry.n;
+  std::vector<double> lengths(n);
+  for (int i = 0; i < n; ++i) lengths[i] = strings::counts_to_length(channels[i], counts[i]);
+  const auto est = strings::solve_position(finger.geometry, lengths);
+  if (!est) return std::nullopt;
+  return est->p_WF;
+}
+
 StabilityCheck::StabilityCheck(const strings::FingerConfig& finger, const Vec3& p_W_target,
                                StabilityParams params)
     : finger_(finger), target_(p_W_target), p_(params) {}
@@ -35,10 +56,8 @@ void StabilityCheck::update(double t_s, std::span<const std::int64_t> counts) {
     spread_m_ = std::max(spread_m_, static_cast<double>(hi - lo) * finger_.channels[i].metres_per_count);
   }
   // Where the present calibration puts the fingertip.
-  std::vector<double> lengths(n);
-  for (int i = 0; i < n; ++i) lengths[i] = strings::counts_to_length(finger_.channels[i], counts[i]);
-  const auto est = strings::solve_position(finger_.geometry, lengths);
-  distance_m_ = est ? (est->p_WF - target_).norm() : 1e9;
+  const auto p_W = fingertip_from_counts(finger_, counts);
+  distance_m_ = p_W ? (*p_W - target_).norm() : 1e9;
   // Held still: the window covers hold_s and nothing moved more than the tolerance in it.
   if (spread_m_ > p_.tolerance_m || distance_m_ > p_.near_m || window_.size() == 1) {
     window_.clear();

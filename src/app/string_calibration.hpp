@@ -6,14 +6,30 @@
 /// config's YAML text (comments and layout kept).
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "spidar/device/device.hpp"
 #include "spidar/device/fingertip_source.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::app {
+
+/// Finger `finger`'s counts (config order) out of a whole device reading.
+std::vector<std::int64_t> finger_counts(const strings::DeviceConfig& config, int finger,
+                                        const device::EncoderReading& reading);
+
+/// Where the finger's calibration `channels` put its fingertip for these counts [m], world;
+/// nullopt if the string lengths do not give a position.
+std::optional<Vec3> fingertip_from_counts(const strings::FingerConfig& finger,
+                                          std::span<const strings::EncoderChannel> channels,
+                                          std::span<const std::int64_t> counts);
+inline std::optional<Vec3> fingertip_from_counts(const strings::FingerConfig& finger,
+                                                 std::span<const std::int64_t> counts) {
+  return fingertip_from_counts(finger, finger.channels, counts);
+}
 
 struct StabilityParams {
   double hold_s = 0.5;          ///< the fingertip must hold still this long [s]
