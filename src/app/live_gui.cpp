@@ -6,6 +6,8 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <csignal>
@@ -164,7 +166,7 @@ void device_panel(LiveSession& s) {
   }
   ImGui::SameLine();
   ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.8f, 0.1f, 0.1f, 1));
-  if (ImGui::Button("EMERGENCY STOP")) s.servo().emergency_stop();
+  if (ImGui::Button("EMERGENCY STOP (space)")) s.servo().emergency_stop();
   ImGui::PopStyleColor();
 
   const auto& h = s.history();
@@ -401,6 +403,9 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   if (!gl.load()) throw SpidarError("window: GL entry points missing (glfwGetProcAddress)");
 
   auto session = LiveSession::create(cfg, *context, options);
+  // Sticky keys: a tap shorter than one GUI frame (the space bar's emergency stop above all) is
+  // still seen by the next glfwGetKey.
+  glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -445,6 +450,8 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
       break;
     }
     context->poll_events();
+    // The space bar stops the device from anywhere in the window, whatever has the keyboard.
+    if (glfwGetKey(window, GLFW_KEY_SPACE) == GLFW_PRESS) session->servo().emergency_stop();
     // Take every frame that is ready (the GUI draws at most at the display's rate).
     for (int k = 0; k < 4 && session->step(); ++k) new_frame = true;
     if (new_frame) {
@@ -537,9 +544,16 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
     if (auto w = render::write_png(screenshot, shot); !w) throw SpidarError(w.error().message);
   }
   const auto st = session->servo().stats();
-  std::cout << "{\"ended_by\": \"" << ended_by << "\", \"frames\": " << session->frames()
-            << ", \"servo_rate_hz\": " << st.rate_hz << ", \"faults\": \"" << device::fault_names(st.faults)
-            << "\"}\n";
+  nlohmann::json summary = {{"ended_by", ended_by},
+                            {"frames", session->frames()},
+                            {"servo_rate_hz", st.rate_hz},
+                            {"faults", device::fault_names(st.faults)}};
+  if (InteractiveHands* ih = session->interactive()) {
+    // Where the keys and sliders left the hands (left, right).
+    for (const HandControl& c : ih->controls())
+      summary["hands"].push_back({{"offset_m", c.offset_W}, {"yaw_rad", c.yaw}, {"closeness", c.closeness}});
+  }
+  std::cout << summary.dump() << "\n";
   if (!session->error().empty()) std::cerr << "spidar-mr run: " << session->error() << "\n";
   return st.faults != 0 || ended_by == "device stopped" || !session->error().empty() ? 1 : 0;
 }

@@ -312,4 +312,29 @@ TEST(LiveGui, WindowScreenshotUnderXvfbIsNotBlank) {
   EXPECT_GT(colours.size(), 50u);
 }
 
+TEST(LiveGui, KeysTypedIntoTheWindowMoveTheHandsAndSpaceStopsTheDevice) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1 && command -v xdotool >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run or xdotool is not installed (scripts/install-deps installs both)";
+  // Real X key events (XTEST) into the GLFW window: Up held moves the right hand away, Z held
+  // closes the left hand, the space bar is the emergency stop.
+  const std::string cfg = variant("keys", "control: scripted", "control: interactive");
+  auto r = run("run --config " + cfg + " --seconds 9",
+               "xvfb-run -a -s '-screen 0 1280x1024x24' sh tests/app/type_into_window.sh ");
+  auto j = parse(r.out);
+  ASSERT_TRUE(j.contains("hands")) << r.err << r.out;
+  EXPECT_EQ(j["ended_by"], "seconds") << r.out;
+  // The emergency stop latched (a late cycle on a loaded machine may add a timing fault).
+  EXPECT_EQ(r.code, 1) << r.err << r.out;
+  EXPECT_NE(j["faults"].get<std::string>().find("emergency_stop"), std::string::npos) << r.out;
+  const auto& left = j["hands"][0];
+  const auto& right = j["hands"][1];
+  // 0.08 m/s for 1.5 s is 0.12 m; the GUI integrates at its frame rate (steps of at most 0.1 s),
+  // so a slow (sanitised) GUI moves less.
+  EXPECT_GT(right["offset_m"][1].get<double>(), 0.03) << r.out;
+  EXPECT_NEAR(right["offset_m"][0].get<double>(), 0.0, 1e-9) << r.out;
+  EXPECT_NEAR(left["offset_m"][1].get<double>(), 0.0, 1e-9) << r.out;  // only the right hand moved
+  EXPECT_GT(left["closeness"].get<double>(), 0.3) << r.out;  // 1.5 per second for 1 s
+  EXPECT_NEAR(right["closeness"].get<double>(), 0.0, 1e-9) << r.out;
+}
+
 }  // namespace
