@@ -57,6 +57,27 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
           {"frames", t.frames.size()}};
 }
 
+/// One row per processed frame: what the report's figures are computed from.
+void write_frames_csv(const std::string& path, const MrTrace& t) {
+  std::ofstream f(path);
+  f << "t_s,latency_ms,pipeline_ms,registration_ms,truth_ms,output_ms,film_ms,iou,fingertip_mm,"
+       "joint_px_left,joint_px_right,occlusion_pct,occlusion_pct_paper,iterations_left,"
+       "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
+       "servo_jitter_max_us\n";
+  f << std::setprecision(6);
+  for (const MrFrame& m : t.frames) {
+    const auto& a = m.truth[0];
+    f << m.t_s << ',' << m.latency_ms << ',' << m.pipeline_ms << ',' << m.registration_ms << ','
+      << m.truth_ms << ',' << m.output_ms << ',' << m.film_ms << ',' << a.iou << ','
+      << 0.5 * (a.fingertip_mm[0] + a.fingertip_mm[1]) << ',' << a.joint_px[0] << ',' << a.joint_px[1]
+      << ',' << a.occlusion_pct << ',' << a.occlusion_pct_paper << ',' << m.iterations[0] << ','
+      << m.iterations[1] << ',' << (m.compared ? 1 : 0) << ',';
+    if (m.compared) f << m.truth[1].iou;
+    f << ',' << m.lift_mm << ',' << m.u_angle_deg << ',' << m.turns << ',' << m.servo_rate_hz << ','
+      << m.servo_jitter_max_us << '\n';
+  }
+}
+
 void save_plot(const std::string& path, const render::PlotSpec& spec,
                const std::vector<render::PlotSeries>& series) {
   auto img = render::plot_lines(spec, series);
@@ -240,6 +261,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   }
   report["haptic"]["force_max_n"] = forces;
   std::ofstream(dir / "report.json") << report.dump(2) << "\n";
+  write_frames_csv((dir / "frames.csv").string(), t);
   if (frames > 1) write_plots(dir, t);
 
   os << "\nresult (" << frames << " frames in " << std::fixed << std::setprecision(1) << s.wall_s

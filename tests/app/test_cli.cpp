@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include <array>
 #include <cstdio>
@@ -243,6 +244,13 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_TRUE(exists(dir + "/registration_error.png"));
   EXPECT_TRUE(exists(dir + "/fingertip_forces.png"));
   EXPECT_TRUE(exists(dir + "/loop_timing.png"));
+  {  // frames.csv: a header and one row per processed frame
+    std::ifstream csv(dir + "/frames.csv");
+    std::string line;
+    int rows = -1;
+    while (std::getline(csv, line)) ++rows;
+    EXPECT_EQ(rows, j["frames"].get<int>());
+  }
   EXPECT_TRUE(exists(j["video"]["path"].get<std::string>()));
   // The first keyframe is due at 1.9 s; the first frame processed after it names the file (under
   // a sanitizer, frames are dropped and that may be 2.1 s or later).
