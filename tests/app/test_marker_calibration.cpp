@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "marker_calibration.hpp"
+#include "ideal_counts.hpp"
 #include "spidar/strings/device_config.hpp"
 #include "spidar/vision/camera_config.hpp"
 #include "spidar/vision/markers.hpp"
@@ -15,15 +16,7 @@
 namespace spidar::app {
 namespace {
 
-/// The counts an ideal encoder reads with the fingertip at p (rounded to whole counts).
-std::vector<std::int64_t> counts_at(const strings::FingerConfig& f, const Vec3& p) {
-  std::vector<std::int64_t> c;
-  for (int i = 0; i < f.geometry.n; ++i) {
-    const double l = (f.geometry.p_WA[i] - p).norm();
-    c.push_back(std::llround((l - f.channels[i].length_at_zero) / (f.channels[i].sign * f.channels[i].metres_per_count)));
-  }
-  return c;
-}
+using test::counts_at;
 
 struct Rig {
   strings::DeviceConfig device = strings::load_device_config("configs/spidar8.yaml");

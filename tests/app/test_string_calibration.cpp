@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "spidar/core/config.hpp"
+#include "ideal_counts.hpp"
 #include "spidar/strings/device_config.hpp"
 #include "string_calibration.hpp"
 
@@ -21,15 +22,7 @@ std::string slurp(const fs::path& p) {
   return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
-/// The counts an ideal encoder reads with the fingertip at p.
-std::vector<std::int64_t> counts_at(const strings::FingerConfig& f, const Vec3& p) {
-  std::vector<std::int64_t> c;
-  for (int i = 0; i < f.geometry.n; ++i) {
-    const double l = (f.geometry.p_WA[i] - p).norm();
-    c.push_back(std::llround((l - f.channels[i].length_at_zero) / (f.channels[i].sign * f.channels[i].metres_per_count)));
-  }
-  return c;
-}
+using test::counts_at;
 
 TEST(StabilityCheck, SamplesOnlyAfterHoldingStillNearTheTarget) {
   const auto cfg = spidar8();
