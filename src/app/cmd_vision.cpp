@@ -13,21 +13,58 @@
 
 namespace spidar::app {
 
+namespace {
+
+struct CalibrateCameraArgs {
+  std::string images;
+  std::string pattern = "9x6";
+  double square = 0.025;
+  std::string markers;
+  std::string base;
+  std::string out = "configs/camera.yaml";
+  bool k3 = false;
+};
+
+/// Extrinsics alone (no --images): the markers against the intrinsics of `base` (the existing
+/// camera file; the default rig camera if there is none), written with the new pose.
+int extrinsics_only(const CalibrateCameraArgs& a, const std::string& base) {
+  if (a.markers.empty())
+    throw UsageError("--images or --markers: expected chessboard images, markers, or both");
+  const vision::CameraFile kept = base.empty() ? vision::CameraFile{vision::default_rig_camera(), {}, ""}
+                                               : vision::load_camera_file(base);
+  const auto set = vision::load_markers(a.markers);
+  auto r = vision::calibrate_extrinsics(kept.camera.intrinsics(), set);
+  if (!r) throw UsageError("--markers " + r.error().message);
+  vision::CalibrationNotes notes = kept.calibration;
+  notes.method = (notes.intrinsics_rms_px ? "chessboard + " : "") + r->method;
+  notes.extrinsics_rms_px = r->rms_px;
+  notes.extrinsics_rms_m = r->rms_m;
+  const vision::Camera camera(kept.camera.intrinsics(), r->X_CW);
+  const std::string backup = keep_previous_version(a.out);
+  if (auto s = vision::save_camera_file(a.out, camera, notes); !s.ok()) throw UsageError("--out " + s.error().message);
+  nlohmann::json extr = {{"method", r->method}, {"markers", set.markers.size()}};
+  if (r->rms_px) extr["rms_px"] = *r->rms_px;
+  if (r->max_px) extr["max_px"] = *r->max_px;
+  if (r->rms_m) extr["rms_m"] = *r->rms_m;
+  const nlohmann::json j = {{"out", a.out},
+                            {"backup", backup},
+                            {"intrinsics", {{"kept_from", base.empty() ? "default rig camera" : base}}},
+                            {"extrinsics", extr},
+                            {"camera_position", to_json(camera.X_WC().p)}};
+  std::cout << j.dump() << "\n";
+  return 0;
+}
+
+}  // namespace
+
 Action add_calibrate_camera(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "calibrate-camera",
       "Camera intrinsics from chessboard images, extrinsics from markers; writes a camera file");
-  struct Args {
-    std::string images;
-    std::string pattern = "9x6";
-    double square = 0.025;
-    std::string markers;
-    std::string base;
-    std::string out = "configs/camera.yaml";
-    bool k3 = false;
-  };
-  auto a = std::make_shared<Args>();
-  cmd->add_option("--images", a->images, "folder of chessboard images")->required();
+  auto a = std::make_shared<CalibrateCameraArgs>();
+  cmd->add_option("--images", a->images,
+                  "folder of chessboard images (intrinsics); without it the intrinsics are kept "
+                  "from --base and only --markers is solved");
   cmd->add_option("--pattern", a->pattern, "inner corners COLSxROWS")->capture_default_str();
   cmd->add_option("--square", a->square, "side of one square [m]")->capture_default_str();
   cmd->add_option("--markers", a->markers,
@@ -39,6 +76,10 @@ Action add_calibrate_camera(CLI::App& app) {
   cmd->add_option("--out", a->out, "camera file to write")->capture_default_str();
   cmd->add_flag("--k3", a->k3, "also estimate the k3 distortion coefficient (default: k3 = 0)");
   return [a] {
+    // The camera file whose parts are kept (intrinsics without --images, pose without --markers).
+    std::string base = a->base;
+    if (base.empty() && std::filesystem::exists(a->out)) base = a->out;
+    if (a->images.empty()) return extrinsics_only(*a, base);
     auto pattern = vision::parse_pattern(a->pattern, a->square);
     if (!pattern) throw UsageError("--pattern/--square: " + pattern.error().message);
     vision::IntrinsicsOptions options;
@@ -64,8 +105,6 @@ Action add_calibrate_camera(CLI::App& app) {
       if (r->max_px) extr["max_px"] = *r->max_px;
       if (r->rms_m) extr["rms_m"] = *r->rms_m;
     } else {
-      std::string base = a->base;
-      if (base.empty() && std::filesystem::exists(a->out)) base = a->out;
       if (base.empty()) {
         X_CW = vision::default_rig_camera().X_CW();
         extr = {{"method", "default rig pose (no --markers)"}};

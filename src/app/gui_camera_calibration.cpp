@@ -99,6 +99,10 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
     else std::snprintf(residual, sizeof residual, "%.2f mm", e.rms_m.value_or(0) * 1e3);
     ImGui::Text("%s: residual %s; camera moved %.1f mm, turned %.2f deg", e.method.c_str(), residual,
                 solution_->moved_m * 1e3, solution_->turned_deg);
+    // Markers that disagree (a click off the cap, a range misread): say so before writing.
+    if (e.rms_px.value_or(0) > 2.0 || e.rms_m.value_or(0) > 0.005)
+      ImGui::TextColored(ImVec4(1, 0.35f, 0.3f, 1),
+                         "the markers disagree: check the clicks (on the cap) and the ranges");
     const std::string& path = s.config().camera_calibration;
     if (ImGui::Button("Write to the camera file")) {
       try {

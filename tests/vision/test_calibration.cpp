@@ -390,6 +390,35 @@ TEST(CalibrateCameraCli, CalibratesFromRenderedBoardsAndMarkers) {
   EXPECT_EQ(std::string((std::istreambuf_iterator<char>(backup_in)), {}), first);
   fs::remove(backup);
 
+  // Extrinsics alone (no --images): the paper's three markers in camera coordinates, the
+  // intrinsics kept from --base.
+  const std::string three = dir + "/../spidar_vision_three_" + std::to_string(getpid()) + ".yaml";
+  {
+    std::ofstream file(three);
+    file << "markers:\n";
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& m = kMarkers[k];
+      const Vec3 c = cam.to_camera(m);
+      file << "  - {world: [" << m.x() << ", " << m.y() << ", " << m.z() << "], camera: [" << c.x() << ", " << c.y()
+        << ", " << c.z() << "]}\n";
+    }
+  }
+  const std::string out3 = dir + "/../spidar_vision_camera_three_" + std::to_string(getpid()) + ".yaml";
+  const auto ex = run("calibrate-camera --markers " + three + " --base " + out + " --out " + out3);
+  ASSERT_EQ(ex.code, 0) << ex.err;
+  EXPECT_NE(ex.out.find("\"method\":\"three-marker\""), std::string::npos) << ex.out;
+  const auto f3 = load_camera_file(out3);
+  EXPECT_EQ(f3.camera.intrinsics().fx, f.camera.intrinsics().fx);  // kept from --base, exactly
+  EXPECT_EQ(f3.camera.intrinsics().cx, f.camera.intrinsics().cx);
+  const auto e3 = pose_error(f3.camera.X_CW(), cam.X_CW());
+  EXPECT_LT(e3.position_m, 1e-4);
+  EXPECT_LT(e3.angle_deg, 0.01);
+  fs::remove(three);
+  fs::remove(out3);
+  auto neither = run("calibrate-camera --out " + out3);
+  EXPECT_EQ(neither.code, 2);
+  EXPECT_NE(neither.err.find("--images or --markers"), std::string::npos) << neither.err;
+
   // Bad input: exit code 2 and a message naming the problem.
   auto bad = run("calibrate-camera --images " + dir + " --pattern 9x9 --out " + out);
   EXPECT_EQ(bad.code, 2);
