@@ -15,7 +15,10 @@ build: deps
 	cmake --preset release >/dev/null
 	cmake --build --preset release -j $(JOBS)
 
-demo: build
+# The demo builds the spidar-mr executable only (not the tests and benchmarks).
+demo: deps
+	cmake --preset release >/dev/null
+	cmake --build --preset release -j $(JOBS) --target spidar-mr
 	$(SPIDAR_MR) demo --out $(DEMO_OUT)
 
 test: build

@@ -1,5 +1,6 @@
 #include "spidar/render/composite_metrics.hpp"
 
+#include <cmath>
 #include <opencv2/core.hpp>
 
 namespace spidar::render {
@@ -21,22 +22,44 @@ Status truth_composite_mask(const cv::Mat& mask, const cv::Mat& depth, const cv:
   return Ok{};
 }
 
-Result<double> occlusion_error_pct(const cv::Mat& alpha, const cv::Mat& truth, const cv::Mat& region) {
+Result<RegionDisagreement> region_disagreement(const cv::Mat& alpha, const cv::Mat& truth,
+                                               const cv::Mat& region) {
   if (alpha.type() != CV_32FC1 || truth.type() != CV_8UC1 || region.type() != CV_8UC1 ||
       alpha.size() != truth.size() || alpha.size() != region.size())
-    return Error{"occlusion_error_pct: expected CV_32FC1 alpha, CV_8UC1 truth and region of one size"};
-  long in = 0, wrong = 0;
+    return Error{"region_disagreement: expected CV_32FC1 alpha, CV_8UC1 truth and region of one size"};
+  RegionDisagreement d;
   for (int y = 0; y < alpha.rows; ++y) {
     const float* a = alpha.ptr<float>(y);
     const std::uint8_t* t = truth.ptr<std::uint8_t>(y);
     const std::uint8_t* r = region.ptr<std::uint8_t>(y);
     for (int x = 0; x < alpha.cols; ++x) {
       if (r[x] == 0) continue;
-      ++in;
-      if ((a[x] >= 0.5f) != (t[x] != 0)) ++wrong;
+      ++d.pixels;
+      if ((a[x] >= 0.5f) != (t[x] != 0)) ++d.wrong;
     }
   }
-  return in == 0 ? 0.0 : 100.0 * static_cast<double>(wrong) / static_cast<double>(in);
+  return d;
+}
+
+Status contested_mask(const cv::Mat& real_mask, const cv::Mat& scene_depth, cv::Mat* out) {
+  if (out == nullptr) return Error{"contested_mask: no output given"};
+  if (real_mask.type() != CV_8UC1 || scene_depth.type() != CV_32FC1 ||
+      real_mask.size() != scene_depth.size())
+    return Error{"contested_mask: expected a CV_8UC1 mask and a CV_32FC1 depth of one size"};
+  out->create(real_mask.size(), CV_8UC1);
+  for (int y = 0; y < real_mask.rows; ++y) {
+    const std::uint8_t* m = real_mask.ptr<std::uint8_t>(y);
+    const float* s = scene_depth.ptr<float>(y);
+    std::uint8_t* o = out->ptr<std::uint8_t>(y);
+    for (int x = 0; x < real_mask.cols; ++x) o[x] = m[x] != 0 && std::isfinite(s[x]) ? 255 : 0;
+  }
+  return Ok{};
+}
+
+Result<double> occlusion_error_pct(const cv::Mat& alpha, const cv::Mat& truth, const cv::Mat& region) {
+  auto d = region_disagreement(alpha, truth, region);
+  if (!d) return Error{"occlusion_error_pct: expected CV_32FC1 alpha, CV_8UC1 truth and region of one size"};
+  return d->pct();
 }
 
 }  // namespace spidar::render

@@ -64,6 +64,17 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
   if (!p) return p.error();
   m.occlusion_pct = *d;
   m.occlusion_pct_paper = *p;
+
+  // The contested pixels: the real hand over a virtual object (scene depth without the hands).
+  if (auto st = render::contested_mask(frame.hand_only, result.virt.depth, &ws->contested); !st)
+    return st.error();
+  auto cd = render::region_disagreement(depth_alpha, ws->truth_alpha, ws->contested);
+  if (!cd) return cd.error();
+  auto cp = render::region_disagreement(paper_alpha, ws->truth_alpha, ws->contested);
+  if (!cp) return cp.error();
+  m.contested_pixels = cd->pixels;
+  m.contested_wrong = cd->wrong;
+  m.contested_wrong_paper = cp->wrong;
   return m;
 }
 

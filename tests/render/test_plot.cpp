@@ -101,5 +101,36 @@ TEST(CompositeMetrics, CountsDisagreementsInsideTheRegionOnly) {
   EXPECT_FALSE(occlusion_error_pct(alpha, truth, cv::Mat(3, 3, CV_8UC1)).ok());
 }
 
+TEST(CompositeMetrics, ContestedPixelsAreTheHandOverAnObjectOnly) {
+  const float inf = std::numeric_limits<float>::infinity();
+  // A 4x6 frame: an object (finite scene depth) in columns 2..5; the real hand in columns 0..3.
+  cv::Mat hand(4, 6, CV_8UC1, cv::Scalar(0)), scene(4, 6, CV_32FC1, cv::Scalar(inf));
+  hand(cv::Rect(0, 0, 4, 4)).setTo(255);
+  scene(cv::Rect(2, 0, 4, 4)).setTo(0.5f);
+  cv::Mat contested;
+  ASSERT_TRUE(contested_mask(hand, scene, &contested).ok());
+  EXPECT_EQ(cv::countNonZero(contested), 8);  // columns 2..3
+  EXPECT_EQ(contested.at<std::uint8_t>(0, 1), 0);
+  EXPECT_EQ(contested.at<std::uint8_t>(0, 4), 0);
+  // Truth: the hand is in front in row 0 only; a composite showing the hand everywhere is wrong
+  // on rows 1..3 of the contested columns (6 of 8) but right on every uncontested hand pixel.
+  cv::Mat truth(4, 6, CV_8UC1, cv::Scalar(0));
+  truth(cv::Rect(0, 0, 2, 4)).setTo(255);
+  truth(cv::Rect(2, 0, 2, 1)).setTo(255);
+  cv::Mat alpha(4, 6, CV_32FC1, cv::Scalar(0));
+  alpha(cv::Rect(0, 0, 4, 4)).setTo(1.0f);
+  auto d = region_disagreement(alpha, truth, contested);
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d->pixels, 8);
+  EXPECT_EQ(d->wrong, 6);
+  EXPECT_DOUBLE_EQ(d->pct(), 75.0);
+  // Over the whole hand the same composite looks far better: 6 of 16.
+  auto whole = occlusion_error_pct(alpha, truth, hand);
+  ASSERT_TRUE(whole.ok());
+  EXPECT_DOUBLE_EQ(*whole, 100.0 * 6 / 16);
+  EXPECT_FALSE(contested_mask(hand, cv::Mat(3, 3, CV_32FC1), &contested).ok());
+  EXPECT_EQ(RegionDisagreement{}.pct(), 0.0);
+}
+
 }  // namespace
 }  // namespace spidar::render

@@ -21,11 +21,22 @@ struct FrameTruthMetrics {
   /// shows the real image, except on the real forearm and bracelet.
   double occlusion_pct = 0;        ///< depth-mode composite vs the truth [% of the hand region]
   double occlusion_pct_paper = 0;  ///< paper-mode composite vs the truth [%]
+  /// Contested pixels: the real hand (palm and digits) over a virtual object in the image, where
+  /// depth order decides (render::contested_mask). Counts, so a run pools them over frames.
+  long contested_pixels = 0;
+  long contested_wrong = 0;        ///< of them, where the depth composite shows the wrong one
+  long contested_wrong_paper = 0;  ///< … and the paper's composite
+  double contested_pct() const {
+    return contested_pixels > 0 ? 100.0 * static_cast<double>(contested_wrong) / static_cast<double>(contested_pixels) : 0.0;
+  }
+  double contested_pct_paper() const {
+    return contested_pixels > 0 ? 100.0 * static_cast<double>(contested_wrong_paper) / static_cast<double>(contested_pixels) : 0.0;
+  }
 };
 
 /// Reusable buffers.
 struct FrameTruthWorkspace {
-  cv::Mat model_mask, truth_alpha, region, tmp;
+  cv::Mat model_mask, truth_alpha, region, tmp, contested;
 };
 
 /// Measures `result` (which must hold both composites: FramePipelineParams::other_composite)
