@@ -67,20 +67,9 @@ int run_mr_demo(const DemoOptions& o) {
   fs::create_directories(o.out);
   fs::create_directories(fs::path(o.out) / "keyframes");
 
-  sim::RubiksTaskParams tp;
-  tp.proxy_radius = wp.proxy.radius;
   Pose X_cube0;
-  if (cube) {
-    X_cube0 = cube->core_pose();
-    tp.p_W_cube = X_cube0.p;
-  } else {
-    SceneSnapshot s0;
-    world->snapshot(s0, false);
-    reach_target(s0, &tp);
-    X_cube0.p = tp.p_W_cube;
-  }
-  auto task = std::make_shared<sim::RubiksTask>(tp);
-  const double seconds = o.seconds > 0 ? o.seconds : tp.duration;
+  auto task = make_scripted_task(*world, cube, wp.proxy.radius, truth_models, &X_cube0);
+  const double seconds = o.seconds > 0 ? o.seconds : task->params().duration;
 
   // --- threads: simulated device ↔ servo loop ↔ physics ---
   device::SimulatedSpidarParams dp;

@@ -64,7 +64,7 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
        "joint_px_left,joint_px_right,occlusion_pct,occlusion_pct_paper,contested_pixels,"
        "contested_error_pct,contested_error_pct_paper,iterations_left,"
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
-       "servo_jitter_max_us\n";
+       "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right\n";
   f << std::setprecision(6);
   for (const MrFrame& m : t.frames) {
     const auto& a = m.truth[0];
@@ -76,7 +76,8 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
       << m.iterations[1] << ',' << (m.compared ? 1 : 0) << ',';
     if (m.compared) f << m.truth[1].iou;
     f << ',' << m.lift_mm << ',' << m.u_angle_deg << ',' << m.turns << ',' << m.servo_rate_hz << ','
-      << m.servo_jitter_max_us << '\n';
+      << m.servo_jitter_max_us << ',' << m.truth_cap_residual_mm[0] << ','
+      << m.truth_cap_residual_mm[1] << '\n';
   }
 }
 

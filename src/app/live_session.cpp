@@ -271,19 +271,8 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   if (!world_r) throw UsageError(c.source + ": scene: " + world_r.error().message);
   s->world_ = std::move(world_r).value();
   if (auto cube_r = physics::RubiksCube::Attach(*s->world_)) s->cube_ = std::move(cube_r).value();
-  sim::RubiksTaskParams tp;
-  tp.proxy_radius = wp.proxy.radius;
   Pose X_cube0;
-  if (s->cube_) {
-    X_cube0 = s->cube_->core_pose();
-    tp.p_W_cube = X_cube0.p;
-  } else {
-    SceneSnapshot s0;
-    s->world_->snapshot(s0, false);
-    reach_target(s0, &tp);
-    X_cube0.p = tp.p_W_cube;
-  }
-  s->task_ = std::make_shared<sim::RubiksTask>(tp);
+  s->task_ = make_scripted_task(*s->world_, s->cube_, wp.proxy.radius, s->user_models_, &X_cube0);
   s->cube_monitor_ = std::make_unique<CubeMonitor>(&s->cube_, X_cube0);
   if (s->cube_) s->task_->track(&s->cube_monitor_->pose());
 

@@ -83,6 +83,28 @@ ServoTiming servo_timing_since(std::span<const device::FingertipSample> s, doubl
   return out;
 }
 
+std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
+                                                    const std::optional<physics::RubiksCube>& cube,
+                                                    double proxy_radius,
+                                                    const std::array<hand::HandModel, 2>& user,
+                                                    Pose* X_cube0) {
+  sim::RubiksTaskParams tp;
+  tp.proxy_radius = proxy_radius;
+  *X_cube0 = Pose{};
+  if (cube) {
+    *X_cube0 = cube->core_pose();
+    tp.p_W_cube = X_cube0->p;
+  } else {
+    SceneSnapshot s0;
+    world.snapshot(s0, false);
+    reach_target(s0, &tp);
+    X_cube0->p = tp.p_W_cube;
+  }
+  auto task = std::make_shared<sim::RubiksTask>(tp);
+  task->fit_to_hands(user);
+  return task;
+}
+
 CubeMonitor::CubeMonitor(std::optional<physics::RubiksCube>* cube, const Pose& X_cube0)
     : cube_(cube), X_cube0_(X_cube0) {}
 

@@ -4,6 +4,7 @@
 /// the cube's state as the physics thread sees it.
 #include <array>
 #include <atomic>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -14,6 +15,7 @@
 #include "spidar/device/servo_types.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
+#include "spidar/physics/world.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 #include "spidar/vision/camera.hpp"
 
@@ -30,6 +32,15 @@ std::array<hand::HandModel, 2> hand_models(const std::string& path, const std::s
 /// Where the scripted user reaches in a scene without a cube: the non-static object nearest the
 /// frame centre (its centre and half size), else the centre itself.
 void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp);
+
+/// The scripted user's task in a scene: the cube's start pose (`X_cube0`) when it has one, else the
+/// object nearest the frame centre; the script fitted to the user's own hands (`user`), so their
+/// fingers can be where the device's caps are. (One place for the demo and the live session.)
+std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
+                                                    const std::optional<physics::RubiksCube>& cube,
+                                                    double proxy_radius,
+                                                    const std::array<hand::HandModel, 2>& user,
+                                                    Pose* X_cube0);
 
 /// The servo loop's timing between two camera frames.
 struct ServoTiming {

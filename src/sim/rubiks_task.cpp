@@ -1,6 +1,8 @@
 #include "spidar/sim/rubiks_task.hpp"
 
 #include <Eigen/Geometry>
+
+#include "spidar/hand/kinematics.hpp"
 #include <algorithm>
 #include <cmath>
 
@@ -146,56 +148,69 @@ void RubiksTask::goals(double t, std::span<Vec3> goal) {
   goals_at(t, frames_, goal);
 }
 
-void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal) const {
+Vec3 RubiksTask::script_path(double t, int f) const {
   const Contacts c = contacts(p_);
   const double approach = ramp(t, 0.0, 1.0);
   const double withdraw = ramp(t, 11.3, 12.0);
-  const double close_left = closeness(t, hand::Side::kLeft);
-  const double close_right = closeness(t, hand::Side::kRight);
+  const bool right = f >= 4;
+  const Vec3& contact = right ? c.right[f - 4] : c.left[f];
+  const Vec3 open = opened(contact, p_.half);
+  // Where the hand starts and ends: the open hand moved as a whole toward its own side and up
+  // (not toward the user, where the camera is). Both ends of the approach lie outside the faces'
+  // planes (the offset toward the user is less than the opening), so the straight path between
+  // them never crosses the cube.
+  const Vec3 away = p_.withdraw * (right ? Vec3(0.75, 0.1, 0.35) : Vec3(-0.75, 0.1, 0.3));
+  const Vec3 far = open + away;
+  Vec3 p = far + (open - far) * approach + (far - open) * withdraw;
+  p += (contact - open) * closeness(t, right ? hand::Side::kRight : hand::Side::kLeft);
+  return p;
+}
+
+Vec3 RubiksTask::path(double t, int f) const {
+  const int h = f >= 4 ? 1 : 0;
+  const auto& table = fitted_[h];
+  if (table.empty()) return script_path(t, f);
+  const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
+  const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
+  const double w = x - static_cast<double>(k);
+  return (1.0 - w) * table[k][f % 4] + w * table[k + 1][f % 4];
+}
+
+void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal) const {
   for (int f = 0; f < 8 && f < static_cast<int>(goal.size()); ++f) {
     const bool right = f >= 4;
     const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
-    const Vec3& contact = right ? c.right[f - 4] : c.left[f];
-    const Vec3 open = opened(contact, p_.half);
-    // Where the hand starts and ends: the open hand moved as a whole toward its own side and up
-    // (not toward the user, where the camera is). Both ends of the approach lie outside the faces' planes (the offset toward
-    // the user is less than the opening), so the straight path between them never crosses the
-    // cube.
-    const Vec3 away = p_.withdraw * (right ? Vec3(0.75, 0.1, 0.35) : Vec3(-0.75, 0.1, 0.3));
-    const Vec3 far = open + away;
-    Vec3 p = far + (open - far) * approach + (far - open) * withdraw;
-    p += (contact - open) * (right ? close_right : close_left);
     const HandState s = state(t, side, f);
     const int h = right ? 1 : 0;
     const Quat q_WG(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
     const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
-    goal[f] = p_WG + q_WG * (rot_z(s.yaw) * p) + Vec3(0, 0, s.lift - fr.lift[h]);
+    goal[f] = p_WG + q_WG * (rot_z(s.yaw) * path(t, f)) + Vec3(0, 0, s.lift - fr.lift[h]);
   }
 }
 
-hand::HandParams RubiksTask::nominal(double t, hand::Side side) const {
+hand::HandParams RubiksTask::nominal_local(double t, hand::Side side) const {
+  const auto& table = fitted_q_[side == hand::Side::kRight ? 1 : 0];
+  if (table.empty()) return script_nominal_local(t, side);
+  const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
+  const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
+  const double w = x - static_cast<double>(k);
+  hand::HandParams q = table[k];
+  q.q = (1.0 - w) * table[k].q + w * table[k + 1].q;  // neighbours 10 ms apart: small steps
+  return q;
+}
+
+hand::HandParams RubiksTask::script_nominal_local(double t, hand::Side side) const {
   const bool right = side == hand::Side::kRight;
   const Contacts c = contacts(p_);
   const auto& cs = right ? c.right : c.left;
-  // The wrist follows the fingertips' mean displacement from the grasp.
-  const GraspFrames fr = published_.read().value_or(frames_);
-  const int h = right ? 1 : 0;
-  const Quat qg(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
-  const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
-  std::array<Vec3, 8> g;
-  goals_at(t, fr, g);
-  const HandState s = state(t, side, 0);
-  const Vec3 up(0, 0, s.lift - fr.lift[h]);
-  const Mat3 R = qg.toRotationMatrix() * rot_z(s.yaw);  // the grasp frame, turned
+  // The wrist follows the fingertips' mean displacement from the grasp (the script's path: the
+  // nominal pose does not depend on the hands it was fitted to).
   Vec3 shift = Vec3::Zero();
-  for (int f = 0; f < 4; ++f) {
-    const Vec3 rel = R.transpose() * (g[(right ? 4 : 0) + f] - p_WG - up);
-    shift += (rel - cs[f]) / 4.0;
-  }
+  for (int f = 0; f < 4; ++f) shift += (script_path(t, (right ? 4 : 0) + f) - cs[f]) / 4.0;
   const Nominal n = nominal_grasp(side);
   hand::HandParams q;
-  const Eigen::AngleAxisd aa(R * n.R);
-  q.set_wrist(p_WG + R * (n.p_wrist + shift) + up, aa.angle() * aa.axis());
+  const Eigen::AngleAxisd aa(n.R);
+  q.set_wrist(n.p_wrist + shift, aa.angle() * aa.axis());
   // A relaxed grip: more flexion as the hand closes.
   const double k = 0.3 + 0.7 * closeness(t, side);
   q[hand::kThumbCmcFlexion] = 0.2 * k;
@@ -203,6 +218,20 @@ hand::HandParams RubiksTask::nominal(double t, hand::Side side) const {
   q[hand::kThumbIp] = 0.2 + 0.3 * k;
   for (int p : {hand::kIndexMcpFlexion, hand::kMiddleMcpFlexion, hand::kRingMcpFlexion}) q[p] = 0.2 + 0.5 * k;
   for (int p : {hand::kIndexDip, hand::kMiddleDip, hand::kRingDip}) q[p] = 0.2 + 0.5 * k;
+  return q;
+}
+
+hand::HandParams RubiksTask::nominal(double t, hand::Side side) const {
+  const int h = side == hand::Side::kRight ? 1 : 0;
+  const GraspFrames fr = published_.read().value_or(frames_);
+  const Quat qg(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
+  const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
+  const HandState s = state(t, side, 0);
+  const Vec3 up(0, 0, s.lift - fr.lift[h]);
+  const Mat3 R = qg.toRotationMatrix() * rot_z(s.yaw);  // the grasp frame, turned
+  hand::HandParams q = nominal_local(t, side);
+  const Eigen::AngleAxisd aa(R * hand::hand_pose(q).R);
+  q.set_wrist(p_WG + R * q.p_W_wrist() + up, aa.angle() * aa.axis());
   return q;
 }
 

@@ -8,7 +8,23 @@
 namespace spidar::sim {
 namespace {
 
-registration::RegistrationParams ik_params(const UserHandsParams& p) {
+/// Mean distance of the hand's fingertip caps from the observed ones [m] (0 without any).
+double mean_cap_distance(const hand::HandModel& model, const hand::HandParams& q,
+                         const registration::HandObservation& obs) {
+  const hand::HandPoints pts = hand::forward_kinematics(model, q);
+  double sum = 0;
+  int n = 0;
+  for (int f = 0; f < hand::kFingertipCount; ++f) {
+    if (!obs.fingertip_valid[f]) continue;
+    sum += (pts.p_W_fingertip[f] - obs.p_W_fingertip[f]).norm();
+    ++n;
+  }
+  return n > 0 ? sum / n : 0.0;
+}
+
+}  // namespace
+
+registration::RegistrationParams fingertip_ik_params(const UserHandsParams& p) {
   registration::RegistrationParams r;
   r.fingertip_sigma_m = p.fingertip_sigma_m;
   r.prior_sigma_wrist_m = p.wrist_sigma_m;
@@ -21,11 +37,9 @@ registration::RegistrationParams ik_params(const UserHandsParams& p) {
   return r;
 }
 
-}  // namespace
-
 UserHands::UserHands(const std::array<hand::HandModel, 2>& truth, const RubiksTask& task,
                      const UserHandsParams& params)
-    : truth_(truth), task_(task), p_(params), solver_(ik_params(params)) {}
+    : truth_(truth), task_(task), p_(params), solver_(fingertip_ik_params(params)) {}
 
 void UserHands::update(double t, std::span<const Vec3> caps) {
   for (int h = 0; h < 2; ++h) {
@@ -40,10 +54,12 @@ void UserHands::update(double t, std::span<const Vec3> caps) {
       obs.fingertip_valid[f] = caps[k].allFinite();
     }
     obs.wrist_px.reset();
-    // First frame: many iterations from the nominal pose; then a warm start.
+    // First frame: many iterations from the nominal pose; then a warm start, with more rounds
+    // while the caps are not yet reached (a fast motion between two frames).
     const int rounds = first_ ? 8 : 1;
-    for (int r = 0; r < rounds; ++r) {
+    for (int r = 0; r < rounds + p_.extra_rounds; ++r) {
       solver_.fit(truth_[h], obs, registration::ImageEvidence{}, &nominal, &q_[h]);
+      if (r + 1 >= rounds && mean_cap_distance(truth_[h], q_[h], obs) <= p_.target_residual_m) break;
     }
     q_[h].little_independent = true;
     q_[h].little = Vec3(q_[h][hand::kRingMcpFlexion], q_[h][hand::kRingMcpAbduction],
@@ -53,15 +69,7 @@ void UserHands::update(double t, std::span<const Vec3> caps) {
     q_[h].little.x() = std::clamp(q_[h].little.x(), lim.lower[hand::kRingMcpFlexion], lim.upper[hand::kRingMcpFlexion]);
     q_[h].little.y() = std::clamp(q_[h].little.y(), lim.lower[hand::kRingMcpAbduction], lim.upper[hand::kRingMcpAbduction]);
     q_[h].little.z() = std::clamp(q_[h].little.z(), lim.lower[hand::kRingDip], lim.upper[hand::kRingDip]);
-    const hand::HandPoints pts = hand::forward_kinematics(truth_[h], q_[h]);
-    double sum = 0;
-    int n = 0;
-    for (int f = 0; f < hand::kFingertipCount; ++f) {
-      if (!obs.fingertip_valid[f]) continue;
-      sum += (pts.p_W_fingertip[f] - obs.p_W_fingertip[f]).norm();
-      ++n;
-    }
-    residual_[h] = n > 0 ? sum / n : 0.0;
+    residual_[h] = mean_cap_distance(truth_[h], q_[h], obs);
   }
   first_ = false;
 }

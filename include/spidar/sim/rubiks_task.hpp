@@ -24,11 +24,13 @@
 /// while held is grasped where it is (up to its 90° symmetry about its vertical axis).
 #include <array>
 #include <span>
+#include <vector>
 
 #include "spidar/core/pose.hpp"
 #include "spidar/core/seqlock.hpp"
 #include "spidar/core/types.hpp"
 #include "spidar/device/fingertip_source.hpp"
+#include "spidar/hand/hand_model.hpp"
 #include "spidar/hand/parameters.hpp"
 
 namespace spidar::sim {
@@ -55,6 +57,15 @@ struct CubePoseSample {
 class RubiksTask final : public device::FingertipSource {
  public:
   explicit RubiksTask(RubiksTaskParams p);
+  /// Makes the script reachable by these hands (left, right: the user's own): each hand's
+  /// fingertip goals, in its grasp frame, are replaced by the nearest fingertip positions the
+  /// hand can take (inverse kinematics along the script, every `dt_s`; linear in between).
+  /// Without it the goals are the script's contact layout, which a hand of another size may not
+  /// reach (adjacent caps closer than fingers are wide): the user's fingers could then not be
+  /// where the device's caps are. Call before the task is shared with other threads.
+  void fit_to_hands(const std::array<hand::HandModel, 2>& hands, double dt_s = 0.01);
+  /// How far the fitted paths move the script's goals, per hand (max over the script) [m].
+  const std::array<double, 2>& fit_shift_max_m() const { return fit_shift_max_; }
   /// Follow the cube's published pose (must outlive the task); nullptr = the start pose.
   void track(const core::Latest<CubePoseSample>* cube) { cube_ = cube; }
   /// Goals of the eight fingertips at time t [s] (world, m).
@@ -86,10 +97,24 @@ class RubiksTask final : public device::FingertipSource {
   /// True while a hand approaches for a grasp: then it follows the cube's pose.
   static bool looks_for_grasp(double t_s, hand::Side side);
   void goals_at(double t_s, const GraspFrames& frames, std::span<Vec3> p_W_goal) const;
+  /// Finger f's (0..7) goal in its hand's grasp frame before the hand's yaw and lift: the
+  /// script's contact path, or the fitted path when fit_to_hands was called.
+  Vec3 path(double t_s, int f) const;
+  Vec3 script_path(double t_s, int f) const;
+  /// The nominal pose of one hand in its grasp frame (before yaw and lift): the pose fitted to
+  /// the hand's path when fit_to_hands was called, else script_nominal_local.
+  hand::HandParams nominal_local(double t_s, hand::Side side) const;
+  /// The script's relaxed grip around its contact layout, in the grasp frame.
+  hand::HandParams script_nominal_local(double t_s, hand::Side side) const;
   RubiksTaskParams p_;
   const core::Latest<CubePoseSample>* cube_ = nullptr;
   GraspFrames frames_;                      ///< servo thread's copy
   core::Latest<GraspFrames> published_;     ///< for nominal()
+  /// Fitted fingertip paths (fit_to_hands): per hand, 4 fingertips every fit_dt_ seconds.
+  std::array<std::vector<std::array<Vec3, 4>>, 2> fitted_;
+  std::array<std::vector<hand::HandParams>, 2> fitted_q_;  ///< the poses that reach them
+  double fit_dt_ = 0.0;
+  std::array<double, 2> fit_shift_max_{0.0, 0.0};
 };
 
 }  // namespace spidar::sim

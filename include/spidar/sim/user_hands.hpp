@@ -22,12 +22,19 @@ struct UserHandsParams {
   double wrist_sigma_m = 0.10;         ///< freedom of the wrist around the nominal pose [m]
   double rotation_sigma_rad = 1.0;     ///< ... of the hand's rotation [rad]
   double joint_sigma_rad = 1.5;        ///< ... of the finger joints [rad]
-  int iterations = 40;                 ///< per update (warm start)
+  int iterations = 40;                 ///< per round of an update (warm start)
+  /// Rounds an update may add while the caps' mean residual exceeds target_residual_m.
+  int extra_rounds = 4;
+  double target_residual_m = 0.0002;
   /// The little finger's own posture relative to the ring finger's (MCP flexion, abduction, DIP)
   /// [rad]; it also sways with this amplitude [rad] at 0.7 Hz, as a real little finger does.
   Vec3 little_offset{0.15, 0.06, 0.12};
   double little_sway = 0.12;
 };
+
+/// The registration solver's settings for fitting a hand to fingertip positions alone (no image),
+/// tight on the caps, loose around the prior: the user's inverse kinematics.
+registration::RegistrationParams fingertip_ik_params(const UserHandsParams& params);
 
 class UserHands {
  public:
