@@ -1,10 +1,14 @@
 #include "spidar/core/config.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
+#include <new>
 #include <sstream>
+
+#include "spidar/core/file_read.hpp"
+#include "yaml_checks.hpp"
 
 namespace spidar::core {
 namespace {
@@ -19,7 +23,12 @@ std::string format_location(const std::string& file, int line, const std::string
 }
 
 const char* type_name(const YAML::Node& n) {
-  switch (n.Type()) {
+  YAML::NodeType::value type = YAML::NodeType::Undefined;
+  try {
+    type = n.Type();
+  } catch (const YAML::Exception&) {
+  }
+  switch (type) {
     case YAML::NodeType::Null:
       return "nothing";
     case YAML::NodeType::Scalar:
@@ -30,6 +39,21 @@ const char* type_name(const YAML::Node& n) {
       return "a map";
     default:
       return "an undefined node";
+  }
+}
+
+/// Runs `body` (an accessor's work on yaml-cpp nodes) so that no yaml-cpp exception leaves it:
+/// any is reported at `node` as `expectation`. ConfigError and std::bad_alloc pass through.
+template <typename Body>
+decltype(auto) guarded(const ConfigNode& node, std::string_view expectation, Body&& body) {
+  try {
+    return body();
+  } catch (const SpidarError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception&) {
+    node.fail(expectation);
   }
 }
 
@@ -46,53 +70,86 @@ ConfigNode::ConfigNode(std::shared_ptr<const YAML::Node> node,
                        std::shared_ptr<const std::string> file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
 
-ConfigNode ConfigNode::LoadFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, 0, "", "cannot open file (does it exist and is it readable?)");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return Parse(ss.str(), path);
+ConfigNode ConfigNode::LoadFile(const std::string& path, std::size_t max_bytes) {
+  std::string text;
+  try {
+    text = read_file_bounded(path, max_bytes, "a config file");
+  } catch (const FileError& e) {
+    throw ConfigError(printable_for_message(path), 0, "", e.reason());
+  }
+  return Parse(text, printable_for_message(path));
 }
 
 ConfigNode ConfigNode::Parse(std::string_view text, const std::string& name) {
   auto file = std::make_shared<const std::string>(name);
-  try {
-    auto node = std::make_shared<const YAML::Node>(YAML::Load(std::string(text)));
-    ConfigNode root(node, file, "");
-    if (!node->IsMap()) root.fail("expected a YAML map at the top level");
-    return root;
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(name, e.mark.is_null() ? 0 : e.mark.line + 1, "",
-                      "malformed YAML: " + e.msg);
+  const YamlLimits limits{kMaxConfigNesting, kMaxConfigNodes};
+  const std::string too_deep = "expected at most " + std::to_string(limits.max_depth) +
+                               " levels of nested maps and sequences";
+  if (const int line = find_excess_nesting(text, limits.max_depth); line > 0) {
+    throw ConfigError(name, line, "", too_deep);
   }
+  std::shared_ptr<const YAML::Node> node;
+  try {
+    node = std::make_shared<const YAML::Node>(YAML::Load(std::string(text)));
+    check_yaml_tree(*node, name, limits);
+  } catch (const SpidarError&) {
+    throw;
+  } catch (const YAML::DeepRecursion& e) {
+    throw ConfigError(name, e.mark.is_null() ? 0 : e.mark.line + 1, "", too_deep);
+  } catch (const YAML::Exception& e) {
+    std::string what = "malformed YAML: " + describe_parser_error(e);
+    if (!e.mark.is_null()) what += " (column " + std::to_string(e.mark.column + 1) + ")";
+    throw ConfigError(name, e.mark.is_null() ? 0 : e.mark.line + 1, "", what);
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception&) {
+    throw ConfigError(name, 0, "", "malformed YAML: the YAML parser failed");
+  }
+  ConfigNode root(node, file, "");
+  if (!node->IsMap()) root.fail("expected a YAML map at the top level");
+  return root;
 }
 
 int ConfigNode::line() const {
-  const auto mark = node_->Mark();
-  return mark.is_null() ? 0 : mark.line + 1;
+  try {
+    const auto mark = node_->Mark();
+    return mark.is_null() ? 0 : mark.line + 1;
+  } catch (const YAML::Exception&) {
+    return 0;
+  }
 }
 
-bool ConfigNode::is_map() const { return node_->IsMap(); }
-bool ConfigNode::is_sequence() const { return node_->IsSequence(); }
-bool ConfigNode::is_null() const { return !node_->IsDefined() || node_->IsNull(); }
+bool ConfigNode::is_map() const {
+  return guarded(*this, "expected a valid node", [&] { return node_->IsMap(); });
+}
+bool ConfigNode::is_sequence() const {
+  return guarded(*this, "expected a valid node", [&] { return node_->IsSequence(); });
+}
+bool ConfigNode::is_null() const {
+  return guarded(*this, "expected a valid node",
+                 [&] { return !node_->IsDefined() || node_->IsNull(); });
+}
 
 std::string ConfigNode::child_path(std::string_view key) const {
-  return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  return child_key_path(path_, key);
 }
 
 std::string ConfigNode::child_path(std::size_t i) const {
-  return path_ + "[" + std::to_string(i) + "]";
+  return child_index_path(path_, i);
 }
 
 bool ConfigNode::has(std::string_view key) const {
-  return node_->IsMap() && (*node_)[std::string(key)].IsDefined();
+  return guarded(*this, "expected a map",
+                 [&] { return node_->IsMap() && (*node_)[std::string(key)].IsDefined(); });
 }
 
 std::optional<ConfigNode> ConfigNode::find(std::string_view key) const {
-  if (!node_->IsMap()) fail(std::string("expected a map, got ") + type_name(*node_));
-  YAML::Node child = (*node_)[std::string(key)];
-  if (!child.IsDefined()) return std::nullopt;
-  return ConfigNode(std::make_shared<const YAML::Node>(child), file_, child_path(key));
+  if (!is_map()) fail(std::string("expected a map, got ") + type_name(*node_));
+  return guarded(*this, "expected a map", [&]() -> std::optional<ConfigNode> {
+    YAML::Node child = (*node_)[std::string(key)];
+    if (!child.IsDefined()) return std::nullopt;
+    return ConfigNode(std::make_shared<const YAML::Node>(child), file_, child_path(key));
+  });
 }
 
 ConfigNode ConfigNode::operator[](std::string_view key) const {
@@ -102,83 +159,99 @@ ConfigNode ConfigNode::operator[](std::string_view key) const {
 }
 
 std::vector<std::string> ConfigNode::keys() const {
-  if (!node_->IsMap()) fail(std::string("expected a map, got ") + type_name(*node_));
-  std::vector<std::string> out;
-  for (const auto& kv : *node_) out.push_back(kv.first.as<std::string>());
-  return out;
+  if (!is_map()) fail(std::string("expected a map, got ") + type_name(*node_));
+  return guarded(*this, "expected a map with plain keys", [&] {
+    std::vector<std::string> out;
+    for (const auto& kv : *node_) out.push_back(kv.first.Scalar());
+    return out;
+  });
 }
 
 void ConfigNode::expect_keys(std::initializer_list<std::string_view> allowed) const {
-  for (const auto& kv : *node_) {
-    const auto key = kv.first.as<std::string>();
-    bool known = false;
-    for (auto a : allowed) known = known || (a == key);
-    if (known) continue;
-    std::string list;
-    for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-    const auto mark = kv.first.Mark();
-    throw ConfigError(*file_, mark.is_null() ? line() : mark.line + 1, child_path(key),
-                      "unknown key; expected one of: " + list);
-  }
+  if (is_null()) return;
+  if (!is_map()) fail(std::string("expected a map, got ") + type_name(*node_));
+  guarded(*this, "expected a map with plain keys", [&] {
+    for (const auto& kv : *node_) {
+      const std::string& key = kv.first.Scalar();
+      bool known = false;
+      for (auto a : allowed) known = known || (a == key);
+      if (known) continue;
+      std::string list;
+      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      const auto mark = kv.first.Mark();
+      const int key_line = mark.is_null() ? line() : mark.line + 1;
+      throw ConfigError(*file_, key_line, child_path(key_for_path(key, key_line)),
+                        "unknown key; expected one of: " + list);
+    }
+  });
 }
 
 std::size_t ConfigNode::size() const {
-  if (!node_->IsSequence()) fail(std::string("expected a sequence, got ") + type_name(*node_));
-  return node_->size();
+  if (!is_sequence()) fail(std::string("expected a sequence, got ") + type_name(*node_));
+  return guarded(*this, "expected a sequence", [&] { return node_->size(); });
 }
 
 ConfigNode ConfigNode::at(std::size_t i) const {
   if (i >= size()) fail("index " + std::to_string(i) + " out of range");
-  return ConfigNode(std::make_shared<const YAML::Node>((*node_)[i]), file_, child_path(i));
+  return guarded(*this, "expected a sequence", [&] {
+    return ConfigNode(std::make_shared<const YAML::Node>((*node_)[i]), file_, child_path(i));
+  });
+}
+
+const std::string& ConfigNode::scalar(std::string_view expected) const {
+  const bool scalar = guarded(*this, expected, [&] { return node_->IsScalar(); });
+  if (!scalar) fail(std::string(expected) + ", got " + type_name(*node_));
+  return guarded(*this, expected, [&]() -> const std::string& { return node_->Scalar(); });
 }
 
 double ConfigNode::as_double() const {
-  if (!node_->IsScalar()) fail(std::string("expected a number, got ") + type_name(*node_));
+  const std::string& text = scalar("expected a number");
   double v = 0.0;
   try {
     v = node_->as<double>();
-  } catch (const YAML::Exception&) {
-    fail("expected a number, got '" + node_->Scalar() + "'");
+  } catch (const std::exception&) {
+    fail("expected a number, got " + quoted_for_message(text));
   }
-  if (!std::isfinite(v)) fail("expected a finite number, got '" + node_->Scalar() + "'");
+  if (!std::isfinite(v)) fail("expected a finite number, got " + quoted_for_message(text));
   return v;
 }
 
 std::int64_t ConfigNode::as_int() const {
-  if (!node_->IsScalar()) fail(std::string("expected an integer, got ") + type_name(*node_));
+  const std::string& text = scalar("expected an integer");
   try {
     return node_->as<std::int64_t>();
-  } catch (const YAML::Exception&) {
-    fail("expected an integer, got '" + node_->Scalar() + "'");
+  } catch (const std::exception&) {
+    fail("expected an integer, got " + quoted_for_message(text));
   }
 }
 
 bool ConfigNode::as_bool() const {
-  if (!node_->IsScalar()) fail(std::string("expected true or false, got ") + type_name(*node_));
+  const std::string& text = scalar("expected true or false");
   try {
     return node_->as<bool>();
-  } catch (const YAML::Exception&) {
-    fail("expected true or false, got '" + node_->Scalar() + "'");
+  } catch (const std::exception&) {
+    fail("expected true or false, got " + quoted_for_message(text));
   }
 }
 
 std::string ConfigNode::as_string() const {
-  if (!node_->IsScalar()) fail(std::string("expected a string, got ") + type_name(*node_));
-  return node_->Scalar();
+  return scalar("expected a string");
 }
 
 std::vector<double> ConfigNode::as_doubles() const {
-  if (!node_->IsSequence()) {
+  if (!is_sequence()) {
     fail(std::string("expected a sequence of numbers, got ") + type_name(*node_));
   }
   std::vector<double> out;
-  for (std::size_t i = 0; i < node_->size(); ++i) out.push_back(at(i).as_double());
+  const std::size_t n = size();
+  for (std::size_t i = 0; i < n; ++i) out.push_back(at(i).as_double());
   return out;
 }
 
 Vec3 ConfigNode::as_vec3() const {
-  if (!node_->IsSequence()) fail(std::string("expected 3 numbers, got ") + type_name(*node_));
-  if (node_->size() != 3) fail("expected 3 numbers, got " + std::to_string(node_->size()));
+  if (!is_sequence()) fail(std::string("expected 3 numbers, got ") + type_name(*node_));
+  const std::size_t n = size();
+  if (n != 3) fail("expected 3 numbers, got " + std::to_string(n));
   return {at(0).as_double(), at(1).as_double(), at(2).as_double()};
 }
 

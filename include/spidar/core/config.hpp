@@ -5,6 +5,17 @@
 /// A `ConfigNode` is a position in a parsed document: the file name, the key path from the
 /// root and the line it came from. Accessors check the type and throw `ConfigError` with that
 /// location. Parsers of module configs take a `ConfigNode`, so they stay free of file I/O.
+///
+/// Loading is strict and bounded, since a config path or its text may come from anyone:
+///   - `LoadFile` reads only regular files of at most `kMaxConfigFileBytes` (see
+///     `read_file_bounded`): no directories, FIFOs or devices, no NUL in the path.
+///   - `Parse` refuses nesting of maps/sequences deeper than `kMaxConfigNesting` (checked on the
+///     raw text before yaml-cpp parses it, and again on the tree), more than `kMaxConfigNodes`
+///     values (aliases expanded), keys that are maps or sequences, and duplicate keys in a map.
+///   - Every failure is a `ConfigError` `file:line: key: expectation`; no yaml-cpp exception
+///     escapes, and messages do not quote the file's content except short plain words (a bad
+///     number such as 'abc', a key name), so a file that is not a config is not echoed.
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 #include <memory>
@@ -38,11 +49,26 @@ class ConfigError : public SpidarError {
   std::string expectation_;
 };
 
+/// The largest config file `LoadFile` reads, in bytes: 1 MiB. Our configs are a few KiB; yaml-cpp
+/// needs about 230 bytes of memory per byte of a dense list such as `[0,0,...]` (a 1 MiB one took
+/// 243 MB and 2.2 s to load here), so this also bounds what a hostile file can cost.
+inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{1} << 20;
+/// The deepest nesting of maps and sequences a config may have; the top-level map is level 1.
+inline constexpr int kMaxConfigNesting = 64;
+/// The most values a config may hold, counting an aliased value each time it is used (bounds
+/// "billion laughs" documents, whose aliases expand exponentially).
+inline constexpr std::size_t kMaxConfigNodes = 1'000'000;
+
 class ConfigNode {
  public:
-  /// Parses a YAML file. Throws ConfigError (with the file name) if it is missing or malformed.
-  static ConfigNode LoadFile(const std::string& path);
-  /// Parses YAML text; `name` stands for the file in messages.
+  /// Reads (at most `max_bytes`, see `read_file_bounded`) and parses a YAML file. Throws
+  /// ConfigError (with the file name) if it is missing, not a regular file, too large, or does
+  /// not pass `Parse`.
+  static ConfigNode LoadFile(const std::string& path, std::size_t max_bytes = kMaxConfigFileBytes);
+  /// Parses YAML text; `name` stands for the file in messages. Throws ConfigError if the text is
+  /// malformed, nests deeper than `kMaxConfigNesting`, holds more than `kMaxConfigNodes` values,
+  /// repeats a key in a map (`duplicate key 'device' (first at line 3)`), has a map or sequence
+  /// as a key, or is not a map at the top level.
   static ConfigNode Parse(std::string_view text, const std::string& name);
 
   const std::string& file() const { return *file_; }
@@ -60,7 +86,8 @@ class ConfigNode {
   std::optional<ConfigNode> find(std::string_view key) const;
   /// Keys of a map in document order.
   std::vector<std::string> keys() const;
-  /// Rejects keys not in `allowed` (catches typos such as `fulcrum:`).
+  /// Rejects keys not in `allowed` (catches typos such as `fulcrum:`). A null node (an empty
+  /// value) has no keys; a scalar or a sequence is an error.
   void expect_keys(std::initializer_list<std::string_view> allowed) const;
 
   /// Number of entries of a sequence (error if not a sequence).
@@ -85,6 +112,8 @@ class ConfigNode {
  private:
   ConfigNode(std::shared_ptr<const YAML::Node> node, std::shared_ptr<const std::string> file,
              std::string path);
+  /// This node's scalar text; fails with `expected` if the node is not a scalar.
+  const std::string& scalar(std::string_view expected) const;
   std::string child_path(std::string_view key) const;
   std::string child_path(std::size_t i) const;
 
