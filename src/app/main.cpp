@@ -1,5 +1,6 @@
 // spidar-mr: command-line entry point. Bad input exits with code 2 and a message on stderr.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 
 #include "cli_support.hpp"
@@ -58,6 +59,10 @@ int main(int argc, char** argv) {
     }
   } catch (const spidar::SpidarError& e) {
     std::cerr << "spidar-mr: error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // An unwritable or misplaced output path: name it, it is the user's to fix.
+    std::cerr << "spidar-mr: error: " << e.path1().string() << ": " << e.code().message() << "\n";
     return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "spidar-mr: internal error: " << e.what() << "\n";
