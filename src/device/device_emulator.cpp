@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <string>
 #include <thread>
 
 #include "spidar/core/clock.hpp"
@@ -10,13 +12,26 @@
 
 namespace spidar::device {
 
+Status validate(const DeviceEmulatorOptions& options) {
+  const double t = options.heartbeat_timeout_s;
+  if (t > 0.0 && t <= kMaxHeartbeatTimeoutS) return Ok{};
+  char msg[256];
+  std::snprintf(msg, sizeof msg,
+                "device emulator: heartbeat timeout %g s is out of range; expected > 0 and <= %g s "
+                "(the device's watchdog must stop the motors within %g s of losing the host)",
+                t, kMaxHeartbeatTimeoutS, kMaxHeartbeatTimeoutS);
+  return Error{std::string(msg)};
+}
+
 DeviceEmulator::DeviceEmulator(Device& backend, int fd, DeviceEmulatorOptions options)
     : backend_(backend),
       fd_(fd),
       options_(options),
       start_ns_(core::monotonic_ns()),
       limit_min_(backend.info().command_min),
-      limit_max_(backend.info().command_max) {}
+      limit_max_(backend.info().command_max) {
+  if (Status s = validate(options_); !s) throw SpidarError(s.error().message);
+}
 
 EmulatorCounters DeviceEmulator::counters() const {
   std::lock_guard<std::mutex> lock(published_mutex_);

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/device/link_budget.hpp"
 
 namespace spidar::device {
 namespace {
@@ -149,6 +150,11 @@ void SerialDevice::close() {
     (void)port_.write_all({tx_.data(), n}, config_.read_timeout_s);  // best effort
   }
   port_.close();
+}
+
+Status SerialDevice::check_rate(double rate_hz) const {
+  if (!config_.check_link_budget || port_.baud_ignored()) return Ok{};
+  return check_link_budget(info_.name.c_str(), config_.baud, config_.string_count, rate_hz);
 }
 
 DeviceStatus SerialDevice::status() const {

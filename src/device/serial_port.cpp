@@ -2,7 +2,10 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/file.h>
 #include <sys/ioctl.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -139,6 +142,13 @@ unsigned baud_to_speed(int baud) {
   return 0;
 }
 
+int standard_baud_at_least(double baud) {
+  for (const auto& e : kBauds) {  // ascending
+    if (static_cast<double>(e.baud) >= baud) return e.baud;
+  }
+  return 0;
+}
+
 namespace {
 
 /// The error for a baud rate termios cannot set, naming the port and the rates it can.
@@ -190,31 +200,57 @@ Status make_raw(int fd, int baud, const std::string& what) {
 SerialPort::~SerialPort() { close(); }
 
 SerialPort::SerialPort(SerialPort&& other) noexcept
-    : fd_(std::exchange(other.fd_, -1)), path_(std::move(other.path_)) {}
+    : fd_(std::exchange(other.fd_, -1)),
+      path_(std::move(other.path_)),
+      baud_ignored_(std::exchange(other.baud_ignored_, false)) {}
 
 SerialPort& SerialPort::operator=(SerialPort&& other) noexcept {
   if (this != &other) {
     close();
     fd_ = std::exchange(other.fd_, -1);
     path_ = std::move(other.path_);
+    baud_ignored_ = std::exchange(other.baud_ignored_, false);
   }
   return *this;
 }
 
 void SerialPort::close() {
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ >= 0) {
+    // Give the tty back: TIOCEXCL would outlive this descriptor on a tty whose other side stays
+    // open (a pty slave while its master lives). The flock goes with the descriptor.
+    (void)::ioctl(fd_, TIOCNXCL);
+    ::close(fd_);
+  }
   fd_ = -1;
+  baud_ignored_ = false;
 }
 
 Result<SerialPort> SerialPort::open(const std::string& path, int baud) {
   std::string what = "serial port ";
   what += path;
   if (baud_to_speed(baud) == 0) return unsupported_baud(what, baud);  // before touching the device
+  auto in_use = [&what] {
+    std::string msg = what;
+    msg += ": in use by another process (it holds the port exclusively; close it first)";
+    return Error{msg};
+  };
   const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
+    if (errno == EBUSY) return in_use();  // another holder set TIOCEXCL
     std::string msg = what;
     msg += ": cannot open (";
     msg += errno_text(errno);
+    msg += ")";
+    return Error{msg};
+  }
+  // flock before TIOCEXCL: a port someone else holds must not lose its TIOCEXCL to our close().
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int e = errno;
+    ::close(fd);
+    if (e == EWOULDBLOCK) return in_use();
+    std::string msg = what;
+    msg += ": cannot lock (flock: ";
+    msg += errno_text(e);
     msg += ")";
     return Error{msg};
   }
@@ -222,6 +258,16 @@ Result<SerialPort> SerialPort::open(const std::string& path, int baud) {
   port.fd_ = fd;
   port.path_ = path;
   if (Status s = make_raw(fd, baud, what); !s) return s.error();
+  if (::ioctl(fd, TIOCEXCL) != 0) {
+    std::string msg = what;
+    msg += ": cannot take the port exclusively (TIOCEXCL: ";
+    msg += errno_text(errno);
+    msg += ")";
+    return Error{msg};
+  }
+  struct stat st {};
+  constexpr unsigned kUsbAcmMajor = 166;  // Linux: /dev/ttyACM*
+  port.baud_ignored_ = ::fstat(fd, &st) == 0 && S_ISCHR(st.st_mode) && major(st.st_rdev) == kUsbAcmMajor;
   tcflush(fd, TCIOFLUSH);
   return port;
 }

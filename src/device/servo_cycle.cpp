@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "spidar/strings/motor.hpp"
 #include "spidar/strings/position.hpp"
@@ -26,6 +27,9 @@ ServoCycle::ServoCycle(const strings::DeviceConfig& config, const DeviceInfo& de
     offset += f.geometry.n;
   }
   unwrap_.assign(offset, strings::CounterUnwrapper(device_.counter_bits));
+  counts_.assign(offset, 0);
+  lengths_.assign(offset, 0.0);
+  residual_.assign(config_.fingers.size(), std::numeric_limits<double>::quiet_NaN());
 }
 
 void ServoCycle::measure(const EncoderReading& reading, FingertipSample& sample) {
@@ -40,14 +44,18 @@ void ServoCycle::measure(const EncoderReading& reading, FingertipSample& sample)
     for (int i = 0; i < n; ++i) {
       const std::int64_t count = unwrap_[off + i].update(reading.counts[off + i]);
       l[i] = strings::counts_to_length(fc.channels[i], count);
+      counts_[off + i] = count;
+      lengths_[off + i] = l[i];
       valid = valid && std::isfinite(l[i]) && l[i] >= 0.0;
     }
+    residual_[f] = std::numeric_limits<double>::quiet_NaN();
     if (!valid) {  // checked here so the solver's error path (which allocates) is never taken
       ++inconsistent_;
       continue;
     }
     const auto est = strings::solve_position(fc.geometry, std::span<const double>(l.data(), n));
     if (!est.ok()) continue;
+    residual_[f] = est->residual;
     if (est->consistent) {
       sample.consistent |= 1u << f;
     } else {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
 #include <cstring>
 
 #include "spidar/core/clock.hpp"
@@ -15,9 +16,20 @@
 namespace spidar::device {
 namespace {
 
-constexpr std::uint32_t kSafeStateFaults =
-    kFaultDeadlineMiss | kFaultForceStall | kFaultEmergencyStop | kFaultWatchdog |
-    kFaultStaleCounts;
+/// Every latched fault holds the safe state until reset_faults(): the loop's own (deadline,
+/// force stall, emergency stop, watchdog, stale counts), the device's status bits and the
+/// reading checks (workspace, inconsistent, encoder glitch, frozen clock).
+constexpr std::uint32_t kSafeStateFaults = ~std::uint32_t{0};
+
+ReadingLimits reading_limits(const ServoConfig& s) {
+  ReadingLimits l;
+  l.period_s = 1.0 / std::max(s.rate_hz, 1.0);
+  l.workspace_margin_m = s.workspace_margin_m;
+  l.max_inconsistent_cycles = s.max_inconsistent_cycles;
+  l.max_fingertip_speed_mps = s.max_fingertip_speed_mps;
+  l.max_frozen_clock_readings = s.max_frozen_clock_readings;
+  return l;
+}
 
 /// q-quantile [µs] of a histogram with 1 µs bins.
 double percentile(const std::vector<std::uint32_t>& hist, double q) {
@@ -56,6 +68,7 @@ ServoLoop::ServoLoop(Device& device, const strings::DeviceConfig& config, ServoC
       force_(std::move(force)),
       period_ns_(static_cast<std::int64_t>(1e9 / std::max(servo_.rate_hz, 1.0))),
       cycle_maths_(config, device.info()),
+      checks_(config, device.info(), reading_limits(servo_)),
       commands_(config.string_count(), device.info().command_min),
       jitter_hist_(kBins, 0),
       compute_hist_(kBins, 0) {
@@ -68,6 +81,24 @@ ServoLoop::ServoLoop(Device& device, const strings::DeviceConfig& config, ServoC
     throw SpidarError("ServoLoop: max_repeated_readings " +
                       std::to_string(servo_.max_repeated_readings) + "; expected >= 0");
   }
+  if (!(std::isfinite(servo_.workspace_margin_m) && servo_.workspace_margin_m >= 0.0)) {
+    throw SpidarError("ServoLoop: workspace_margin_m " + std::to_string(servo_.workspace_margin_m) +
+                      " m; expected a finite margin >= 0 m");
+  }
+  if (servo_.max_inconsistent_cycles < 0) {
+    throw SpidarError("ServoLoop: max_inconsistent_cycles " +
+                      std::to_string(servo_.max_inconsistent_cycles) + "; expected >= 0");
+  }
+  if (!(std::isfinite(servo_.max_fingertip_speed_mps) && servo_.max_fingertip_speed_mps > 0.0)) {
+    throw SpidarError("ServoLoop: max_fingertip_speed_mps " +
+                      std::to_string(servo_.max_fingertip_speed_mps) +
+                      " m/s; expected a finite speed > 0 m/s");
+  }
+  if (servo_.max_frozen_clock_readings < 2) {
+    throw SpidarError("ServoLoop: max_frozen_clock_readings " +
+                      std::to_string(servo_.max_frozen_clock_readings) +
+                      "; expected >= 2 (a device clock in µs may read the same twice)");
+  }
 }
 
 ServoLoop::~ServoLoop() { stop(); }
@@ -75,6 +106,9 @@ ServoLoop::~ServoLoop() { stop(); }
 Status ServoLoop::start() {
   if (running_.load()) return Error{"servo loop already running"};
   if (!device_.status().open) return Error{"servo loop: device " + device_.info().name + " is not open"};
+  if (Status budget = device_.check_rate(servo_.rate_hz); !budget) {
+    return Error{"servo loop: " + budget.error().message};
+  }
   stop_.store(false);
   running_.store(true, std::memory_order_release);
   thread_ = std::thread([this] { run(); });
@@ -93,12 +127,33 @@ void ServoLoop::wait() {
   if (monitor_thread_.joinable()) monitor_thread_.join();
 }
 
-void ServoLoop::latch(std::uint32_t fault) { faults_.fetch_or(fault, std::memory_order_acq_rel); }
+std::uint32_t ServoLoop::latch(std::uint32_t faults, const char* format, ...) noexcept {
+  if ((faults_.load(std::memory_order_acquire) & faults) == faults) return 0;  // nothing new
+  const std::uint32_t fresh = faults & ~faults_.fetch_or(faults, std::memory_order_acq_rel);
+  if (fresh != 0) {
+    std::va_list args;
+    va_start(args, format);
+    fault_log_.vrecordf(fresh, format, args);
+    va_end(args);
+  }
+  return fresh;
+}
+
+void ServoLoop::latch_findings() {
+  device_.request_safe_state();
+  std::array<char, FaultLog::kTextSize> text;
+  for (int i = 0; i < findings_.count; ++i) {
+    const ReadingFault& f = findings_.items[static_cast<std::size_t>(i)];
+    if (faults_.load(std::memory_order_acquire) & f.fault) continue;  // latched before: no text
+    latch(f.fault, "%s", checks_.describe(f, text));
+  }
+}
 
 void ServoLoop::emergency_stop() {
   estop_.store(true, std::memory_order_release);
   device_.request_safe_state();
-  latch(kFaultEmergencyStop);
+  latch(kFaultEmergencyStop, "emergency stop requested through ServoLoop::emergency_stop() at cycle %llu",
+        static_cast<unsigned long long>(cycle_.load(std::memory_order_acquire)));
 }
 
 void ServoLoop::reset_faults() {
@@ -112,15 +167,23 @@ void ServoLoop::monitor() {
   const auto window_ns = std::max<std::int64_t>(
       static_cast<std::int64_t>(servo_.deadline_periods * static_cast<double>(period_ns_)), 1'000'000);
   std::uint64_t last = cycle_.load(std::memory_order_acquire);
-  std::int64_t next = core::monotonic_ns() + 4 * window_ns;  // grace for start-up
+  std::int64_t last_progress_ns = core::monotonic_ns();  // when `last` was first seen
+  std::int64_t next = last_progress_ns + 4 * window_ns;  // grace for start-up
   while (running_.load(std::memory_order_acquire) && !stop_.load(std::memory_order_acquire)) {
     core::sleep_until_ns(std::min(next, core::monotonic_ns() + 1'000'000));
     if (core::monotonic_ns() < next) continue;
     const std::uint64_t now_cycles = cycle_.load(std::memory_order_acquire);
     if (now_cycles == last && running_.load(std::memory_order_acquire)) {
       device_.request_safe_state();
-      latch(kFaultWatchdog);
+      latch(kFaultWatchdog,
+            "monitor: the servo thread completed no cycle for %.3f ms (bound %.3f ms = "
+            "deadline_periods %g x period %.3f ms, at least 1 ms; 4 times that before the "
+            "first cycle); stuck in cycle %llu (a read, the force source or the scheduler)",
+            static_cast<double>(core::monotonic_ns() - last_progress_ns) * 1e-6,
+            static_cast<double>(window_ns) * 1e-6, servo_.deadline_periods,
+            static_cast<double>(period_ns_) * 1e-6, static_cast<unsigned long long>(now_cycles));
     }
+    if (now_cycles != last) last_progress_ns = core::monotonic_ns();
     last = now_cycles;
     next = core::monotonic_ns() + window_ns;
   }
@@ -159,47 +222,74 @@ void ServoLoop::run() {
     }
     prev_wake = wake;
     last_wake_ns_ = wake;
+    sample_.cycle = cycle_.load(std::memory_order_relaxed);
+    const auto cycle_no = static_cast<unsigned long long>(sample_.cycle);
     if (wake - deadline > late_limit) {  // the safe state within this cycle
       device_.request_safe_state();
-      latch(kFaultDeadlineMiss);
+      latch(kFaultDeadlineMiss,
+            "cycle %llu woke %.3f ms after its deadline (bound %.3f ms = deadline_periods %g x "
+            "period %.3f ms)",
+            cycle_no, static_cast<double>(wake - deadline) * 1e-6,
+            static_cast<double>(late_limit) * 1e-6, servo_.deadline_periods,
+            static_cast<double>(period_ns_) * 1e-6);
     }
 
     reading.repeats = 0;  // backends that never repeat a reading do not touch it
     if (auto st = device_.read(reading); !st.ok()) {
       device_.request_safe_state();
-      latch(device_.status().faults | kFaultDisconnected);
-      fault_message_ = st.error().message;
+      latch(device_.status().faults | kFaultDisconnected, "cycle %llu: %s", cycle_no,
+            st.error().message.c_str());
       break;
     }
+    // What the device says about itself comes first: the safe state before anything is computed.
+    findings_.clear();
+    checks_.check_status(reading, sample_.cycle, findings_);
+    if (findings_.faults != 0) latch_findings();
     if (reading.repeats > 0) {
       ++repeated_readings_;
       longest_repeat_ = std::max<std::uint64_t>(longest_repeat_, reading.repeats);
       if (reading.repeats > static_cast<std::uint32_t>(servo_.max_repeated_readings)) {
         device_.request_safe_state();
-        latch(kFaultStaleCounts);
+        latch(kFaultStaleCounts,
+              "cycle %llu ran on the same device reading for the %u-th time in a row (bound "
+              "max_repeated_readings %d): the device's answers stopped arriving (all strings)",
+              cycle_no, reading.repeats, servo_.max_repeated_readings);
       }
     }
-    sample_.cycle = cycle_.load(std::memory_order_relaxed);
     cycle_maths_.measure(reading, sample_);
+    if (reading.repeats == 0) {  // a repeated reading was checked when it was new
+      findings_.clear();
+      checks_.check_measurement(reading, cycle_maths_, sample_, findings_);
+      if (findings_.faults != 0) latch_findings();
+    }
     force_->forces(sample_, force_frame_);
     if (wake - force_frame_.t_ns > core::s_to_ns(servo_.force_timeout_s)) {
       device_.request_safe_state();
-      latch(kFaultForceStall);
+      latch(kFaultForceStall,
+            "cycle %llu: the force source's forces are %.3f ms old (bound force_timeout_s %.3f ms; "
+            "all fingers)",
+            cycle_no, static_cast<double>(wake - force_frame_.t_ns) * 1e-6,
+            servo_.force_timeout_s * 1e3);
     }
     sample_.faults = faults_.load(std::memory_order_acquire);
     const bool safe = (sample_.faults & kSafeStateFaults) || estop_.load(std::memory_order_acquire);
     cycle_maths_.command(force_frame_, safe, sample_, commands_);
     // A cycle that ran far past its deadline (a stall in the read or the force source) must not
     // send the commands it computed from old data.
-    if (cycle_.load(std::memory_order_relaxed) > 0 && core::monotonic_ns() - deadline > late_limit) {
+    if (const std::int64_t late = core::monotonic_ns() - deadline;
+        cycle_.load(std::memory_order_relaxed) > 0 && late > late_limit) {
       device_.request_safe_state();
-      latch(kFaultDeadlineMiss);
+      latch(kFaultDeadlineMiss,
+            "cycle %llu ended %.3f ms after its deadline (bound %.3f ms = deadline_periods %g x "
+            "period %.3f ms); its commands were replaced by the minimum",
+            cycle_no, static_cast<double>(late) * 1e-6, static_cast<double>(late_limit) * 1e-6,
+            servo_.deadline_periods, static_cast<double>(period_ns_) * 1e-6);
       std::fill(commands_.begin(), commands_.end(), device_.info().command_min);
     }
     if (auto st = device_.write(commands_); !st.ok()) {
       device_.request_safe_state();
-      latch(device_.status().faults | kFaultDisconnected);
-      fault_message_ = st.error().message;
+      latch(device_.status().faults | kFaultDisconnected, "cycle %llu: %s", cycle_no,
+            st.error().message.c_str());
       break;
     }
     if (reading.repeats == 0) ring_.push(sample_);
@@ -231,6 +321,7 @@ ServoStats ServoLoop::stats() const {
   ServoStats s;
   s.cycles = cycle_.load(std::memory_order_acquire);
   s.faults = faults_.load(std::memory_order_acquire);
+  s.fault_message = fault_log_.describe(s.faults);  // lock-free: safe while running too
   if (running_.load(std::memory_order_acquire)) return s;  // histograms belong to the servo thread
   s.seconds = core::ns_to_s(last_wake_ns_ - first_wake_ns_);
   const std::uint64_t periods = s.cycles > first_timed_cycle_ + 1 ? s.cycles - 1 - first_timed_cycle_ : 0;
@@ -245,7 +336,6 @@ ServoStats ServoLoop::stats() const {
   s.repeated_readings = repeated_readings_;
   s.longest_repeat = longest_repeat_;
   s.inconsistent = cycle_maths_.inconsistent();
-  s.fault_message = fault_message_;
   s.realtime_scheduling = realtime_granted_;
   return s;
 }

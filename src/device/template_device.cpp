@@ -19,6 +19,7 @@ class TemplateDevice final : public Device {
     info_.counter_bits = 24;   // (1) your counters' width
     info_.command_min = 0;     //     DAC count for the minimum tension
     info_.command_max = 4095;  //     full-scale DAC count
+    info_.device_clock = false;  //   true if read() fills device_time_us from the hardware's clock
     hw_counts_.assign(string_count, 0);
     hw_commands_.assign(string_count, 0);
   }
@@ -44,7 +45,7 @@ class TemplateDevice final : public Device {
     // (3) Read every counter from your hardware. On a lost device, latch the fault and return
     //     an error: faults_ |= kFaultDisconnected; return Error{...};
     out.host_time_ns = core::monotonic_ns();
-    out.device_time_us = 0;
+    out.device_time_us = 0;  // the hardware's own µs clock, if it has one (see device_clock)
     out.status_flags = faults_.load();
     out.string_count = info_.string_count;
     for (int i = 0; i < info_.string_count; ++i) out.counts[i] = hw_counts_[i];

@@ -42,6 +42,7 @@ class RecordingDevice final : public Device {
   }
   void clear_safe_state() override { inner_.clear_safe_state(); }
   DeviceStatus status() const override { return inner_.status(); }
+  Status check_rate(double rate_hz) const override { return inner_.check_rate(rate_hz); }
 
   std::int32_t min_command() const { return min_.load(); }
   std::int32_t max_command() const { return max_.load(); }

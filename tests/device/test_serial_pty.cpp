@@ -229,14 +229,17 @@ TEST(SerialDevice, EmulatorEnforcesHostLimitsToo) {
   ASSERT_TRUE(dev.open().ok());
   EncoderReading r;
   ASSERT_TRUE(dev.read(r).ok());
-  // Bypass the host's clamping: a raw SetCommands frame.
+  // Bypass the host's clamping: a raw SetCommands frame, on the port the host has let go of (it
+  // holds it exclusively while open; its close() sends minimums, 10 and 10, first).
+  dev.close();
   Result<SerialPort> raw = SerialPort::open(link.slave_path, 921600);
-  ASSERT_TRUE(raw.ok());
+  ASSERT_TRUE(raw.ok()) << raw.error().message;
   std::array<std::uint8_t, protocol::kMaxFrameSize> buf{};
   const std::array<std::int16_t, 2> wild{-1000, 30000};
   const std::size_t n = protocol::encode_set_commands(buf, 77, wild);
   ASSERT_EQ(write_all(raw->fd(), {buf.data(), n}, 1.0).status, IoStatus::kOk);
-  ASSERT_TRUE(PtyLink::wait_until([&] { return link.fake.writes() >= 1; }));
+  ASSERT_TRUE(PtyLink::wait_until(
+      [&] { return link.fake.last_commands() == std::vector<std::int32_t>{10, 20}; }));
   EXPECT_EQ(link.fake.last_commands(), (std::vector<std::int32_t>{10, 20}));
 }
 

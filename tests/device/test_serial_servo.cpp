@@ -21,6 +21,7 @@ TEST(SerialServo, LoopKeepsCyclingOnTheLastCountsWhileTheDeviceIsSilent) {
   link.start_emulator();
   SerialDeviceConfig c = link.config(cfg.string_count());
   c.reply_wait_s = 0.0;  // as device-test drives it
+  c.baud = 2000000;      // 24 strings at 1 kHz need 1.66 Mbaud (link_budget.hpp)
   SerialDevice dev(c);
   ASSERT_TRUE(dev.open().ok());
   ServoConfig servo;

@@ -110,7 +110,8 @@ TEST(ServoLoop, CycleBodyDoesNotAllocate) {
   loop.stop();
   EXPECT_GE(loop.cycles(), start + 1000);
   EXPECT_EQ(alloc::count(), 0);
-  EXPECT_GT(rig.rec.max_command(), rig.sim.info().command_min);  // forces were displayed
+  EXPECT_GT(rig.rec.max_command(), rig.sim.info().command_min)  // forces were displayed
+      << fault_names(loop.faults()) << ": " << loop.fault_message();
 }
 
 TEST(ServoLoop, CommandsNeverLeaveTheMotorLimitsWhateverTheForces) {
@@ -136,7 +137,8 @@ TEST(ServoLoop, CommandsNeverLeaveTheMotorLimitsWhateverTheForces) {
   loop.stop();
   EXPECT_GE(rig.rec.min_command(), rig.sim.info().command_min);
   EXPECT_LE(rig.rec.max_command(), rig.sim.info().command_max);
-  EXPECT_EQ(rig.rec.max_command(), rig.sim.info().command_max);  // saturated, not wrapped
+  EXPECT_EQ(rig.rec.max_command(), rig.sim.info().command_max)  // saturated, not wrapped
+      << fault_names(loop.faults()) << ": " << loop.fault_message();
   // Wild forces are not a fault (a loaded machine may still make a cycle late).
   EXPECT_EQ(loop.faults() & ~(kFaultDeadlineMiss | kFaultWatchdog), 0u) << fault_names(loop.faults());
 }
@@ -174,6 +176,8 @@ TEST(ServoLoop, StalledForceProducerTripsTheSafeStateWithinOneCycle) {
     }
   }
   EXPECT_GE(rig.rec.safe_requests(), 1);
+  EXPECT_TRUE(loop.stats().fault_message.find("force_stall: cycle ") != std::string::npos)
+      << loop.stats().fault_message;
 }
 
 TEST(ServoLoop, MissedDeadlineTripsTheSafeState) {
@@ -196,6 +200,8 @@ TEST(ServoLoop, MissedDeadlineTripsTheSafeState) {
   const auto s = loop.stats();
   EXPECT_GE(s.overruns, 1u);
   EXPECT_GE(s.jitter_max_us, 15000.0);
+  EXPECT_NE(s.fault_message.find("deadline_miss: cycle "), std::string::npos) << s.fault_message;
+  EXPECT_NE(s.fault_message.find("deadline_periods 5"), std::string::npos) << s.fault_message;
   // Latched: cleared only on request.
   loop.reset_faults();
   EXPECT_FALSE(loop.faults() & kFaultDeadlineMiss);
@@ -214,6 +220,9 @@ TEST(ServoLoop, MonitorCatchesAServoThreadStuckInARead) {
   EXPECT_TRUE(loop.faults() & kFaultWatchdog) << fault_names(loop.faults());
   EXPECT_GE(rig.rec.safe_requests(), 1);
   loop.stop();
+  EXPECT_NE(loop.fault_message().find("watchdog: monitor: the servo thread completed no cycle"),
+            std::string::npos)
+      << loop.fault_message();
 }
 
 TEST(ServoLoop, DisconnectEndsTheLoopCleanlyWithTheFault) {
@@ -249,6 +258,10 @@ TEST(ServoLoop, EmergencyStopHoldsMinimumTensionUntilReset) {
   ASSERT_EQ(loop.newest_samples(&s, 1), 1u);
   EXPECT_TRUE(s.faults & kFaultEmergencyStop);
   for (int f = 0; f < 8; ++f) EXPECT_EQ(s.f_W[f][2], 0.0);
+  EXPECT_NE(loop.fault_message().find("emergency_stop: emergency stop requested through "
+                                      "ServoLoop::emergency_stop()"),
+            std::string::npos)
+      << loop.fault_message();
   loop.reset_faults();
   wait_for_cycles(loop, loop.cycles() + 20);
   ASSERT_EQ(loop.newest_samples(&s, 1), 1u);
@@ -280,6 +293,7 @@ class LateAnswers final : public Device {
   void request_safe_state() override { inner_.request_safe_state(); }
   void clear_safe_state() override { inner_.clear_safe_state(); }
   DeviceStatus status() const override { return inner_.status(); }
+  Status check_rate(double rate_hz) const override { return inner_.check_rate(rate_hz); }
 
  private:
   Device& inner_;
@@ -341,6 +355,11 @@ TEST(ServoLoop, TooManyLateReadingsInARowTripTheSafeState) {
   EXPECT_TRUE(loop.faults() & kFaultStaleCounts) << fault_names(loop.faults());
   EXPECT_GE(safe_requests, 1);
   EXPECT_EQ(loop.stats().longest_repeat, 8u);
+  EXPECT_NE(loop.stats().fault_message.find("stale_counts: cycle 107 ran on the same device "
+                                            "reading for the 8-th time in a row (bound "
+                                            "max_repeated_readings 7)"),
+            std::string::npos)
+      << loop.stats().fault_message;
   // Latched: the samples after the fault (fresh readings again) display no force.
   FingertipSample s;
   ASSERT_EQ(loop.newest_samples(&s, 1), 1u);

@@ -31,7 +31,19 @@ enum Fault : std::uint32_t {
   kFaultDeadlineMiss = 1u << 6,   ///< the servo loop missed its deadline by too much
   kFaultForceStall = 1u << 7,     ///< the force producer stopped delivering
   kFaultStaleCounts = 1u << 8,    ///< the device gave no new reading for too many cycles in a row
+  // Host-side checks of the readings (the servo loop; a firmware never sets these bits):
+  kFaultWorkspace = 1u << 9,      ///< a solved fingertip left the device's workspace
+  kFaultInconsistent = 1u << 10,  ///< a finger's string lengths disagreed for too many cycles
+  kFaultEncoderGlitch = 1u << 11, ///< a string's length jumped faster than a fingertip can move
+  kFaultFrozenClock = 1u << 12,   ///< the device's clock stopped while the host's ran on
 };
+
+/// The bits a device may report in `EncoderReading::status_flags` (docs/protocol.md: bits 0–7).
+/// Any other bit set by a device is a protocol fault.
+inline constexpr std::uint32_t kDeviceStatusBits = 0xFFu;
+
+/// The name of one fault bit ("over_current"), or nullptr for a bit without a name.
+const char* fault_name(std::uint32_t bit);
 
 /// Names of the set fault bits, e.g. "disconnected,read_timeout".
 std::string fault_names(std::uint32_t faults);
@@ -43,6 +55,9 @@ struct DeviceInfo {
   int counter_bits = 24;           ///< width of the signed, wrapping encoder counters
   std::int32_t command_min = 0;    ///< smallest motor command (DAC counts) = minimum tension
   std::int32_t command_max = 4095; ///< largest motor command (DAC counts)
+  /// Readings carry the device's own clock in `EncoderReading::device_time_us`. The servo loop
+  /// faults when that clock stops (kFaultFrozenClock); a backend without a clock sets false.
+  bool device_clock = true;
 };
 
 /// One reading of every encoder.
@@ -88,6 +103,15 @@ class Device {
   /// Leaves the safe state (the servo loop calls this when it starts).
   virtual void clear_safe_state() = 0;
   virtual DeviceStatus status() const = 0;
+
+  /// Whether the device's link can serve `rate_hz` servo cycles per second; the servo loop asks
+  /// before it starts and refuses to start on an error (which says what limits the rate and what
+  /// would lift it). Default: no known limit. The serial backend checks its baud rate. A wrapper
+  /// that forwards to another device must forward this too.
+  virtual Status check_rate(double rate_hz) const {
+    (void)rate_hz;
+    return Ok{};
+  }
 };
 
 }  // namespace spidar::device

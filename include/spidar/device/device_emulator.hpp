@@ -27,9 +27,17 @@
 
 namespace spidar::device {
 
+/// Longest heartbeat timeout a device may be given [s]: its watchdog must stop the motors
+/// within a second of losing the host (a timeout of 1e9 s would switch the watchdog off).
+inline constexpr double kMaxHeartbeatTimeoutS = 1.0;
+
 struct DeviceEmulatorOptions {
-  double heartbeat_timeout_s = 0.1;  ///< watchdog: longest gap between commands/heartbeats [s]
+  /// Watchdog: longest gap between commands/heartbeats [s], in (0, kMaxHeartbeatTimeoutS].
+  double heartbeat_timeout_s = 0.1;
 };
+
+/// Ok, or an error saying which option is out of range and what is expected.
+Status validate(const DeviceEmulatorOptions& options);
 
 struct EmulatorCounters {
   std::uint64_t frames_in = 0;       ///< valid frames decoded
@@ -42,7 +50,8 @@ struct EmulatorCounters {
 
 class DeviceEmulator {
  public:
-  /// Serves `fd` (not owned, not closed) with `backend` (must outlive the emulator).
+  /// Serves `fd` (not owned, not closed) with `backend` (must outlive the emulator). Throws
+  /// SpidarError if the options are invalid (`validate`).
   DeviceEmulator(Device& backend, int fd, DeviceEmulatorOptions options = {});
 
   /// Waits up to `timeout_s` [s] for host bytes (less if the watchdog is due), handles every

@@ -26,6 +26,9 @@
 /// of every Counts frame except kFaultWatchdog, which the device raises and clears itself (it is
 /// reported per reading in `EncoderReading::status_flags`). `open()` clears the latched faults.
 ///
+/// The port is held exclusively (SerialPort::open): a second open, from this or another process,
+/// fails with "serial port PATH: in use by another process".
+///
 /// No allocation in `read()`/`write()` unless they return an error.
 #include <atomic>
 #include <cstdint>
@@ -52,6 +55,10 @@ struct SerialDeviceConfig {
   /// reading it has [s]. 0: never wait (servo loops: the answer to the previous cycle's write has
   /// had a whole period to arrive). Keep it well below the servo period.
   double reply_wait_s = 0.0;
+  /// `check_rate` refuses a servo rate whose SetCommands + Counts frames do not fit the baud rate
+  /// (link_budget.hpp). Skipped by itself on USB CDC-ACM ports (the baud rate is ignored there);
+  /// false skips it on any port (e.g. a pseudo-terminal standing in for a faster transport).
+  bool check_link_budget = true;
 };
 
 /// Counters of the host side of the link.
@@ -88,6 +95,11 @@ class SerialDevice final : public Device {
   void request_safe_state() override { safe_.store(true, std::memory_order_release); }
   void clear_safe_state() override { safe_.store(false, std::memory_order_release); }
   DeviceStatus status() const override;
+
+  /// The link budget at `rate_hz` (link_budget.hpp): an error naming the port, baud rate,
+  /// strings, rate and the minimum baud rate needed when the frames of one cycle do not fit.
+  /// Ok on CDC-ACM ports and with `check_link_budget` false.
+  Status check_rate(double rate_hz) const override;
 
   /// Asks the device to zero the counters of the strings in `mask` (bit i = string i).
   Status zero_counters(std::uint32_t mask = 0xFFFFFFFFu);

@@ -42,6 +42,8 @@ IoResult write_all(int fd, std::span<const std::uint8_t> data, double timeout_s)
 /// The termios speed for a baud rate, or 0 if the rate is not one of the standard Linux rates
 /// (9600 … 4000000).
 unsigned baud_to_speed(int baud);
+/// The smallest standard rate ≥ `baud`, or 0 if even 4000000 is less.
+int standard_baud_at_least(double baud);
 /// Puts an open tty in raw mode at `baud` (0 keeps the current speed). Errors name `what`.
 Status make_raw(int fd, int baud, const std::string& what);
 
@@ -57,7 +59,11 @@ class SerialPort {
 
   /// Opens `path` (any tty: /dev/ttyACM0, /dev/ttyUSB0, a pty slave) in raw mode at `baud`,
   /// non-blocking, without making it the controlling terminal, and discards stale input.
-  /// Errors name the path and the errno text; an unsupported baud rate is an error.
+  /// The port is held exclusively: TIOCEXCL (further open()s of the tty fail with EBUSY, except
+  /// for root) and flock(LOCK_EX | LOCK_NB) (what other serial tools check, and what stops a
+  /// second process even when it runs as root). A port another process holds is the error
+  /// "serial port PATH: in use by another process". Other errors name the path and the errno
+  /// text; an unsupported baud rate is an error.
   static Result<SerialPort> open(const std::string& path, int baud);
 
   IoResult read_some(std::span<std::uint8_t> out, double timeout_s) {
@@ -71,10 +77,14 @@ class SerialPort {
   bool is_open() const { return fd_ >= 0; }
   int fd() const { return fd_; }
   const std::string& path() const { return path_; }
+  /// True for a USB CDC-ACM port (/dev/ttyACM*, character major 166): the device ignores the baud
+  /// rate and the USB link carries the frames at its own speed.
+  bool baud_ignored() const { return baud_ignored_; }
 
  private:
   int fd_ = -1;
   std::string path_;
+  bool baud_ignored_ = false;
 };
 
 /// A pseudo-terminal pair: the master side (for the device emulator) and the path of the slave

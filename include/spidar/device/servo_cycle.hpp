@@ -3,6 +3,7 @@
 /// lengths → fingertip positions; desired forces → tensions → motor commands. `ServoLoop` runs it
 /// at a fixed rate; benchmarks and offline replays call it directly. Allocates nothing after
 /// construction.
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -19,7 +20,8 @@ class ServoCycle {
   ServoCycle(const strings::DeviceConfig& config, const DeviceInfo& device);
 
   /// Counts → positions into `sample` (t_ns, p_W, consistent). A finger whose lengths are
-  /// invalid or inconsistent keeps its previous position and is counted in `inconsistent()`.
+  /// invalid keeps its previous position; invalid and inconsistent solves are counted in
+  /// `inconsistent()`. What was measured stays readable below until the next call.
   void measure(const EncoderReading& reading, FingertipSample& sample);
 
   /// Forces → motor commands (clamped to the device's range) and the displayed forces into
@@ -30,6 +32,17 @@ class ServoCycle {
   int string_count() const { return static_cast<int>(unwrap_.size()); }
   std::uint64_t inconsistent() const { return inconsistent_; }
 
+  // --- the last `measure`, per device string k (0 … string_count−1) or finger f ---
+  /// Unwrapped encoder counts of each string.
+  std::span<const std::int64_t> counts() const { return counts_; }
+  /// Length of each string [m].
+  std::span<const double> lengths() const { return lengths_; }
+  /// RMS length residual of each finger's solve [m]; NaN if its lengths were invalid or the
+  /// solve failed.
+  std::span<const double> residuals() const { return residual_; }
+  /// First string of each finger (its strings are string_offset(f) … + n − 1).
+  int string_offset(int finger) const { return string_offset_[finger]; }
+
  private:
   const strings::DeviceConfig& config_;
   DeviceInfo device_;
@@ -37,6 +50,9 @@ class ServoCycle {
   std::vector<strings::CounterUnwrapper> unwrap_;
   std::vector<int> string_offset_;  // first string index of each finger
   std::uint64_t inconsistent_ = 0;
+  std::vector<std::int64_t> counts_;  // per string, unwrapped
+  std::vector<double> lengths_;       // per string [m]
+  std::vector<double> residual_;      // per finger [m]
 };
 
 }  // namespace spidar::device

@@ -14,6 +14,15 @@
 /// thread itself stops cycling. A device error (disconnect, timeout) puts the device in its safe
 /// state and ends the loop with the fault reported.
 ///
+/// Device faults reach the safe state within the cycle their reading arrives (reading_checks.hpp):
+/// status bits the device reports (over-current, emergency stop, …) are checked right after the
+/// read, before anything is computed; after the positions are solved, a string length that jumps
+/// faster than a fingertip can move (kFaultEncoderGlitch), a device clock that stopped
+/// (kFaultFrozenClock), a fingertip outside the workspace (kFaultWorkspace) and a finger whose
+/// lengths stay inconsistent (kFaultInconsistent). Every latched fault holds the safe state until
+/// `reset_faults()`, and has a line of text in `ServoStats::fault_message` saying what, where
+/// (finger, string) and the value against its bound, written on the cycle it latched (fault_log.hpp).
+///
 /// Late readings: a device may return its previous reading again (`EncoderReading::repeats` > 0;
 /// the serial backend does when the answer to the last commands has not arrived yet). The loop
 /// then runs the cycle on the last counts, as drivers of USB SPIDARs do, counts it, and does not
@@ -30,7 +39,9 @@
 
 #include "spidar/core/seqlock.hpp"
 #include "spidar/device/device.hpp"
+#include "spidar/device/fault_log.hpp"
 #include "spidar/device/force_source.hpp"
+#include "spidar/device/reading_checks.hpp"
 #include "spidar/device/servo_cycle.hpp"
 #include "spidar/device/servo_types.hpp"
 #include "spidar/strings/device_config.hpp"
@@ -46,6 +57,19 @@ struct ServoConfig {
   /// Consecutive cycles that may run on a repeated (late) device reading; one more trips the
   /// safe state (kFaultStaleCounts). 20 cycles = 5 ms at 4 kHz, 20 ms at 1 kHz.
   int max_repeated_readings = 20;
+  /// A solved fingertip farther than this outside the box of the device's fulcrums latches
+  /// kFaultWorkspace in that cycle [m], ≥ 0. SPIDAR-8's box is 0.73 × 0.57 × 0.46 m.
+  double workspace_margin_m = 0.1;
+  /// Consecutive new readings a finger's lengths may fail to meet in one point (or be invalid);
+  /// one more latches kFaultInconsistent. ≥ 0. 5 = 5 ms at 1 kHz.
+  int max_inconsistent_cycles = 5;
+  /// Fastest a fingertip moves [m/s], > 0. A string whose length changes by more than this speed
+  /// allows between two readings (plus kGlitchSlackCounts counts) latches kFaultEncoderGlitch.
+  /// 10 m/s = 10 mm per period at 1 kHz, 342 SPIDAR-8 counts.
+  double max_fingertip_speed_mps = 10.0;
+  /// New readings in a row on which the device's clock (`device_time_us`) may not advance while
+  /// the host's does; reaching it latches kFaultFrozenClock. ≥ 2. 10 = 10 ms at 1 kHz.
+  int max_frozen_clock_readings = 10;
   double max_seconds = 0.0;       ///< > 0: stop by itself after this long
   /// Runs in the servo thread before the first cycle (tests: allocation counters).
   std::function<void()> on_thread_start;
@@ -62,7 +86,9 @@ struct ServoStats {
   std::uint64_t longest_repeat = 0;     ///< longest run of consecutive cycles on repeated readings
   std::uint64_t inconsistent = 0;   ///< finger solves flagged inconsistent
   std::uint32_t faults = 0;         ///< latched Fault bits
-  std::string fault_message;        ///< the error that ended the loop, if any
+  /// What each latched fault was, first fault first: "name: what, which finger/string, value vs
+  /// bound; …" (FaultLog::describe). Empty when no fault is latched.
+  std::string fault_message;
   bool realtime_scheduling = false; ///< SCHED_FIFO was granted
 };
 
@@ -76,7 +102,8 @@ class ServoLoop {
   ServoLoop(const ServoLoop&) = delete;
   ServoLoop& operator=(const ServoLoop&) = delete;
 
-  /// Starts the servo and monitor threads. Errors if already running or the device is closed.
+  /// Starts the servo and monitor threads. Errors if already running, the device is closed, or
+  /// its link cannot carry the rate (`Device::check_rate`).
   Status start();
   /// Stops the threads (device left in its safe state). Idempotent.
   void stop();
@@ -86,7 +113,9 @@ class ServoLoop {
 
   /// Safe state now, from any thread; latched until `reset_faults()`.
   void emergency_stop();
-  /// Clears latched faults (not device faults) and leaves the safe state.
+  /// Clears the loop's latched faults (a backend's own `status().faults` stay) and leaves the
+  /// safe state. A condition that still holds (a status bit the device still reports, a finger
+  /// still outside the workspace) latches again within a cycle.
   void reset_faults();
 
   /// Newest fingertip samples, newest first (lock-free; any thread).
@@ -95,13 +124,20 @@ class ServoLoop {
   }
   std::uint64_t cycles() const { return cycle_.load(std::memory_order_acquire); }
   std::uint32_t faults() const { return faults_.load(std::memory_order_acquire); }
+  /// What each latched fault was (as ServoStats::fault_message); any thread, lock-free.
+  std::string fault_message() const { return fault_log_.describe(faults()); }
   /// Statistics; complete once the loop has ended, approximate while it runs.
   ServoStats stats() const;
 
  private:
   void run();
   void monitor();
-  void latch(std::uint32_t fault);
+  /// Latches `faults`; for the bits not latched before, records the text (printf `format`).
+  /// Returns the newly latched bits. No allocation.
+  std::uint32_t latch(std::uint32_t faults, const char* format, ...) noexcept
+      __attribute__((format(printf, 3, 4)));
+  /// Safe state first, then latches what `findings_` holds, with their texts.
+  void latch_findings();
 
   Device& device_;
   ServoConfig servo_;
@@ -110,6 +146,8 @@ class ServoLoop {
 
   // Preallocated cycle state.
   ServoCycle cycle_maths_;
+  ReadingChecks checks_;
+  ReadingFindings findings_;
   std::vector<std::int32_t> commands_;
   FingertipSample sample_;
   ForceFrame force_frame_;
@@ -122,7 +160,7 @@ class ServoLoop {
   std::uint64_t first_timed_cycle_ = 0;  ///< the first cycle is untimed (device handshake)
   std::uint64_t overruns_ = 0;
   std::uint64_t repeated_readings_ = 0, longest_repeat_ = 0;
-  std::string fault_message_;
+  FaultLog fault_log_;
   bool realtime_granted_ = false;
 
   core::SampleRing<FingertipSample, 1024> ring_;
