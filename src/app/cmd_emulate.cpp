@@ -47,7 +47,8 @@ Action add_emulate_device(CLI::App& app) {
   cmd->add_option("--seed", a->seed, "random seed of the simulated device")->capture_default_str();
   return [a] {
     if (a->seconds < 0) throw UsageError("--seconds: expected >= 0");
-    if (!(a->heartbeat_timeout > 0)) throw UsageError("--heartbeat-timeout: expected > 0 s");
+    if (const Status v = device::validate(device::DeviceEmulatorOptions{a->heartbeat_timeout}); !v)
+      throw UsageError("--heartbeat-timeout: " + v.error().message);
     const auto cfg = strings::load_device_config(resolve_data_path(a->config));
     auto sim = make_simulated(cfg, a->seed);
     if (auto st = sim->open(); !st.ok()) throw UsageError(st.error().message);

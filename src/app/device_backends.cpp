@@ -13,6 +13,9 @@ void add_backend_options(CLI::App& cmd, BackendArgs& a) {
       ->capture_default_str();
   cmd.add_option("--port", a.port, "serial: device path, e.g. /dev/ttyACM0");
   cmd.add_option("--baud", a.baud, "serial: baud rate")->capture_default_str();
+  cmd.add_flag("!--no-link-check", a.check_link_budget,
+               "serial: do not refuse a rate whose frames exceed the baud rate (a pseudo-terminal, "
+               "or a transport faster than its baud setting)");
   cmd.add_option("--seed", a.seed, "sim: random seed")->capture_default_str();
 }
 
@@ -30,6 +33,7 @@ std::unique_ptr<device::Device> make_backend(const BackendArgs& a, const strings
   device::SerialDeviceConfig sc;
   sc.port = a.port;
   sc.baud = a.baud;
+  sc.check_link_budget = a.check_link_budget;
   sc.string_count = cfg.string_count();
   sc.counter_bits = cfg.counter_bits;
   sc.command_min = cfg.command_range().min;

@@ -13,7 +13,8 @@ struct BackendArgs {
   std::string config = "configs/spidar8.yaml";
   std::string backend = "sim";  ///< sim | serial
   std::string port;             ///< serial: tty path
-  int baud = 921600;
+  int baud = 2000000;  ///< enough for 24 strings at 1 kHz (link_budget.hpp)
+  bool check_link_budget = true;  ///< false: a pty or a transport faster than its baud setting
   std::uint64_t seed = 1;
 };
 

@@ -50,6 +50,7 @@ class RecordingDevice final : public device::Device {
   void request_safe_state() override { inner_.request_safe_state(); }
   void clear_safe_state() override { inner_.clear_safe_state(); }
   device::DeviceStatus status() const override { return inner_.status(); }
+  Status check_rate(double rate_hz) const override { return inner_.check_rate(rate_hz); }
 
   static constexpr std::size_t kRing = 4096;
   using Ring = core::SampleRing<DeviceCycleRecord, kRing>;

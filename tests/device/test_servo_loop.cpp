@@ -36,6 +36,9 @@ TEST(ServoLoop, RunsAndKeepsOrderedStatistics) {
   ServoConfig cfg;
   cfg.rate_hz = 1000;
   cfg.max_seconds = 0.4;
+  // Not a timing test: a loaded machine (or a sanitizer) may wake the thread late; the deadline
+  // watchdog has its own tests.
+  cfg.deadline_periods = 1000;
   ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<ZeroForce>());
   ASSERT_TRUE(loop.start().ok());
   loop.wait();
@@ -92,6 +95,7 @@ TEST(ServoLoop, CycleBodyDoesNotAllocate) {
   Rig rig;
   ServoConfig cfg;
   cfg.rate_hz = 2000;
+  cfg.deadline_periods = 1000;  // allocation, not timing: a late wake-up must not stop the forces
   cfg.on_thread_start = [] { alloc::mark_this_thread(); };
   // A force source that asks for real forces, so tensions and commands vary.
   struct Pushing final : ForceSource {
