@@ -2,7 +2,9 @@
 // motion blur.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "gl_test_support.hpp"
 #include "spidar/hand/render_geometry.hpp"
@@ -133,6 +135,26 @@ TEST(SyntheticCamera, FilmsAnAnatomicalHandNotTheModelsSkin) {
 
   // The forearm and bracelet are in the mask but not in hand_only.
   EXPECT_GT(cv::countNonZero(frame.mask) - cv::countNonZero(frame.hand_only), 2000);
+
+  // To look at them: SPIDAR_TEST_IMAGES=dir writes the frame, both masks and close-ups.
+  if (const char* dir = std::getenv("SPIDAR_TEST_IMAGES")) {
+    const std::string d(dir);
+    cv::imwrite(d + "/anatomical_frame.png", frame.bgr);
+    cv::Mat both(model_hand.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+    both.setTo(cv::Scalar(0, 0, 255), model_hand);
+    both.setTo(cv::Scalar(0, 255, 0), frame.hand_only);
+    both.setTo(cv::Scalar(255, 255, 255), model_hand & frame.hand_only);
+    cv::imwrite(d + "/anatomical_vs_model.png", both);
+    vision::Intrinsics K = cam.intrinsics();
+    const Vec3 c = q[1].p_W_wrist() + 0.08 * hand::hand_pose(q[1]).R.toRotationMatrix().col(1);
+    int k = 0;
+    for (const Vec3& eye : {Vec3(0.0, 0.0, 0.32), Vec3(0.0, 0.0, -0.32), Vec3(0.25, -0.15, 0.05)}) {
+      camera->set_camera(vision::Camera(K, vision::look_at(c + eye, c, Vec3::UnitY())));
+      SyntheticFrame close;
+      ASSERT_TRUE(camera->film({&q[0], &q[1]}, &close).ok());
+      cv::imwrite(d + "/anatomical_close" + std::to_string(k++) + ".png", close.bgr);
+    }
+  }
 }
 
 TEST(SyntheticCamera, MotionBlurAndNoiseLeaveGroundTruthAtTheCurrentPose) {
