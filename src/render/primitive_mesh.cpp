@@ -178,4 +178,27 @@ CpuMesh mesh_with_normals(const MeshData& mesh, double crease_deg) {
   return m;
 }
 
+void snapshot_mesh(const MeshData& mesh, CpuMesh* out) {
+  const std::size_t floats = mesh.vertices.size() / 3 * 3;
+  if (mesh.normals.size() != mesh.vertices.size()) {
+    *out = mesh_with_normals(mesh);
+    return;
+  }
+  out->vertices.resize(2 * floats);
+  for (std::size_t v = 0; v < floats / 3; ++v)
+    for (std::size_t k = 0; k < 3; ++k) {
+      out->vertices[6 * v + k] = mesh.vertices[3 * v + k];
+      out->vertices[6 * v + 3 + k] = mesh.normals[3 * v + k];
+    }
+  const int nv = static_cast<int>(floats / 3);
+  out->indices.clear();
+  for (std::size_t f = 0; f + 2 < mesh.faces.size(); f += 3) {
+    const int a = mesh.faces[f], b = mesh.faces[f + 1], c = mesh.faces[f + 2];
+    if (a < 0 || b < 0 || c < 0 || a >= nv || b >= nv || c >= nv) continue;
+    out->indices.insert(out->indices.end(), {static_cast<std::uint32_t>(a),
+                                             static_cast<std::uint32_t>(b),
+                                             static_cast<std::uint32_t>(c)});
+  }
+}
+
 }  // namespace spidar::render

@@ -31,5 +31,9 @@ CpuMesh unit_quad();
 /// at its vertex that lie within `crease_deg` of its own face, so curved surfaces look smooth and
 /// edges (e.g. a cubelet's bevels) stay sharp. Out-of-range indices are skipped.
 CpuMesh mesh_with_normals(const MeshData& mesh, double crease_deg = 40.0);
+/// A snapshot mesh as the renderer uploads it, into `out` (its buffers reused): with the mesh's
+/// own normals (MeshData::normals, one per vertex) the vertices stay shared and only triangles
+/// with indices out of range are dropped; without them, mesh_with_normals(mesh).
+void snapshot_mesh(const MeshData& mesh, CpuMesh* out);
 
 }  // namespace spidar::render

@@ -77,6 +77,8 @@ static_assert(sizeof(Instance) == 28 * sizeof(float));
 struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
   GLsizei index_count = 0;
+  std::size_t vertex_bytes = 0, index_bytes = 0;  // sizes of the buffers' stores
+  std::uint64_t version = 0;                      // MeshData::version uploaded
 };
 
 enum Primitive : int {
@@ -125,6 +127,7 @@ struct Renderer::Impl {
     std::vector<GpuMesh> meshes;
   };
   std::vector<MeshSet> mesh_sets;
+  CpuMesh staging;  // a changed mesh on its way to the GPU (reused: no allocation per frame)
   // Per frame, reused: instances per draw key (primitive, then meshes), objects and hands.
   std::vector<std::vector<Instance>> object_batches, hand_batches;
   std::vector<Instance> upload;
@@ -234,6 +237,8 @@ struct Renderer::Impl {
                    static_cast<GLsizeiptr>(cpu.indices.size() * sizeof(std::uint32_t)),
                    cpu.indices.data(), GL_STATIC_DRAW);
     m.index_count = static_cast<GLsizei>(cpu.indices.size());
+    m.vertex_bytes = cpu.vertices.size() * sizeof(float);
+    m.index_bytes = cpu.indices.size() * sizeof(std::uint32_t);
     // Per-instance attributes 2..7 come from the shared instance buffer; their offsets are set
     // before each draw (GL 3.3 has no base instance).
     gl::BindBuffer(GL_ARRAY_BUFFER, instance_vbo);
@@ -245,12 +250,51 @@ struct Renderer::Impl {
     return m;
   }
 
-  /// The uploaded meshes of a snapshot's mesh list (uploading them the first time).
+  /// Uploads a changed mesh's contents into its buffers: in place (glBufferSubData) when the
+  /// sizes are unchanged, else into new stores.
+  void reupload_mesh(const MeshData& md, GpuMesh& m) {
+    snapshot_mesh(md, &staging);
+    const std::size_t vbytes = staging.vertices.size() * sizeof(float);
+    const std::size_t ibytes = staging.indices.size() * sizeof(std::uint32_t);
+    gl::BindVertexArray(m.vao);  // the element buffer binding belongs to the VAO
+    gl::BindBuffer(GL_ARRAY_BUFFER, m.vbo);
+    if (vbytes == m.vertex_bytes) {
+      gl::BufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(vbytes), staging.vertices.data());
+    } else {
+      gl::BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vbytes), staging.vertices.data(),
+                     GL_DYNAMIC_DRAW);
+      m.vertex_bytes = vbytes;
+    }
+    gl::BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m.ebo);
+    if (ibytes == m.index_bytes) {
+      gl::BufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(ibytes), staging.indices.data());
+    } else {
+      gl::BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(ibytes), staging.indices.data(),
+                     GL_DYNAMIC_DRAW);
+      m.index_bytes = ibytes;
+    }
+    m.index_count = static_cast<GLsizei>(staging.indices.size());
+    m.version = md.version;
+    gl::BindVertexArray(0);
+  }
+
+  /// The uploaded meshes of a snapshot's mesh list (uploading them the first time, and again
+  /// each mesh whose MeshData::version changed since).
   const std::vector<GpuMesh>* meshes_for(const SceneSnapshot& scene) {
     if (!scene.meshes || scene.meshes->empty()) return nullptr;
     const void* key = scene.meshes.get();
-    for (auto& set : mesh_sets)
-      if (set.key == key && !set.source.expired()) return &set.meshes;
+    for (auto& set : mesh_sets) {
+      if (set.key != key || set.source.expired()) continue;
+      const std::vector<MeshData>& source = *scene.meshes;
+      for (std::size_t i = 0; i < source.size() && i < set.meshes.size(); ++i)
+        if (source[i].version != set.meshes[i].version) reupload_mesh(source[i], set.meshes[i]);
+      for (std::size_t i = set.meshes.size(); i < source.size(); ++i) {  // the list grew
+        snapshot_mesh(source[i], &staging);
+        set.meshes.push_back(upload_mesh(staging));
+        set.meshes.back().version = source[i].version;
+      }
+      return &set.meshes;
+    }
     // Drop sets whose lists are gone, and the oldest beyond four.
     for (std::size_t i = 0; i < mesh_sets.size();) {
       if (mesh_sets[i].source.expired() || mesh_sets.size() >= 4) {
@@ -263,7 +307,11 @@ struct Renderer::Impl {
     MeshSet set;
     set.source = scene.meshes;
     set.key = key;
-    for (const MeshData& md : *scene.meshes) set.meshes.push_back(upload_mesh(mesh_with_normals(md)));
+    for (const MeshData& md : *scene.meshes) {
+      snapshot_mesh(md, &staging);
+      set.meshes.push_back(upload_mesh(staging));
+      set.meshes.back().version = md.version;
+    }
     mesh_sets.push_back(std::move(set));
     return &mesh_sets.back().meshes;
   }

@@ -4,14 +4,15 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "spidar/render/hand_skin.hpp"
+#include "spidar/render/hand_skin.hpp"  // part ids
 #include "spidar/render/renderer.hpp"
+#include "spidar/sim/anatomical_hand.hpp"
 
 namespace spidar::sim {
 
 Status validate(const SyntheticCameraParams& p) {
   auto bad = [](const std::string& what) { return Status(Error{"synthetic camera: " + what}); };
-  for (const auto* c : {&p.screen_rgb, &p.skin_rgb, &p.bracelet_rgb})
+  for (const auto* c : {&p.screen_rgb, &p.skin_rgb, &p.bracelet_rgb, &p.nail_rgb})
     for (float v : *c)
       if (!(v >= 0.f && v <= 1.f)) return bad("colours must be in [0, 1]");
   if (!(p.bracelet_width_m > 0 && p.bracelet_width_m < 0.1))
@@ -20,8 +21,6 @@ Status validate(const SyntheticCameraParams& p) {
     return bad("bracelet_offset_m must be in [0, 0.1) m");
   if (!(p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
     return bad("forearm_length_m must be in [0, 0.5] m");
-  if (!(p.taper >= 0 && p.taper < 0.5)) return bad("taper must be in [0, 0.5)");
-  if (!(p.palm_fullness >= 0.5 && p.palm_fullness <= 2)) return bad("palm_fullness must be in [0.5, 2]");
   if (!(p.ambient >= 0.f && p.ambient <= 1.f)) return bad("ambient must be in [0, 1]");
   if (!p.light_dir_C.allFinite() || p.light_dir_C.norm() < 1e-9) return bad("light_dir_C must be a direction");
   if (!(p.psf_sigma_px >= 0 && p.psf_sigma_px <= 5)) return bad("psf_sigma_px must be in [0, 5]");
@@ -34,10 +33,10 @@ Status validate(const SyntheticCameraParams& p) {
 struct SyntheticCamera::Impl {
   vision::Camera camera;
   SyntheticCameraParams params;
-  std::array<hand::HandModel, 2> models;
-  std::array<render::HandSkin, 2> skins;
-  render::HandSkinParams skin;
-  std::shared_ptr<const std::vector<MeshData>> meshes;
+  std::array<AnatomicalHand, 2> hands;
+  /// Both hands' parts, left then right: posed in place every frame (MeshData::version).
+  std::shared_ptr<std::vector<MeshData>> meshes;
+  std::array<std::size_t, 2> first_mesh{};
   std::unique_ptr<render::Renderer> renderer;
   render::RenderParams render_params;
   SceneSnapshot scene;
@@ -48,8 +47,22 @@ struct SyntheticCamera::Impl {
   void build_scene(const HandPoses& poses) {
     scene.shapes.clear();
     scene.meshes = meshes;
-    for (int h = 0; h < 2; ++h)
-      if (poses[h]) render::pose_hand_skin(models[h], skins[h], *poses[h], skin, &scene);
+    for (int h = 0; h < 2; ++h) {
+      if (!poses[h]) continue;
+      const AnatomicalHand& hand = hands[static_cast<std::size_t>(h)];
+      const std::size_t first = first_mesh[static_cast<std::size_t>(h)];
+      pose_anatomical_hand(hand, *poses[h], std::span<MeshData>(*meshes).subspan(first, hand.parts.size()));
+      for (std::size_t i = 0; i < hand.parts.size(); ++i) {
+        Shape s;  // vertices are in world already: X_WS = identity
+        s.type = Shape::Type::kMesh;
+        s.mesh = static_cast<int>(first + i);
+        s.hand = h;
+        s.finger = hand.parts[i].finger;
+        const auto& c = hand.parts[i].rgb;
+        s.rgba = {c[0], c[1], c[2], 1.f};
+        scene.shapes.push_back(s);
+      }
+    }
   }
 };
 
@@ -65,18 +78,21 @@ Result<std::unique_ptr<SyntheticCamera>> SyntheticCamera::create(
   auto impl = std::make_unique<Impl>();
   impl->camera = camera;
   impl->params = params;
-  impl->models = truth;
-  render::HandSkinParams& k = impl->skin;
-  k.taper = params.taper;
-  k.palm_fullness = params.palm_fullness;
+  AnatomicalHandParams k;
   k.forearm_length_m = params.forearm_length_m;
-  k.bracelet = true;
   k.bracelet_width_m = params.bracelet_width_m;
   k.bracelet_offset_m = params.bracelet_offset_m;
   k.skin_rgb = params.skin_rgb;
+  k.nail_rgb = params.nail_rgb;
   k.bracelet_rgb = params.bracelet_rgb;
   auto meshes = std::make_shared<std::vector<MeshData>>();
-  for (int h = 0; h < 2; ++h) impl->skins[h] = render::build_hand_skin(truth[h], impl->skin, meshes.get());
+  for (std::size_t h = 0; h < 2; ++h) {
+    auto built = build_anatomical_hand(truth[h], k);
+    if (!built) return Error{"synthetic camera: " + built.error().message};
+    impl->hands[h] = std::move(built).value();
+    impl->first_mesh[h] = meshes->size();
+    for (MeshData& m : part_meshes(impl->hands[h])) meshes->push_back(std::move(m));
+  }
   impl->meshes = meshes;
   auto renderer = render::Renderer::create(context, camera.width(), camera.height());
   if (!renderer) return renderer.error();
@@ -110,7 +126,10 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
       const double t = static_cast<double>(k) / samples;
       for (int h = 0; h < 2; ++h) {
         if (!poses[h] || !(*previous)[h]) continue;
+        blended[h] = *poses[h];  // the little finger's own angles too
         blended[h].q = (1 - t) * (*previous)[h]->q + t * poses[h]->q;
+        if ((*previous)[h]->little_independent == poses[h]->little_independent)
+          blended[h].little = (1 - t) * (*previous)[h]->little + t * poses[h]->little;
         at[h] = &blended[h];
       }
     }

@@ -1,6 +1,7 @@
 // Convergence from perturbed poses on synthetic frames: the simulated camera films the user's
 // true hands ("user" profile of configs/hands.yaml: 4 % longer, 3 % narrower than the model,
-// tapered bones, a fuller palm) as skin over a blue screen with red bracelets; chroma key,
+// their own anatomical mesh, sim/anatomical_hand.hpp) as skin over a blue screen with red
+// bracelets; chroma key,
 // bracelet detection and the distance transform run on that image; the registration fits the
 // default model hands to it and to string fingertips with 0.5 mm noise.
 //

@@ -164,8 +164,11 @@ TEST(Renderer, MeshesPlanesSpheresAndBadShapes) {
   SPIDAR_REQUIRE_GL();
   const vision::Camera cam = vision::default_rig_camera();
   auto meshes = std::make_shared<std::vector<MeshData>>();
-  meshes->push_back({"tetra", {0, 0, 0.03f, 0.03f, 0, -0.01f, -0.015f, 0.026f, -0.01f, -0.015f, -0.026f, -0.01f},
-                     {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2}});
+  MeshData tetra;
+  tetra.name = "tetra";
+  tetra.vertices = {0, 0, 0.03f, 0.03f, 0, -0.01f, -0.015f, 0.026f, -0.01f, -0.015f, -0.026f, -0.01f};
+  tetra.faces = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2};
+  meshes->push_back(tetra);
   SceneSnapshot scene;
   scene.meshes = meshes;
   Shape tet;
@@ -205,6 +208,82 @@ TEST(Renderer, MeshesPlanesSpheresAndBadShapes) {
   EXPECT_TRUE(std::isfinite(t.depth.at<float>(cam.height() - 1, cam.width() / 2)));
   cv::Mat nan_mask = t.depth != t.depth;
   EXPECT_EQ(cv::countNonZero(nan_mask), 0);
+}
+
+// A cube mesh in world coordinates (X_WS = identity), with or without its own normals.
+MeshData cube_mesh(const Vec3& c, double half, bool with_normals) {
+  MeshData m;
+  m.name = "cube";
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+    const Vec3 p = c + half * corner;
+    for (int k = 0; k < 3; ++k) m.vertices.push_back(static_cast<float>(p[k]));
+    if (with_normals)
+      for (int k = 0; k < 3; ++k) m.normals.push_back(static_cast<float>(corner.normalized()[k]));
+  }
+  // Corners: bit 0 = +x, bit 1 = +y, bit 2 = +z; counter-clockwise from outside.
+  m.faces = {0, 3, 1, 0, 2, 3, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+             3, 2, 6, 3, 6, 7, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
+  return m;
+}
+
+// Hand pixels (id > 0) within 6 px of the projection of p.
+int hand_pixels_near(const RenderTargets& t, const vision::Camera& cam, const Vec3& p) {
+  const Vec2 uv = cam.project(p);
+  const cv::Rect r(int(uv.x()) - 6, int(uv.y()) - 6, 13, 13);
+  return cv::countNonZero(t.hand_id(r & cv::Rect(0, 0, t.hand_id.cols, t.hand_id.rows)) > 0);
+}
+
+TEST(Renderer, ChangedMeshesAreUploadedAgainWhenTheirVersionChanges) {
+  SPIDAR_REQUIRE_GL();
+  const vision::Camera cam = vision::default_rig_camera();
+  const Vec3 a(-0.05, 0.0, 0.03), b(0.06, 0.02, 0.03);
+  for (bool with_normals : {true, false}) {
+    SCOPED_TRACE(with_normals ? "own normals" : "derived normals");
+    auto meshes = std::make_shared<std::vector<MeshData>>();
+    meshes->push_back(cube_mesh(a, 0.01, with_normals));
+    SceneSnapshot scene;
+    scene.meshes = meshes;
+    Shape s;
+    s.type = Shape::Type::kMesh;
+    s.mesh = 0;
+    s.hand = 1;
+    s.finger = 2;
+    scene.shapes.push_back(s);
+    auto renderer = Renderer::create(*gl_context()).value();
+    RenderTargets t;
+    auto draw = [&] {
+      ASSERT_TRUE(renderer->render(scene, cam).ok());
+      ASSERT_TRUE(renderer->read(&t, kHandId).ok());
+    };
+    draw();
+    EXPECT_EQ(hand_pixels_near(t, cam, a), 169);
+    EXPECT_EQ(hand_pixels_near(t, cam, b), 0);
+    EXPECT_EQ(t.hand_id.at<std::uint8_t>(cv::Point(cam.project(a).cast<int>().x(), cam.project(a).cast<int>().y())),
+              encode_hand_id(1, 2));
+    // Moved in place without a new version: the renderer keeps what it uploaded.
+    (*meshes)[0].vertices = cube_mesh(b, 0.01, with_normals).vertices;
+    draw();
+    EXPECT_EQ(hand_pixels_near(t, cam, a), 169);
+    EXPECT_EQ(hand_pixels_near(t, cam, b), 0);
+    // A new version: drawn where it is now (same sizes: updated in place).
+    ++(*meshes)[0].version;
+    draw();
+    EXPECT_EQ(hand_pixels_near(t, cam, a), 0);
+    EXPECT_EQ(hand_pixels_near(t, cam, b), 169);
+    // A new version with more triangles (two cubes): new buffer stores.
+    MeshData two = cube_mesh(b, 0.01, with_normals);
+    const MeshData other = cube_mesh(a, 0.01, with_normals);
+    const int n = static_cast<int>(two.vertices.size() / 3);
+    two.vertices.insert(two.vertices.end(), other.vertices.begin(), other.vertices.end());
+    two.normals.insert(two.normals.end(), other.normals.begin(), other.normals.end());
+    for (int f : other.faces) two.faces.push_back(f + n);
+    two.version = (*meshes)[0].version + 1;
+    (*meshes)[0] = two;
+    draw();
+    EXPECT_EQ(hand_pixels_near(t, cam, a), 169);
+    EXPECT_EQ(hand_pixels_near(t, cam, b), 169);
+  }
 }
 
 TEST(Renderer, ResizesToTheCamera) {

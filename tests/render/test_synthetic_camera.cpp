@@ -2,11 +2,14 @@
 // motion blur.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "gl_test_support.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/render/hand_shapes.hpp"
+#include "spidar/render/hand_skin.hpp"
 #include "spidar/render/renderer.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
 #include "spidar/vision/bracelet.hpp"
@@ -90,6 +93,68 @@ TEST(SyntheticCamera, DiffersFromTheModelsCapsules) {
   const double score = iou(t.hand_id > 0, frame.mask);
   EXPECT_GT(score, 0.6);
   EXPECT_LT(score, 0.97);
+}
+
+TEST(SyntheticCamera, FilmsAnAnatomicalHandNotTheModelsSkin) {
+  SPIDAR_REQUIRE_GL();
+  // DESIGN.md "The simulated world is not the model": the filmed hand is the user's anatomical
+  // hand, not the skin the registration draws. Same pose, same sizes: the hands (no forearm, no
+  // bracelet) overlap mostly but clearly differ (the model's skin at the true pose scored 0.993
+  // when the camera filmed it).
+  const vision::Camera cam = vision::default_rig_camera();
+  const auto q = render::test::reaching_hands();
+  const auto models = render::test::truth_models();
+  auto camera = SyntheticCamera::create(*gl_context(), cam, models).value();
+  SyntheticFrame frame;
+  ASSERT_TRUE(camera->film({&q[0], &q[1]}, &frame).ok());
+
+  render::HandSkinParams model_skin{0.12, 1.2, 0.10, false};  // the pipeline's model skin
+  auto meshes = std::make_shared<std::vector<MeshData>>();
+  std::array<render::HandSkin, 2> skins;
+  for (int h = 0; h < 2; ++h) skins[h] = render::build_hand_skin(models[h], model_skin, meshes.get());
+  SceneSnapshot scene;
+  scene.meshes = meshes;
+  for (int h = 0; h < 2; ++h) render::pose_hand_skin(models[h], skins[h], q[h], model_skin, &scene);
+  auto renderer = render::Renderer::create(*gl_context()).value();
+  ASSERT_TRUE(renderer->render(scene, cam).ok());
+  render::RenderTargets t;
+  ASSERT_TRUE(renderer->read(&t, render::kHandId).ok());
+  cv::Mat model_hand(t.hand_id.size(), CV_8UC1);
+  for (int y = 0; y < model_hand.rows; ++y)
+    for (int x = 0; x < model_hand.cols; ++x) {
+      const std::uint8_t id = t.hand_id.at<std::uint8_t>(y, x);
+      model_hand.at<std::uint8_t>(y, x) =
+          id != 0 && render::decode_hand_id(id).finger != render::kForearmPart ? 255 : 0;
+    }
+  const double score = iou(model_hand, frame.hand_only);
+  std::cout << "IoU anatomical hand vs model skin (hands only, same pose and sizes): " << score
+            << " (" << cv::countNonZero(frame.hand_only) << " vs " << cv::countNonZero(model_hand)
+            << " px)\n";
+  EXPECT_GT(score, 0.75);
+  EXPECT_LT(score, 0.97);
+
+  // The forearm and bracelet are in the mask but not in hand_only.
+  EXPECT_GT(cv::countNonZero(frame.mask) - cv::countNonZero(frame.hand_only), 2000);
+
+  // To look at them: SPIDAR_TEST_IMAGES=dir writes the frame, both masks and close-ups.
+  if (const char* dir = std::getenv("SPIDAR_TEST_IMAGES")) {
+    const std::string d(dir);
+    cv::imwrite(d + "/anatomical_frame.png", frame.bgr);
+    cv::Mat both(model_hand.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+    both.setTo(cv::Scalar(0, 0, 255), model_hand);
+    both.setTo(cv::Scalar(0, 255, 0), frame.hand_only);
+    both.setTo(cv::Scalar(255, 255, 255), model_hand & frame.hand_only);
+    cv::imwrite(d + "/anatomical_vs_model.png", both);
+    vision::Intrinsics K = cam.intrinsics();
+    const Vec3 c = q[1].p_W_wrist() + 0.08 * hand::hand_pose(q[1]).R.toRotationMatrix().col(1);
+    int k = 0;
+    for (const Vec3& eye : {Vec3(0.0, 0.0, 0.32), Vec3(0.0, 0.0, -0.32), Vec3(0.25, -0.15, 0.05)}) {
+      camera->set_camera(vision::Camera(K, vision::look_at(c + eye, c, Vec3::UnitY())));
+      SyntheticFrame close;
+      ASSERT_TRUE(camera->film({&q[0], &q[1]}, &close).ok());
+      cv::imwrite(d + "/anatomical_close" + std::to_string(k++) + ".png", close.bgr);
+    }
+  }
 }
 
 TEST(SyntheticCamera, MotionBlurAndNoiseLeaveGroundTruthAtTheCurrentPose) {

@@ -2,6 +2,7 @@
 /// A neutral picture of a scene for renderers: shapes with poses and colours, and the meshes they
 /// use. Physics exports it; render draws it; neither knows the other.
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +15,14 @@ struct MeshData {
   std::string name;
   std::vector<float> vertices;  ///< x y z per vertex [m], in the shape's frame
   std::vector<int> faces;       ///< three vertex indices per triangle
+  /// Optional unit normals, x y z per vertex (same count as `vertices`), in the shape's frame.
+  /// Empty: the renderer derives them from the faces (smooth within a crease angle).
+  std::vector<float> normals;
+  /// Change counter of a mesh whose contents change after it was first drawn (e.g. a skinned
+  /// hand posed every frame): whoever edits `vertices`, `normals` or `faces` in place increments
+  /// it, and a renderer that has the mesh uploaded uploads it again when the number differs from
+  /// the one it uploaded. Static meshes leave it at 0.
+  std::uint64_t version = 0;
 };
 
 struct Shape {

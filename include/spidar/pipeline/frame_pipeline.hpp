@@ -47,10 +47,11 @@ struct FramePipelineParams {
   /// How the fitted hands are drawn (their depth decides occlusion; their pixels give the IoU):
   /// a skin (tapered bones, rounded palm: render/hand_skin.hpp) or the model's capsules.
   bool skinned_hands = true;
-  /// The model hands' skin: the taper and palm fullness of a typical hand (the same numbers the
-  /// synthetic camera gives its users) and a forearm (it lends the real forearm its depth, and it
-  /// hides the palm where the camera sees the forearm in front), no bracelet. The user's hand
-  /// still differs in length, width, fingertip caps, joint ranges and an independent little finger.
+  /// The model hands' skin: the taper and palm fullness of a typical hand and a forearm (it lends
+  /// the real forearm its depth, and it hides the palm where the camera sees the forearm in
+  /// front), no bracelet. The simulated user's hand is another mesh altogether
+  /// (sim/anatomical_hand.hpp) and also differs in length, width, fingertip caps, joint ranges and
+  /// an independent little finger.
   render::HandSkinParams model_skin{0.12, 1.2, 0.10, false};
   /// Hand rotations to start from on the first frame (rotation vectors, world) [rad].
   std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};

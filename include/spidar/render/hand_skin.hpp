@@ -2,9 +2,9 @@
 /// A hand's skin: smooth meshes built once per hand shape, posed per frame. Tapered bones
 /// (sphere-swept cones, thicker at their proximal end), a superellipsoid palm, optionally a
 /// forearm and a bracelet, all on the same joints as the model's capsules
-/// (hand/render_geometry.hpp). The synthetic camera films users' hands with it; the frame
-/// pipeline draws the fitted model hands with it (with the model's own, slightly different,
-/// skin parameters), so that a hand is compared with a hand, not with sticks.
+/// (hand/render_geometry.hpp). The frame pipeline draws the fitted model hands with it, so that a
+/// hand is compared with a hand, not with sticks. (The synthetic camera does not film it: the
+/// simulated user has an anatomical hand of its own, sim/anatomical_hand.hpp.)
 #include <array>
 #include <vector>
 

@@ -3,13 +3,14 @@
 /// the lab camera would, so that chroma key, bracelet detection and registration run on images
 /// they did not draw themselves.
 ///
-/// The hands are deliberately *not* the model's capsules: each bone is a tapered sphere-swept
-/// cone (thicker at its proximal end), the palm a fuller rounded box (superellipsoid), the wrist
-/// continues into a short forearm, with a red bracelet around the wrist. Skin colour with
-/// Lambert shading over a uniformly lit blue screen; then an optical blur (Gaussian PSF), sensor
-/// noise (Gaussian, in 8-bit levels) and, optionally, motion blur (the mean of sub-frames
-/// between the previous and the current pose). Ground truth comes with every frame: the mask of
-/// everything in front of the screen (skin, bracelet, forearm), which hand, and depth.
+/// The hands are deliberately *not* the registration model's skin: they are the user's own
+/// anatomical hands (sim/anatomical_hand.hpp: a palm with its pads, tapered digits with knuckles,
+/// webs, fingernails, a wrist and forearm with a red bracelet), skinned to the user's skeleton
+/// and posed on the CPU every frame. Skin colour with Lambert shading over a uniformly lit blue
+/// screen; then an optical blur (Gaussian PSF), sensor noise (Gaussian, in 8-bit levels) and,
+/// optionally, motion blur (the mean of sub-frames between the previous and the current pose).
+/// Ground truth comes with every frame: the mask of everything in front of the screen (skin,
+/// nails, bracelet, forearm), which hand, and depth.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -29,8 +30,7 @@ struct SyntheticCameraParams {
   double bracelet_width_m = 0.018;    ///< along the forearm [m]
   double bracelet_offset_m = 0.012;   ///< bracelet centre, from the wrist toward the elbow [m]
   double forearm_length_m = 0.10;     ///< visible forearm beyond the wrist [m]; 0 = none
-  double taper = 0.12;                ///< bone radius: (1 + taper)·r proximal, (1 − taper)·r distal
-  double palm_fullness = 1.2;         ///< palm thickness and width × this (vs the model's box)
+  std::array<float, 3> nail_rgb{0.94f, 0.80f, 0.78f};     ///< fingernails' albedo
   float ambient = 0.45f;              ///< share of light that is not directional
   Vec3 light_dir_C{0.2, -0.6, -0.75}; ///< toward the light, camera frame
   double psf_sigma_px = 0.5;          ///< optical blur [px]; 0 = off
