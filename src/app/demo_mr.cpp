@@ -31,6 +31,7 @@
 #include "spidar/sim/camera_thread.hpp"
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
+#include "spidar/sim/model_ceiling.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
 #include "spidar/sim/user_hands.hpp"
@@ -120,6 +121,11 @@ int run_mr_demo(const DemoOptions& o) {
   auto alt_r = pipeline::FramePipeline::create(*context, camera, models, pp_alt);
   if (!alt_r) throw UsageError(alt_r.error().message);
   auto alt = std::move(alt_r).value();
+
+  // The model's ceiling: its own skin at the user's true pose and sizes (every compared frame).
+  auto ceiling_r = sim::ModelCeiling::create(*context, camera, truth_models, pp.model_skin);
+  if (!ceiling_r) throw SpidarError(ceiling_r.error().message);
+  auto ceiling = std::move(ceiling_r).value();
 
   std::unique_ptr<render::VideoOutput> video;
   if (o.video) {
@@ -242,6 +248,10 @@ int run_mr_demo(const DemoOptions& o) {
       if (!alt_m) throw SpidarError(alt_m.error().message);
       m.truth[1] = *alt_m;
       m.compared = true;
+      auto c = ceiling->iou(filmed.truth, frame.hand_only);
+      if (!c) throw SpidarError(c.error().message);
+      m.ceiling_iou = *c;
+      m.ceiling_measured = true;
     }
     ++frame_index;
     for (int h = 0; h < 2; ++h) {
@@ -333,6 +343,8 @@ int run_mr_demo(const DemoOptions& o) {
   summary.height = o.height;
   summary.scene = scene_path;
   summary.user_hand = hand_path;
+  summary.user_length_m = truth_models[0].shape.dimensions.length;
+  summary.user_width_m = truth_models[0].shape.dimensions.width;
   return write_mr_report(o.out, trace, summary, std::cout);
 }
 

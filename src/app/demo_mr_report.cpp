@@ -64,7 +64,7 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
        "joint_px_left,joint_px_right,occlusion_pct,occlusion_pct_paper,contested_pixels,"
        "contested_error_pct,contested_error_pct_paper,iterations_left,"
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
-       "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right\n";
+       "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou\n";
   f << std::setprecision(6);
   for (const MrFrame& m : t.frames) {
     const auto& a = m.truth[0];
@@ -77,7 +77,9 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
     if (m.compared) f << m.truth[1].iou;
     f << ',' << m.lift_mm << ',' << m.u_angle_deg << ',' << m.turns << ',' << m.servo_rate_hz << ','
       << m.servo_jitter_max_us << ',' << m.truth_cap_residual_mm[0] << ','
-      << m.truth_cap_residual_mm[1] << '\n';
+      << m.truth_cap_residual_mm[1] << ',';
+    if (m.ceiling_measured) f << m.ceiling_iou;
+    f << '\n';
   }
 }
 
@@ -202,6 +204,9 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   const double contested_pct = pooled_pct(contested_wrong);
   const double contested_pct_paper = pooled_pct(contested_wrong_paper);
   const double contested_mean = frames > 0 ? static_cast<double>(contested) / frames : 0.0;
+  std::vector<double> ceiling;
+  for (const MrFrame& m : t.frames)
+    if (m.ceiling_measured) ceiling.push_back(m.ceiling_iou);
   const auto cap_res = column(t, [](const MrFrame& m) { return std::max(m.truth_cap_residual_mm[0], m.truth_cap_residual_mm[1]); });
   // Frames delivered per second of the run: processed frames over the span of their exposures
   // (the camera runs at its rate; every frame the frame thread could not take is missing here).
@@ -276,7 +281,12 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
            for (const auto& [f, a] : s.face_deg) j[std::string(1, f)] = a;
            return j;
          }()}}},
-      {"ground_truth", {{"cap_residual_mm_max", quantile(cap_res, 1.0)}}},
+      {"ground_truth", {{"cap_residual_mm_max", quantile(cap_res, 1.0)},
+                        {"cap_residual_mm_median", quantile(cap_res, 0.5)},
+                        {"model_ceiling_iou", mean(ceiling)},
+                        {"model_ceiling_iou_p5", quantile(ceiling, 0.05)},
+                        {"model_ceiling_frames", ceiling.size()},
+                        {"hand_shape", {{"length_m", s.user_length_m}, {"width_m", s.user_width_m}}}}},
       {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
   nlohmann::json forces = nlohmann::json::array();
   int touching = 0;
@@ -299,6 +309,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << reg["fingertip_mm_mean"].get<double>() << " mm, joints " << reg["joint_px_mean"].get<double>()
      << " px, " << reg["ms_per_frame_median"].get<double>() << " ms/frame (both hands), "
      << reg["iterations_mean"].get<double>() << " iterations\n"
+     << "  model ceiling  IoU " << std::setprecision(3) << mean(ceiling)
+     << " (the model's skin at the true pose with the user's sizes)\n"
      << "  comparison     " << other["method"].get<std::string>() << ": IoU "
      << std::setprecision(3) << other["iou_mean"].get<double>() << ", fingertip "
      << std::setprecision(2) << other["fingertip_mm_mean"].get<double>() << " mm, joints "

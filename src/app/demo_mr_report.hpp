@@ -26,6 +26,10 @@ struct MrFrame {
   /// [0]: the main registration, [1]: the comparison (silhouette term switched the other way).
   std::array<sim::FrameTruthMetrics, 2> truth{};
   bool compared = false;  ///< truth[1] measured in this frame
+  /// The model's skin at the true pose with the user's sizes vs the real silhouette
+  /// (sim::ModelCeiling); measured on compared frames (ceiling_measured).
+  double ceiling_iou = 0;
+  bool ceiling_measured = false;
   std::array<int, 2> iterations{};
   std::array<double, 2> truth_cap_residual_mm{};
   double lift_mm = 0, u_angle_deg = 0, d_angle_deg = 0;
@@ -47,6 +51,7 @@ struct MrSummary {
   bool solved = false, has_cube = false;
   std::map<char, double> face_deg;  ///< each face layer's final angle [deg]
   std::string facelets, video_path, video_format, compositor, scene, user_hand;
+  double user_length_m = 0, user_width_m = 0;  ///< the simulated user's true hand sizes
   bool main_silhouette = false;
   int width = 0, height = 0;
 };

@@ -12,6 +12,7 @@
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/physics/world.hpp"
+#include "spidar/hand/hand_config.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 
 namespace spidar::sim {
@@ -27,7 +28,8 @@ struct TaskRun {
   bool solved = true;
 };
 
-TaskRun run_task() {
+/// `fit`: the user's hands the script is fitted to (RubiksTask::fit_to_hands), or nullptr.
+TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr) {
   auto world = physics::World::Load(source("scenes/rubiks_cube.xml")).value();
   auto cube = physics::RubiksCube::Attach(*world).value();
   RubiksTaskParams tp;
@@ -35,6 +37,7 @@ TaskRun run_task() {
   tp.p_W_cube = cube.core_pose().p;
   const Pose X0 = cube.core_pose();
   RubiksTask task(tp);
+  if (fit) task.fit_to_hands(*fit);
   core::Latest<CubePoseSample> pose;
   task.track(&pose);
   std::vector<Vec3> x(8), v(8, Vec3::Zero()), goal(8);
@@ -78,6 +81,26 @@ TEST(RubiksTask, LockstepPhysicsLiftsAndTurnsTheTopLayerTwice) {
   // The grasps twist no other layer out of its click.
   for (int f = 1; f < 6; ++f) EXPECT_LT(r.other_faces_max_rad[f], units::deg_to_rad(3)) << "UDFBRL"[f];
 }
+
+// The script fitted to users' own hands (their fingers reach the caps) still turns twice.
+class FittedTaskPhysics : public ::testing::TestWithParam<std::pair<double, double>> {};
+
+TEST_P(FittedTaskPhysics, LiftsAndTurnsTheTopLayerTwice) {
+  hand::HandProfile profile;
+  profile.dimensions.length = 0.19 * GetParam().first;
+  profile.dimensions.width = 0.085 * GetParam().second;
+  const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft),
+                                             profile.model(hand::Side::kRight)};
+  const TaskRun r = run_task(&hands);
+  std::printf("length x%.2f width x%.2f: lift %.1f mm, U %d quarter turns\n", GetParam().first,
+              GetParam().second, r.lift_max_m * 1e3, r.quarter_turns_u);
+  EXPECT_GT(r.lift_max_m, 0.010);
+  EXPECT_EQ(r.quarter_turns_u, 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Users, FittedTaskPhysics,
+                         ::testing::Values(std::make_pair(1.04, 0.97), std::make_pair(0.9, 1.1),
+                                           std::make_pair(1.1, 0.9)));
 
 }  // namespace
 }  // namespace spidar::sim
