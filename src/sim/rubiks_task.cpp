@@ -148,6 +148,17 @@ void RubiksTask::goals(double t, std::span<Vec3> goal) {
   goals_at(t, frames_, goal);
 }
 
+Vec3 RubiksTask::squeeze_path(double t, int f) const {
+  const Contacts c = contacts(p_);
+  const bool right = f >= 4;
+  const Vec3& contact = right ? c.right[f - 4] : c.left[f];
+  const Vec3 n = face_normal(contact, p_.half);
+  // How far the goal lies inside the face: the contact's depth below the touching position
+  // (fingertip centre one proxy radius off the face).
+  const double depth = (p_.half + p_.proxy_radius) - contact.dot(n);
+  return -depth * closeness(t, right ? hand::Side::kRight : hand::Side::kLeft) * n;
+}
+
 Vec3 RubiksTask::script_path(double t, int f) const {
   const Contacts c = contacts(p_);
   const double approach = ramp(t, 0.0, 1.0);
@@ -170,13 +181,18 @@ Vec3 RubiksTask::path(double t, int f) const {
   const int h = f >= 4 ? 1 : 0;
   const auto& table = fitted_[h];
   if (table.empty()) return script_path(t, f);
+  // The fitted touching positions, pressed in by the script's squeeze.
   const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
   const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
   const double w = x - static_cast<double>(k);
-  return (1.0 - w) * table[k][f % 4] + w * table[k + 1][f % 4];
+  return (1.0 - w) * table[k][f % 4] + w * table[k + 1][f % 4] + squeeze_path(t, f);
 }
 
-void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal) const {
+void RubiksTask::touch_points(double t, std::span<Vec3> p_W) const {
+  goals_at(t, published_.read().value_or(frames_), p_W, false);
+}
+
+void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal, bool squeeze) const {
   for (int f = 0; f < 8 && f < static_cast<int>(goal.size()); ++f) {
     const bool right = f >= 4;
     const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
@@ -184,7 +200,8 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal)
     const int h = right ? 1 : 0;
     const Quat q_WG(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
     const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
-    goal[f] = p_WG + q_WG * (rot_z(s.yaw) * path(t, f)) + Vec3(0, 0, s.lift - fr.lift[h]);
+    const Vec3 p = squeeze ? path(t, f) : Vec3(path(t, f) - squeeze_path(t, f));
+    goal[f] = p_WG + q_WG * (rot_z(s.yaw) * p) + Vec3(0, 0, s.lift - fr.lift[h]);
   }
 }
 

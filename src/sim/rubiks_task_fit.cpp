@@ -24,7 +24,8 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
       const double t = static_cast<double>(k) * fit_dt_;
       registration::HandObservation obs;
       for (int f = 0; f < hand::kFingertipCount; ++f) {
-        obs.p_W_fingertip[f] = script_path(t, 4 * h + f);
+        // Where the finger touches: it stops at the face, the squeeze is only its setpoint.
+        obs.p_W_fingertip[f] = script_path(t, 4 * h + f) - squeeze_path(t, 4 * h + f);
         obs.fingertip_valid[f] = true;
       }
       const hand::HandParams prior = script_nominal_local(t, side);

@@ -58,8 +58,10 @@ class RubiksTask final : public device::FingertipSource {
  public:
   explicit RubiksTask(RubiksTaskParams p);
   /// Makes the script reachable by these hands (left, right: the user's own): each hand's
-  /// fingertip goals, in its grasp frame, are replaced by the nearest fingertip positions the
-  /// hand can take (inverse kinematics along the script, every `dt_s`; linear in between).
+  /// touching positions (goals less their squeeze into the faces), in its grasp frame, are
+  /// replaced by the nearest fingertip positions the hand can take (inverse kinematics along the
+  /// script, every `dt_s`; linear in between); the squeeze is added back, so the grip is the
+  /// script's.
   /// Without it the goals are the script's contact layout, which a hand of another size may not
   /// reach (adjacent caps closer than fingers are wide): the user's fingers could then not be
   /// where the device's caps are. Call before the task is shared with other threads.
@@ -70,6 +72,9 @@ class RubiksTask final : public device::FingertipSource {
   void track(const core::Latest<CubePoseSample>* cube) { cube_ = cube; }
   /// Goals of the eight fingertips at time t [s] (world, m).
   void goals(double t_s, std::span<Vec3> p_W_goal) override;
+  /// Where the eight fingertips touch at time t (world, m): the goals less their squeeze into the
+  /// faces (a finger stops at the face), in the grasp frames last published by goals().
+  void touch_points(double t_s, std::span<Vec3> p_W) const;
   /// The nominal pose of one hand at time t (wrist in world, relaxed finger angles).
   hand::HandParams nominal(double t_s, hand::Side side) const;
   /// Name of the phase at time t (progress output).
@@ -96,11 +101,16 @@ class RubiksTask final : public device::FingertipSource {
   static double closeness(double t_s, hand::Side side);
   /// True while a hand approaches for a grasp: then it follows the cube's pose.
   static bool looks_for_grasp(double t_s, hand::Side side);
-  void goals_at(double t_s, const GraspFrames& frames, std::span<Vec3> p_W_goal) const;
+  void goals_at(double t_s, const GraspFrames& frames, std::span<Vec3> p_W_goal,
+                bool squeeze = true) const;
   /// Finger f's (0..7) goal in its hand's grasp frame before the hand's yaw and lift: the
   /// script's contact path, or the fitted path when fit_to_hands was called.
   Vec3 path(double t_s, int f) const;
   Vec3 script_path(double t_s, int f) const;
+  /// The part of script_path that presses into the face (the grip force through the fingertip's
+  /// impedance): zero while open, `squeeze` along the face's inward normal when closed. A finger
+  /// stops at the face; its touching position is script_path − squeeze_path.
+  Vec3 squeeze_path(double t_s, int f) const;
   /// The nominal pose of one hand in its grasp frame (before yaw and lift): the pose fitted to
   /// the hand's path when fit_to_hands was called, else script_nominal_local.
   hand::HandParams nominal_local(double t_s, hand::Side side) const;
