@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "spidar/core/units.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/rotation_vector.hpp"
 
@@ -27,7 +28,7 @@ void InteractiveHands::set(const HandControls& c) {
   HandControls k = c;
   for (HandControl& h : k) {
     for (double& v : h.offset_W) v = std::isfinite(v) ? std::clamp(v, -0.25, 0.25) : 0.0;
-    h.yaw = std::isfinite(h.yaw) ? std::clamp(h.yaw, -M_PI, M_PI) : 0.0;
+    h.yaw = std::isfinite(h.yaw) ? std::clamp(h.yaw, -units::kPi, units::kPi) : 0.0;
     h.closeness = std::isfinite(h.closeness) ? std::clamp(h.closeness, 0.0, 1.0) : 0.0;
   }
   controls_.publish(k);

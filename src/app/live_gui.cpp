@@ -20,6 +20,7 @@
 
 #include "cli_support.hpp"
 #include "gui_camera_calibration.hpp"
+#include "spidar/core/units.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/render/overlay.hpp"
@@ -256,7 +257,7 @@ void scene_panel(LiveSession& s) {
   if (!s.cube().has_cube()) ImGui::TextUnformatted("no Rubik's cube in this scene");
   if (st) {
     ImGui::Text("cube: %s, %d turns, lift %.1f mm, top layer %.0f deg, %d contacts",
-                st->solved ? "SOLVED" : "scrambled", st->turns, st->lift * 1e3, st->u_angle * 180 / M_PI,
+                st->solved ? "SOLVED" : "scrambled", st->turns, st->lift * 1e3, st->u_angle * 180 / units::kPi,
                 st->contacts);
   }
   if (ImGui::Button("Reset scene")) s.cube().request_reset();
@@ -295,11 +296,11 @@ void hands_panel(InteractiveHands& ih, GLFWwindow* window, double dt) {
     ImGui::PushID(h);
     float off[3] = {static_cast<float>(c[h].offset_W[0]), static_cast<float>(c[h].offset_W[1]),
                     static_cast<float>(c[h].offset_W[2])};
-    float yaw = static_cast<float>(c[h].yaw * 180 / M_PI), close = static_cast<float>(c[h].closeness);
+    float yaw = static_cast<float>(c[h].yaw * 180 / units::kPi), close = static_cast<float>(c[h].closeness);
     ImGui::Text("%s hand", names[h]);
     if (ImGui::SliderFloat3("offset x y z [m]", off, -0.25f, 0.25f, "%.3f"))
       for (int i = 0; i < 3; ++i) c[h].offset_W[i] = off[i];
-    if (ImGui::SliderFloat("turn [deg]", &yaw, -180.f, 180.f, "%.0f")) c[h].yaw = yaw * M_PI / 180;
+    if (ImGui::SliderFloat("turn [deg]", &yaw, -180.f, 180.f, "%.0f")) c[h].yaw = yaw * units::kPi / 180;
     if (ImGui::SliderFloat("closed", &close, 0.f, 1.f, "%.2f")) c[h].closeness = close;
     ImGui::PopID();
   }

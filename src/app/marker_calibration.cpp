@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "spidar/core/units.hpp"
+
 namespace spidar::app {
 
 MarkerCalibration::MarkerCalibration(const vision::Camera& present, const strings::FingerConfig& finger,
@@ -95,7 +97,7 @@ Result<MarkerCalibration::Solution> MarkerCalibration::solve() const {
   if (!r) return Error{"camera calibration: " + r.error().message};
   Solution s{vision::Camera(present_.intrinsics(), r->X_CW), *r, 0, 0};
   s.moved_m = (s.camera.X_WC().p - present_.X_WC().p).norm();
-  s.turned_deg = present_.X_CW().R.angularDistance(r->X_CW.R) * 180.0 / M_PI;
+  s.turned_deg = present_.X_CW().R.angularDistance(r->X_CW.R) * 180.0 / units::kPi;
   return s;
 }
 

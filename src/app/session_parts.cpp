@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "cli_support.hpp"
+#include "spidar/core/units.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/physics/world_reset.hpp"
@@ -54,14 +55,14 @@ constexpr char kFaces[6] = {'U', 'D', 'F', 'B', 'R', 'L'};
 
 void TurnCounter::rebase(const physics::RubiksCube& cube) {
   for (int f = 0; f < 6; ++f)
-    quarter_[f] = static_cast<int>(std::lround(cube.face_angle(kFaces[f]) / (M_PI / 2)));
+    quarter_[f] = static_cast<int>(std::lround(cube.face_angle(kFaces[f]) / (units::kPi / 2)));
 }
 
 void TurnCounter::update(const physics::RubiksCube& cube) {
   for (int f = 0; f < 6; ++f) {
     const double a = cube.face_angle(kFaces[f]);
     if (std::abs(cube.face_misalignment(kFaces[f])) > 0.05) continue;
-    const int q = static_cast<int>(std::lround(a / (M_PI / 2)));
+    const int q = static_cast<int>(std::lround(a / (units::kPi / 2)));
     if (q != quarter_[f]) {
       turns_ += std::abs(q - quarter_[f]);
       quarter_[f] = q;

@@ -1,3 +1,4 @@
+#include "spidar/core/units.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 
 #include <Eigen/Geometry>
@@ -133,8 +134,8 @@ void RubiksTask::goals(double t, std::span<Vec3> goal) {
       const Quat q(c->q_WC[0], c->q_WC[1], c->q_WC[2], c->q_WC[3]);
       const Mat3 R = q.normalized().toRotationMatrix();
       const double yaw = std::atan2(R(1, 0), R(0, 0));
-      const double k = std::round(yaw / (M_PI / 2));
-      const Quat g(R * rot_z(-k * M_PI / 2));
+      const double k = std::round(yaw / (units::kPi / 2));
+      const Quat g(R * rot_z(-k * units::kPi / 2));
       for (int h = 0; h < 2; ++h) {
         const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
         if (!looks_for_grasp(t, side)) continue;  // holding on or leaving: keep the frame

@@ -1,3 +1,4 @@
+#include "spidar/core/units.hpp"
 #include "spidar/sim/user_hands.hpp"
 
 #include <cmath>
@@ -64,7 +65,7 @@ void UserHands::update(double t, std::span<const Vec3> caps) {
     q_[h].little_independent = true;
     q_[h].little = Vec3(q_[h][hand::kRingMcpFlexion], q_[h][hand::kRingMcpAbduction],
                         q_[h][hand::kRingDip]) +
-                   p_.little_offset + Vec3(p_.little_sway * std::sin(2 * M_PI * 0.7 * t), 0, 0);
+                   p_.little_offset + Vec3(p_.little_sway * std::sin(2 * units::kPi * 0.7 * t), 0, 0);
     const auto& lim = truth_[h].limits;
     q_[h].little.x() = std::clamp(q_[h].little.x(), lim.lower[hand::kRingMcpFlexion], lim.upper[hand::kRingMcpFlexion]);
     q_[h].little.y() = std::clamp(q_[h].little.y(), lim.lower[hand::kRingMcpAbduction], lim.upper[hand::kRingMcpAbduction]);
