@@ -1,5 +1,7 @@
 // spidar-mr: command-line entry point. Bad input exits with code 2 and a message on stderr.
 #include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 #include <filesystem>
 #include <iostream>
 
@@ -9,6 +11,9 @@
 
 int main(int argc, char** argv) {
   using namespace spidar::app;
+  // Logs and warnings (e.g. "SCHED_FIFO not permitted") go to stderr: stdout carries only the
+  // command's result (JSON for device-test, position, tension).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("spidar-mr"));
   CLI::App app{"spidar-mr: SPIDAR-8 string haptics in mixed reality"};
   app.require_subcommand(1);
   std::vector<std::pair<CLI::App*, Action>> actions;
