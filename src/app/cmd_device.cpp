@@ -74,6 +74,8 @@ Action add_device_test(CLI::App& app) {
                         {"jitter_p99_us", s.jitter_p99_us},
                         {"jitter_max_us", s.jitter_max_us},
                         {"overruns", s.overruns},
+                        {"deadline_misses", s.deadline_misses},
+                        {"stale_force_cycles", s.stale_force_cycles},
                         {"repeated_readings", s.repeated_readings},
                         {"longest_repeat", s.longest_repeat},
                         {"cycle_us_median", s.cycle_us_median},

@@ -237,6 +237,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"jitter_p99_us", s.servo.jitter_p99_us},
         {"jitter_max_us", s.servo.jitter_max_us},
         {"overruns", s.servo.overruns},
+        {"deadline_misses", s.servo.deadline_misses},
+        {"stale_force_cycles", s.servo.stale_force_cycles},
         {"cycle_us_median", s.servo.cycle_us_median},
         {"faults", device::fault_names(s.servo.faults)}}},
       {"physics",
@@ -323,7 +325,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << quantile(lat_ms, 0.5) << " ms, " << quantile(pipe_ms, 0.5) << " ms/frame (capacity "
      << (quantile(pipe_ms, 0.5) > 0 ? 1000.0 / quantile(pipe_ms, 0.5) : 0.0) << " fps)\n"
      << "  haptics        servo " << s.servo.rate_hz << " Hz, jitter p99 " << s.servo.jitter_p99_us
-     << " us, overruns " << s.servo.overruns << ", faults " << device::fault_names(s.servo.faults)
+     << " us, overruns " << s.servo.overruns << " (" << s.servo.deadline_misses
+     << " cycles without force, " << s.servo.stale_force_cycles << " on stale physics), faults " << device::fault_names(s.servo.faults)
      << "; physics step median " << std::setprecision(2) << s.physics.step_ms_median << " ms\n"
      << "  contact        " << touching << " of 8 fingertips felt more than 0.5 N\n"
      << "  cube           "

@@ -72,6 +72,12 @@ ServoLoop::ServoLoop(Device& device, const strings::DeviceConfig& config, ServoC
       commands_(config.string_count(), device.info().command_min),
       jitter_hist_(kBins, 0),
       compute_hist_(kBins, 0) {
+  if (!(servo_.deadline_periods > 0) || !(servo_.force_timeout_s > 0) ||
+      !(servo_.stall_limit_s > 0 && servo_.stall_limit_s <= 1.0))
+    throw SpidarError("ServoLoop: expected deadline_periods > 0, force_timeout_s > 0 s and "
+                      "stall_limit_s in (0, 1] s, got " + std::to_string(servo_.deadline_periods) +
+                      ", " + std::to_string(servo_.force_timeout_s) + " s, " +
+                      std::to_string(servo_.stall_limit_s) + " s");
   if (!force_) throw SpidarError("ServoLoop: no force source");
   if (!(servo_.rate_hz >= 1.0 && servo_.rate_hz <= 100000.0)) {
     throw SpidarError("ServoLoop: rate " + std::to_string(servo_.rate_hz) +
@@ -164,8 +170,7 @@ void ServoLoop::reset_faults() {
 
 void ServoLoop::monitor() {
   // Detects a servo thread that stopped cycling (stuck in a read, starved): safe state at once.
-  const auto window_ns = std::max<std::int64_t>(
-      static_cast<std::int64_t>(servo_.deadline_periods * static_cast<double>(period_ns_)), 1'000'000);
+  const auto window_ns = std::max<std::int64_t>(core::s_to_ns(servo_.stall_limit_s), 1'000'000);
   std::uint64_t last = cycle_.load(std::memory_order_acquire);
   std::int64_t last_progress_ns = core::monotonic_ns();  // when `last` was first seen
   std::int64_t next = last_progress_ns + 4 * window_ns;  // grace for start-up
@@ -176,12 +181,11 @@ void ServoLoop::monitor() {
     if (now_cycles == last && running_.load(std::memory_order_acquire)) {
       device_.request_safe_state();
       latch(kFaultWatchdog,
-            "monitor: the servo thread completed no cycle for %.3f ms (bound %.3f ms = "
-            "deadline_periods %g x period %.3f ms, at least 1 ms; 4 times that before the "
-            "first cycle); stuck in cycle %llu (a read, the force source or the scheduler)",
+            "monitor: the servo thread completed no cycle for %.3f ms (bound stall_limit_s "
+            "%.3f ms, at least 1 ms; 4 times that before the first cycle); stuck in cycle %llu "
+            "(a read, the force source or the scheduler)",
             static_cast<double>(core::monotonic_ns() - last_progress_ns) * 1e-6,
-            static_cast<double>(window_ns) * 1e-6, servo_.deadline_periods,
-            static_cast<double>(period_ns_) * 1e-6, static_cast<unsigned long long>(now_cycles));
+            static_cast<double>(window_ns) * 1e-6, static_cast<unsigned long long>(now_cycles));
     }
     if (now_cycles != last) last_progress_ns = core::monotonic_ns();
     last = now_cycles;
@@ -209,6 +213,8 @@ void ServoLoop::run() {
   std::int64_t prev_wake = 0;
   const std::int64_t late_limit =
       static_cast<std::int64_t>(servo_.deadline_periods * static_cast<double>(period_ns_));
+  const std::int64_t stall_limit = core::s_to_ns(servo_.stall_limit_s);
+  std::int64_t stale_since = -1;  ///< host time the forces went stale, −1 while fresh
   while (!stop_.load(std::memory_order_acquire)) {
     core::sleep_until_ns(deadline);
     const std::int64_t wake = core::monotonic_ns();
@@ -224,14 +230,14 @@ void ServoLoop::run() {
     last_wake_ns_ = wake;
     sample_.cycle = cycle_.load(std::memory_order_relaxed);
     const auto cycle_no = static_cast<unsigned long long>(sample_.cycle);
-    if (wake - deadline > late_limit) {  // the safe state within this cycle
+    // Woken late: the reading below is fresh, so the cycle runs; it only counts (see the end of
+    // the cycle for its commands). A stall long enough to matter latches the safe state.
+    if (wake - deadline > stall_limit) {
       device_.request_safe_state();
       latch(kFaultDeadlineMiss,
-            "cycle %llu woke %.3f ms after its deadline (bound %.3f ms = deadline_periods %g x "
-            "period %.3f ms)",
-            cycle_no, static_cast<double>(wake - deadline) * 1e-6,
-            static_cast<double>(late_limit) * 1e-6, servo_.deadline_periods,
-            static_cast<double>(period_ns_) * 1e-6);
+            "cycle %llu woke %.3f ms after its deadline (bound stall_limit_s %.3f ms): the motors "
+            "held the previous commands that long",
+            cycle_no, static_cast<double>(wake - deadline) * 1e-6, servo_.stall_limit_s * 1e3);
     }
 
     reading.repeats = 0;  // backends that never repeat a reading do not touch it
@@ -263,28 +269,41 @@ void ServoLoop::run() {
       if (findings_.faults != 0) latch_findings();
     }
     force_->forces(sample_, force_frame_);
-    if (wake - force_frame_.t_ns > core::s_to_ns(servo_.force_timeout_s)) {
-      device_.request_safe_state();
-      latch(kFaultForceStall,
-            "cycle %llu: the force source's forces are %.3f ms old (bound force_timeout_s %.3f ms; "
-            "all fingers)",
-            cycle_no, static_cast<double>(wake - force_frame_.t_ns) * 1e-6,
-            servo_.force_timeout_s * 1e3);
+    // Stale forces are not displayed (the force source fell behind: a starved physics thread);
+    // stale for longer than the stall limit, the safe state latches.
+    const bool stale = wake - force_frame_.t_ns > core::s_to_ns(servo_.force_timeout_s);
+    if (stale) {
+      ++stale_force_cycles_;
+      if (stale_since < 0) stale_since = force_frame_.t_ns;
+      if (wake - stale_since > stall_limit) {
+        device_.request_safe_state();
+        latch(kFaultForceStall,
+              "cycle %llu: the force source's forces are %.3f ms old (not displayed after "
+              "force_timeout_s %.3f ms; safe state after stall_limit_s %.3f ms; all fingers)",
+              cycle_no, static_cast<double>(wake - force_frame_.t_ns) * 1e-6,
+              servo_.force_timeout_s * 1e3, servo_.stall_limit_s * 1e3);
+      }
+    } else {
+      stale_since = -1;
     }
     sample_.faults = faults_.load(std::memory_order_acquire);
-    const bool safe = (sample_.faults & kSafeStateFaults) || estop_.load(std::memory_order_acquire);
+    const bool safe = (sample_.faults & kSafeStateFaults) || estop_.load(std::memory_order_acquire) || stale;
     cycle_maths_.command(force_frame_, safe, sample_, commands_);
-    // A cycle that ran far past its deadline (a stall in the read or the force source) must not
-    // send the commands it computed from old data.
-    if (const std::int64_t late = core::monotonic_ns() - deadline;
+    // A cycle woken or ended far past its deadline (a stall in the scheduler, the read or the
+    // force source) must not send the forces it computed from old data: minimum tension this
+    // cycle, counted. A stall past the stall limit latches the safe state.
+    if (const std::int64_t late = std::max(wake, core::monotonic_ns()) - deadline;
         cycle_.load(std::memory_order_relaxed) > 0 && late > late_limit) {
-      device_.request_safe_state();
-      latch(kFaultDeadlineMiss,
-            "cycle %llu ended %.3f ms after its deadline (bound %.3f ms = deadline_periods %g x "
-            "period %.3f ms); its commands were replaced by the minimum",
-            cycle_no, static_cast<double>(late) * 1e-6, static_cast<double>(late_limit) * 1e-6,
-            servo_.deadline_periods, static_cast<double>(period_ns_) * 1e-6);
+      ++deadline_misses_;
       std::fill(commands_.begin(), commands_.end(), device_.info().command_min);
+      for (int f = 0; f < sample_.finger_count; ++f) sample_.f_W[f] = {0.0, 0.0, 0.0};
+      if (late > stall_limit) {
+        device_.request_safe_state();
+        latch(kFaultDeadlineMiss,
+              "cycle %llu ended %.3f ms after its deadline (bound stall_limit_s %.3f ms); its "
+              "commands were replaced by the minimum",
+              cycle_no, static_cast<double>(late) * 1e-6, servo_.stall_limit_s * 1e3);
+      }
     }
     if (auto st = device_.write(commands_); !st.ok()) {
       device_.request_safe_state();
@@ -333,6 +352,8 @@ ServoStats ServoLoop::stats() const {
   s.cycle_us_p99 = percentile(compute_hist_, 0.99);
   s.cycle_us_max = compute_max_us_;
   s.overruns = overruns_;
+  s.deadline_misses = deadline_misses_;
+  s.stale_force_cycles = stale_force_cycles_;
   s.repeated_readings = repeated_readings_;
   s.longest_repeat = longest_repeat_;
   s.inconsistent = cycle_maths_.inconsistent();

@@ -47,6 +47,7 @@ ServoConfig calm() {
   c.rate_hz = 1000;
   c.realtime = false;
   c.deadline_periods = 1e6;
+  c.stall_limit_s = 1.0;
   c.force_timeout_s = 1e3;
   return c;
 }

@@ -153,6 +153,7 @@ TEST(SerialServoFaults, OverCurrentReportedByTheDeviceTripsTheSafeState) {
   servo.max_repeated_readings = 1'000'000;  // a loaded pty may hold answers back; not tested here
   servo.force_timeout_s = 1e3;
   servo.deadline_periods = 1e6;
+  servo.stall_limit_s = 1.0;
   ServoLoop loop(dev, cfg, servo, std::make_shared<Pushing>());
   ASSERT_TRUE(loop.start().ok());
   ASSERT_TRUE(PtyLink::wait_until([&] { return loop.cycles() >= 30 || !loop.running(); }, 30.0));

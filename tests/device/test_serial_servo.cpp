@@ -31,6 +31,7 @@ TEST(SerialServo, LoopKeepsCyclingOnTheLastCountsWhileTheDeviceIsSilent) {
   // Not the watchdog's test: a sanitizer build on a busy machine may wake a few periods late
   // (seen under ASan in CI: the 5-period bound tripped), which is not what is checked here.
   servo.deadline_periods = 1000.0;
+  servo.stall_limit_s = 1.0;
   ServoLoop loop(dev, cfg, servo, std::make_shared<ZeroForce>());
   ASSERT_TRUE(loop.start().ok());
   auto wait_for_cycles = [&](std::uint64_t n) {

@@ -8,10 +8,15 @@
 /// when permitted (a warning otherwise), and in the cycle allocates nothing, takes no locks and
 /// logs nothing.
 ///
-/// Safety: commands are clamped to the device limits; the safe state (minimum tension on every
-/// motor) is entered within one cycle if the loop wakes more than `deadline_periods` late, if the
-/// force source's data goes stale, on emergency stop, or — from a monitor thread — if the servo
-/// thread itself stops cycling. A device error (disconnect, timeout) puts the device in its safe
+/// Safety (docs/realtime.md, "When a fault latches"): commands are clamped to the device limits.
+/// A busy machine degrades the display, it does not stop it: a cycle that wakes or ends more than
+/// `deadline_periods` late sends no force (minimum tension) that cycle and is counted
+/// (`deadline_misses`); forces older than `force_timeout_s` are not displayed (minimum tension)
+/// until fresh ones come, counted (`stale_force_cycles`). The safe state latches when safety is
+/// at stake: the loop stalled for longer than `stall_limit_s` (the motors held old commands that
+/// long: kFaultDeadlineMiss, or kFaultWatchdog from the monitor thread when the servo thread stops
+/// cycling), forces stale for longer than `stall_limit_s` (kFaultForceStall), emergency stop, and
+/// the device faults below. A device error (disconnect, timeout) puts the device in its safe
 /// state and ends the loop with the fault reported.
 ///
 /// Device faults reach the safe state within the cycle their reading arrives (reading_checks.hpp):
@@ -52,8 +57,15 @@ struct ServoConfig {
   double rate_hz = 1000.0;
   bool realtime = true;           ///< try SCHED_FIFO (priority 80) and CPU pinning
   int cpu = -1;                   ///< CPU to pin to; -1: the last CPU
-  double deadline_periods = 5.0;  ///< waking this many periods late trips the safe state
-  double force_timeout_s = 0.02;  ///< forces older than this trip the safe state
+  /// A cycle that wakes or ends this many periods late displays no force that cycle (its data
+  /// is old) and counts as a deadline miss; > 0.
+  double deadline_periods = 5.0;
+  double force_timeout_s = 0.02;  ///< forces older than this are not displayed [s], > 0
+  /// A stall this long latches the safe state [s]: the loop late by it (kFaultDeadlineMiss), no
+  /// cycle completed in it (kFaultWatchdog, the monitor thread), or forces stale for it
+  /// (kFaultForceStall, counted from when they went stale). In (0, 1] s: a device's safety
+  /// cannot be switched off by a large value.
+  double stall_limit_s = 0.1;
   /// Consecutive cycles that may run on a repeated (late) device reading; one more trips the
   /// safe state (kFaultStaleCounts). 20 cycles = 5 ms at 4 kHz, 20 ms at 1 kHz.
   int max_repeated_readings = 20;
@@ -82,6 +94,8 @@ struct ServoStats {
   double jitter_p50_us = 0, jitter_p99_us = 0, jitter_max_us = 0;  ///< |period − nominal|
   double cycle_us_median = 0, cycle_us_p99 = 0, cycle_us_max = 0;  ///< compute time per cycle
   std::uint64_t overruns = 0;       ///< cycles that ended after the next deadline
+  std::uint64_t deadline_misses = 0;  ///< cycles more than deadline_periods late (no force shown)
+  std::uint64_t stale_force_cycles = 0;  ///< cycles whose forces were older than force_timeout_s
   std::uint64_t repeated_readings = 0;  ///< cycles that ran on a repeated (late) device reading
   std::uint64_t longest_repeat = 0;     ///< longest run of consecutive cycles on repeated readings
   std::uint64_t inconsistent = 0;   ///< finger solves flagged inconsistent
@@ -159,6 +173,8 @@ class ServoLoop {
   std::int64_t first_wake_ns_ = 0, last_wake_ns_ = 0;
   std::uint64_t first_timed_cycle_ = 0;  ///< the first cycle is untimed (device handshake)
   std::uint64_t overruns_ = 0;
+  std::uint64_t deadline_misses_ = 0;
+  std::uint64_t stale_force_cycles_ = 0;
   std::uint64_t repeated_readings_ = 0, longest_repeat_ = 0;
   FaultLog fault_log_;
   bool realtime_granted_ = false;
