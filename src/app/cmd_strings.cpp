@@ -42,15 +42,16 @@ std::string num(double x) {
 
 /// UsageError unless `p_W` lies in the device's workspace (the fulcrums' box grown by the servo
 /// loop's margin: a solved point outside it means lengths no fingertip in the frame can have).
-void require_in_workspace(const strings::DeviceConfig& cfg, const Vec3& p_W, const std::string& what) {
+void require_in_workspace(const strings::DeviceConfig& cfg, const Vec3& p_W, const std::string& what,
+                          const std::string& expected) {
   const double margin = device::ServoConfig{}.workspace_margin_m;
   const auto ws = device::device_workspace(cfg, margin);
   const auto ex = device::workspace_excess(ws, {p_W.x(), p_W.y(), p_W.z()});
   if (ex.axis < 0 && ex.distance_m == 0) return;
   const char* axis = ex.axis == 0 ? "x" : ex.axis == 1 ? "y" : ex.axis == 2 ? "z" : "?";
-  throw UsageError(what + " (" + num(p_W.x()) + ", " + num(p_W.y()) + ", " + num(p_W.z()) + ") m lies " +
+  throw UsageError(what + " (" + num(p_W.x()) + ", " + num(p_W.y()) + ", " + num(p_W.z()) + ") m, " +
                    num(ex.distance_m) + " m outside the device's workspace along " + axis + " (face at " +
-                   num(ex.limit_m) + " m); expected a point within " + num(margin) +
+                   num(ex.limit_m) + " m); expected " + expected + " within " + num(margin) +
                    " m of the box of " + cfg.source + "'s fulcrums");
 }
 
@@ -110,7 +111,8 @@ Action add_position(CLI::App& app) {
       throw UsageError("--lengths: finger " + std::to_string(f) + " (" + cfg.fingers[f].name +
                        "): " + est.error().message);
     }
-    require_in_workspace(cfg, est->p_WF, "--lengths: " + finger_label(cfg, f) + ": the lengths put the fingertip at");
+    require_in_workspace(cfg, est->p_WF, "--lengths: " + finger_label(cfg, f) + ": the lengths put the fingertip at",
+                         "the lengths of a point");
     nlohmann::json j = {{"finger", f},
                         {"position", to_json(est->p_WF)},
                         {"consistent", est->consistent},
@@ -140,9 +142,9 @@ Action add_tension(CLI::App& app) {
     const int f = find_finger(cfg, a->finger);
     const Vec3 p = vec3_arg(a->position, "--position");
     const Vec3 force = vec3_arg(a->force, "--force");
-    require_in_workspace(cfg, p, "--position: " + finger_label(cfg, f) + ":");
-    if (!(force.norm() <= kMaxForceN)) {
-      throw UsageError("--force: " + num(force.norm()) + " N; expected a force of at most " + num(kMaxForceN) + " N");
+    require_in_workspace(cfg, p, "--position: " + finger_label(cfg, f) + ":", "a point");
+    if (!(force.stableNorm() <= kMaxForceN)) {  // stableNorm: |(1e308, 0, 0)| is 1e308, not inf
+      throw UsageError("--force: " + num(force.stableNorm()) + " N; expected a force of at most " + num(kMaxForceN) + " N");
     }
     auto sol = strings::solve_tensions(cfg.fingers[f].geometry, p, force, cfg.effective_limits());
     if (!sol) {

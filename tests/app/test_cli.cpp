@@ -218,10 +218,19 @@ bool exists(const std::string& path) {
 TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   const std::string dir = ::testing::TempDir() + "spidar_mr_demo_" + std::to_string(getpid());
   auto r = run("demo --seconds 3 --width 320 --height 240 --out " + dir);
-  ASSERT_EQ(r.code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("registration"), std::string::npos);
   const auto j = read_json(dir + "/report.json");
-  ASSERT_TRUE(j.is_object()) << "no report.json";
+  ASSERT_TRUE(j.is_object()) << "no report.json; exit " << r.code << "\n" << r.err;
+  // Exit code 1 exactly when a servo fault latched; on a loaded machine (or under a sanitizer) a
+  // late physics step or servo cycle can latch a timing fault, nothing else may.
+  const std::string faults = j["haptic"]["faults"];
+  EXPECT_EQ(r.code, faults == "none" ? 0 : 1) << r.err;
+  if (faults != "none") {
+    EXPECT_NE(r.err.find("the servo loop latched"), std::string::npos) << r.err;
+    for (const char* f : {"workspace", "inconsistent", "encoder_glitch", "over_current", "protocol"})
+      EXPECT_EQ(faults.find(f), std::string::npos) << faults;
+  }
+  EXPECT_EQ(j["ended_by"], "completed");
   // 30 fps for 3 s = 90 frames (89 measured); a loaded VM or a sanitizer build drops many (ASan
   // with one core busy elsewhere: 6–8 frames, 2 fps). Speed is the benchmarks' and the demo
   // report's to measure, not this test's: it asks for enough frames to measure registration.
@@ -398,7 +407,7 @@ TEST(Cli, DemoExitsWithCode1WhenTheServoLatchesAFault) {
   EXPECT_NE(r.err.find("workspace"), std::string::npos) << r.err;
   const auto j = read_json(dir + "/out/report.json");
   ASSERT_TRUE(j.is_object()) << "no report.json";
-  EXPECT_FALSE(j["haptic"]["faults"].get<std::string>().empty());
+  EXPECT_NE(j["haptic"]["faults"].get<std::string>().find("workspace"), std::string::npos) << j["haptic"];
   EXPECT_FALSE(j["haptic"]["fault_message"].get<std::string>().empty());
 }
 
