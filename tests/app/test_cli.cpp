@@ -458,4 +458,34 @@ TEST(Cli, DemoEndsCleanlyOnSigint) {
   fs::remove_all(dir);
 }
 
+// MuJoCo's warnings (here: a contact buffer of 1 in a scene with many contacts) are counted in
+// the report and written to OUT/mujoco_log.txt, not to MUJOCO_LOG.TXT in the working directory.
+TEST(Cli, DemoReportsMujocoWarningsInItsOutputFolder) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / ("spidar_demo_mjwarn_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string scene = slurp_file("scenes/blocks.xml");
+  const std::string size = "<size nconmax=\"300\"";
+  const auto at = scene.find(size);
+  ASSERT_NE(at, std::string::npos) << "scenes/blocks.xml changed: update this test";
+  scene.replace(at, size.size(), "<size nconmax=\"1\"");
+  std::ofstream(dir / "tiny_contact_buffer.xml") << scene;
+  const bool log_before = fs::exists("MUJOCO_LOG.TXT");
+  const auto size_before = log_before ? fs::file_size("MUJOCO_LOG.TXT") : 0;
+  auto r = run("demo --seconds 1 --no-video --width 320 --height 240 --scene " + (dir / "tiny_contact_buffer.xml").string() +
+               " --out " + (dir / "out").string());
+  const auto j = read_json((dir / "out" / "report.json").string());
+  ASSERT_TRUE(j.is_object()) << "no report.json; exit " << r.code << "\n" << r.err;
+  EXPECT_GE(j["physics"]["mujoco_warnings"].get<int>(), 1);
+  EXPECT_GE(j["physics"]["mujoco_warning_kinds"]["contact_full"].get<int>(), 1) << j["physics"];
+  const std::string log = slurp_file((dir / "out" / "mujoco_log.txt").string());
+  EXPECT_NE(log.find("contact buffer is full"), std::string::npos) << log;
+  EXPECT_EQ(fs::exists("MUJOCO_LOG.TXT"), log_before);
+  if (log_before) {
+    EXPECT_EQ(fs::file_size("MUJOCO_LOG.TXT"), size_before);
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
