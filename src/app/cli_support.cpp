@@ -1,7 +1,9 @@
 #include "cli_support.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <filesystem>
+#include <sstream>
 
 namespace spidar::app {
 
@@ -35,5 +37,61 @@ int find_finger(const strings::DeviceConfig& cfg, const std::string& finger) {
 }
 
 nlohmann::json to_json(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit) {
+  if (x >= lo && x <= hi) return;
+  std::ostringstream os;
+  os << option << ": expected " << lo << " to " << hi << (unit.empty() ? "" : " ") << unit << ", got " << x;
+  throw UsageError(os.str());
+}
+
+CLI::Validator seed_check() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        const std::string expected = "expected a whole number 0 to " + std::to_string(kMaxSeed) + ", got '" + s + "'";
+        if (s.empty() || s.size() > 10) return expected;
+        std::uint64_t v = 0;
+        const char* end = s.data() + s.size();
+        auto [ptr, ec] = std::from_chars(s.data(), end, v);
+        if (ec != std::errc() || ptr != end || v > kMaxSeed) return expected;
+        return {};
+      },
+      "SEED 0.." + std::to_string(kMaxSeed));
+}
+
+namespace {
+
+/// The first non-finite number under `j`, as a JSON pointer ("" if none).
+bool find_non_finite(const nlohmann::json& j, const std::string& path, std::string* where, double* value) {
+  if (j.is_number_float()) {
+    const double v = j.get<double>();
+    if (std::isfinite(v)) return false;
+    *where = path.empty() ? "/" : path;
+    *value = v;
+    return true;
+  }
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (find_non_finite(*it, path + "/" + it.key(), where, value)) return true;
+    }
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      if (find_non_finite(j[i], path + "/" + std::to_string(i), where, value)) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void require_finite_json(const nlohmann::json& j, std::string_view what) {
+  std::string where;
+  double v = 0;
+  if (!find_non_finite(j, "", &where, &v)) return;
+  std::ostringstream os;
+  os << std::string(what) << ": " << where << " is " << v
+     << " (a bug: every number written must be finite; JSON would show it as null)";
+  throw SpidarError(os.str());
+}
 
 }  // namespace spidar::app

@@ -1,7 +1,11 @@
 #pragma once
 /// Helpers shared by the spidar-mr subcommands.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 
 #include "spidar/core/result.hpp"
 #include "spidar/strings/device_config.hpp"
@@ -10,6 +14,11 @@ namespace spidar::app {
 
 /// Exit code for bad input (arguments, files, configs).
 inline constexpr int kExitBadInput = 2;
+/// Exit code when the servo loop latched a fault (or the device stopped) during a run.
+inline constexpr int kExitFault = 1;
+/// Exit codes when SIGINT / SIGTERM ended a run (128 + the signal, as a shell reports it).
+inline constexpr int kExitSigint = 130;
+inline constexpr int kExitSigterm = 143;
 
 /// An error the user caused; main prints its message and exits with kExitBadInput.
 class UsageError : public SpidarError {
@@ -25,5 +34,22 @@ std::string resolve_data_path(const std::string& path);
 int find_finger(const strings::DeviceConfig& cfg, const std::string& finger);
 
 nlohmann::json to_json(const Vec3& v);
+
+/// UsageError unless lo <= x <= hi (NaN is refused too): "--seconds: expected 0 to 600 s, got nan".
+void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit = "");
+
+/// The largest seed a --seed option takes.
+inline constexpr std::uint64_t kMaxSeed = 4294967295u;
+/// Check for --seed options: a decimal whole number 0 to kMaxSeed. CLI11 would otherwise map
+/// "-1" or "1e30" to some other seed (strtoull wraps and saturates) instead of refusing it.
+CLI::Validator seed_check();
+
+/// SpidarError naming the JSON path (e.g. "/haptic/jitter_p99_us") of the first number in `j`
+/// that is NaN or infinite, which nlohmann::json would write as null; `what` names the output
+/// ("report.json"). Call before writing any JSON.
+void require_finite_json(const nlohmann::json& j, std::string_view what);
+
+/// `x` if finite, else `fallback` (a statistic of an empty or broken set).
+inline double finite_or(double x, double fallback) { return std::isfinite(x) ? x : fallback; }
 
 }  // namespace spidar::app

@@ -66,7 +66,8 @@ Action add_calibrate_strings(CLI::App& app) {
   cmd->add_option("--timeout", a->timeout_s, "give up on a finger after this long [s]")->capture_default_str();
   cmd->add_flag("--dry-run", a->dry_run, "print the results, do not write the config");
   return [a] {
-    if (a->jig == 1 || a->jig < 0 || a->jig > 5) throw UsageError("--jig: expected 0 (pole) or 2 to 5");
+    if (!(a->jig == 0 || (a->jig >= 2 && a->jig <= 5)))
+      throw UsageError("--jig: expected 0 (pole) or 2 to 5, got " + std::to_string(a->jig));
     if (!(a->jig_spacing > 0.005 && a->jig_spacing < 0.2)) throw UsageError("--jig-spacing: expected 0.005 to 0.2 m");
     if (!(a->hold_s >= 0.05 && a->hold_s <= 10)) throw UsageError("--hold: expected 0.05 to 10 s");
     if (!(a->tolerance_mm > 0 && a->tolerance_mm <= 20)) throw UsageError("--tolerance: expected 0 to 20 mm");
@@ -214,6 +215,7 @@ Action add_calibrate_strings(CLI::App& app) {
       report["written"] = true;
       std::cerr << "wrote " << path << " (previous version: " << report["backup"].get<std::string>() << ")\n";
     }
+    require_finite_json(report, "calibrate-strings report");
     std::cout << report.dump(2) << "\n";
     return 0;
   };

@@ -39,13 +39,13 @@ Action add_demo(CLI::App& app) {
   cmd->add_option("--out", o->out, "output directory")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "length [s] (0: the scenario's own)");
   cmd->add_option("--rate", o->rate_hz, "servo rate [Hz]")->capture_default_str();
-  cmd->add_option("--seed", o->seed, "random seed")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "random seed")->check(seed_check())->capture_default_str();
   return [o] {
-    if (o->seconds < 0 || o->seconds > 600) throw UsageError("--seconds: expected 0 to 600");
-    if (!(o->rate_hz >= 10 && o->rate_hz <= 20000)) throw UsageError("--rate: expected 10 to 20000 Hz");
-    if (o->width < 64 || o->width > 3840 || o->height < 48 || o->height > 2160)
-      throw UsageError("--width/--height: expected 64..3840 x 48..2160 px");
-    if (!(o->fps >= 1 && o->fps <= 240)) throw UsageError("--fps: expected 1 to 240 Hz");
+    require_range(o->seconds, 0, 600, "--seconds", "s");
+    require_range(o->rate_hz, 10, 20000, "--rate", "Hz");
+    require_range(o->width, 64, 3840, "--width", "px");
+    require_range(o->height, 48, 2160, "--height", "px");
+    require_range(o->fps, 1, 240, "--fps", "Hz");
     if (o->scenario == "strings") return run_strings_demo(*o);
     if (o->scenario == "haptic") return run_haptic_demo(*o);
     return run_mr_demo(*o);

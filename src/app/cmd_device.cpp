@@ -3,6 +3,7 @@
 #include <csignal>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
@@ -28,8 +29,12 @@ Action add_device_test(CLI::App& app) {
   cmd->add_option("--seconds", *seconds, "how long to run [s]")->capture_default_str();
   cmd->add_option("--rate", *rate, "servo rate [Hz]")->capture_default_str();
   return [a, seconds, rate] {
-    if (!(*seconds > 0 && *seconds <= 3600)) throw UsageError("--seconds: expected (0, 3600]");
-    if (!(*rate >= 10 && *rate <= 20000)) throw UsageError("--rate: expected 10 to 20000 Hz");
+    if (!(*seconds > 0 && *seconds <= 3600)) {
+      std::ostringstream os;
+      os << "--seconds: expected more than 0 and at most 3600 s, got " << *seconds;
+      throw UsageError(os.str());
+    }
+    require_range(*rate, 10, 20000, "--rate", "Hz");
     const auto cfg = strings::load_device_config(resolve_data_path(a->config));
     auto dev = make_backend(*a, cfg);
     if (auto st = dev->open(); !st.ok()) throw UsageError(st.error().message);
@@ -92,6 +97,7 @@ Action add_device_test(CLI::App& app) {
                           {"repeated", l.repeated},         {"timeouts", l.timeouts},
                           {"unexpected", l.unexpected},     {"decoder_errors", l.decoder.errors()}};
     }
+    require_finite_json(j, "device-test report");
     std::cout << j.dump(2) << "\n";
     return s.faults ? 1 : 0;
   };

@@ -44,9 +44,11 @@ Action add_emulate_device(CLI::App& app) {
   cmd->add_option("--heartbeat-timeout", a->heartbeat_timeout,
                   "safe state when the host is silent this long [s]")
       ->capture_default_str();
-  cmd->add_option("--seed", a->seed, "random seed of the simulated device")->capture_default_str();
+  cmd->add_option("--seed", a->seed, "random seed of the simulated device")
+      ->check(seed_check())
+      ->capture_default_str();
   return [a] {
-    if (a->seconds < 0) throw UsageError("--seconds: expected >= 0");
+    require_range(a->seconds, 0, 86400, "--seconds", "s");
     if (const Status v = device::validate(device::DeviceEmulatorOptions{a->heartbeat_timeout}); !v)
       throw UsageError("--heartbeat-timeout: " + v.error().message);
     const auto cfg = strings::load_device_config(resolve_data_path(a->config));

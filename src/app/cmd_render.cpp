@@ -78,9 +78,9 @@ Action add_render_test(CLI::App& app) {
   return [a] {
     const auto mode = render::parse_composite_mode(a->mode);
     if (!mode) throw UsageError("--mode: " + mode.error().message);
-    if (a->frames < 0 || a->frames > 10000) throw UsageError("--frames: expected 0..10000");
-    if (!std::isfinite(a->registration_error_mm) || std::abs(a->registration_error_mm) > 100)
-      throw UsageError("--registration-error-mm: expected a finite value within ±100 mm");
+    require_range(a->frames, 0, 10000, "--frames");
+    require_range(a->fps, 1, 240, "--fps", "Hz");
+    require_range(a->registration_error_mm, -100, 100, "--registration-error-mm", "mm");
     const vision::Camera camera = vision::load_camera_file(resolve_data_path(a->camera)).camera;
     const auto device = strings::load_device_config(resolve_data_path(a->device));
     auto world = physics::World::Load(resolve_data_path(a->scene));

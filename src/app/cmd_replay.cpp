@@ -110,6 +110,8 @@ struct RecordedFrame {
 struct RecordedFit {
   std::array<hand::HandParams, 2> hands;
   std::array<double, 2> cost{};
+  /// The row had a NaN or infinity (a live fit that diverged): not compared.
+  std::array<bool, 2> broken{};
 };
 
 }  // namespace
@@ -187,6 +189,7 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
       RecordedFit& r = recorded[c.i64(0)];
       r.cost[h] = c.d(5);
       for (int i = 0; i < hand::kParamCount; ++i) r.hands[h].q[i] = c.d(11 + i);
+      r.broken[h] = !std::isfinite(r.cost[h]) || !r.hands[h].q.allFinite();
     }
   }
   std::vector<device::FingertipSample> samples;  // newest first, for re-interpolation
@@ -236,7 +239,7 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
   std::vector<double> t, iou, iters, ms;
   std::array<std::vector<double>, 5> terms;
   double max_dq = 0, max_dcost = 0, max_resample_mm = 0, sum_dq = 0;
-  int compared = 0;
+  int compared = 0, compared_hands = 0, broken_fits = 0;
   const std::int64_t t0 = frames.front().t_ns;
   for (const RecordedFrame& f : frames) {
     cv::Mat bgr;
@@ -269,10 +272,15 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
     if (auto it = recorded.find(f.index); it != recorded.end()) {
       ++compared;
       for (int h = 0; h < 2; ++h) {
+        if (it->second.broken[h]) {
+          ++broken_fits;
+          continue;
+        }
         const double dq = (result.hands[h].q - it->second.hands[h].q).cwiseAbs().maxCoeff();
-        max_dq = std::max(max_dq, dq);
-        sum_dq += dq / 2;
-        max_dcost = std::max(max_dcost, std::abs(result.fits[h].cost_final - it->second.cost[h]));
+        max_dq = std::max(max_dq, finite_or(dq, 0.0));
+        sum_dq += finite_or(dq, 0.0);
+        ++compared_hands;
+        max_dcost = std::max(max_dcost, finite_or(std::abs(result.fits[h].cost_final - it->second.cost[h]), 0.0));
       }
     }
     if (auto s = device::interpolate_samples(samples, f.t_ns)) {
@@ -306,7 +314,8 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
                                           {"prior", mean(terms[4])}}}};
   j["reproduction"] = {{"frames_compared", compared},
                        {"max_param_diff", max_dq},
-                       {"mean_param_diff", compared > 0 ? sum_dq / compared : 0.0},
+                       {"mean_param_diff", compared_hands > 0 ? sum_dq / compared_hands : 0.0},
+                       {"recorded_fits_not_finite", broken_fits},
                        {"max_cost_diff", max_dcost},
                        {"fingertip_resample_max_mm", max_resample_mm},
                        {"frames_store", png ? "png (lossless)"
@@ -330,6 +339,7 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
   }
   write_plot("iterations.png", {"Registration iterations (both hands)", "time [s]", "iterations", 960, 360, 0.0, std::nullopt, {}},
              {{"iterations", t, iters, render::plot_colour(2)}});
+  require_finite_json(j, (fs::path(out) / "report.json").string());
   std::ofstream rep(fs::path(out) / "report.json");
   rep << j.dump(2) << "\n";
   if (!rep) throw SpidarError("cannot write " + (fs::path(out) / "report.json").string());

@@ -13,34 +13,11 @@
 #include "commands.hpp"
 #include "live_gui.hpp"
 #include "live_session.hpp"
+#include "signal_scope.hpp"
 #include "spidar/core/config.hpp"
 
 namespace spidar::app {
 namespace {
-
-std::atomic<int> g_signal{0};
-
-extern "C" void on_signal(int sig) { g_signal.store(sig); }
-
-/// SIGINT and SIGTERM end the session cleanly (the previous handlers come back afterwards).
-class SignalScope {
- public:
-  SignalScope() {
-    g_signal.store(0);
-    struct sigaction sa {};
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~SignalScope() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-
- private:
-  struct sigaction old_int_ {}, old_term_ {};
-};
 
 nlohmann::json summary_json(const LiveSession& s, const std::string& ended_by, double wall_s) {
   nlohmann::json j;
@@ -102,7 +79,7 @@ Action add_run(CLI::App& app) {
   cmd->add_option("--screenshot", a->screenshot,
                   "window: save the window's pixels to this PNG just before exiting (tests)");
   return [a] {
-    if (!(a->seconds >= 0 && a->seconds <= 86400)) throw UsageError("--seconds: expected 0 to 86400");
+    require_range(a->seconds, 0, 86400, "--seconds", "s");
     SignalScope signals;  // from the start: a signal during start-up ends the session once it runs
     const LiveConfig cfg = load_live_config(a->config);
     LiveSessionOptions opt;
@@ -145,9 +122,10 @@ Action add_run(CLI::App& app) {
     const double wall = session->seconds();
     session->stop();
     const auto j = summary_json(*session, ended_by, wall);
+    require_finite_json(j, "run's summary");
     std::cout << j.dump(2) << "\n";
-    if (session->servo().stats().faults != 0) return 1;
-    if (ended_by == "device stopped" || !session->error().empty()) return 1;
+    if (session->servo().stats().faults != 0) return kExitFault;
+    if (ended_by == "device stopped" || !session->error().empty()) return kExitFault;
     return 0;
   };
 }

@@ -1,10 +1,14 @@
 // spidar-mr check-config | position | tension: the string maths from the command line.
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <sstream>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "spidar/device/servo_loop.hpp"
+#include "spidar/device/workspace.hpp"
 #include "spidar/strings/position.hpp"
 #include "spidar/strings/tension.hpp"
 
@@ -18,6 +22,37 @@ Vec3 vec3_arg(const std::vector<double>& v, const char* name) {
     }
   }
   return {v[0], v[1], v[2]};
+}
+
+/// The largest force the CLI takes [N]: far above any string drive (SPIDAR-8's saturates at
+/// 17 N per string); beyond it an input is a typo, not a request.
+constexpr double kMaxForceN = 1000.0;
+/// String lengths above this multiple of the farthest fulcrum from the frame centre are refused.
+constexpr double kMaxLengthFactor = 100.0;
+
+std::string finger_label(const strings::DeviceConfig& cfg, int f) {
+  return "finger " + std::to_string(f) + " (" + cfg.fingers[f].name + ")";
+}
+
+std::string num(double x) {
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
+
+/// UsageError unless `p_W` lies in the device's workspace (the fulcrums' box grown by the servo
+/// loop's margin: a solved point outside it means lengths no fingertip in the frame can have).
+void require_in_workspace(const strings::DeviceConfig& cfg, const Vec3& p_W, const std::string& what,
+                          const std::string& expected) {
+  const double margin = device::ServoConfig{}.workspace_margin_m;
+  const auto ws = device::device_workspace(cfg, margin);
+  const auto ex = device::workspace_excess(ws, {p_W.x(), p_W.y(), p_W.z()});
+  if (ex.axis < 0 && ex.distance_m == 0) return;
+  const char* axis = ex.axis == 0 ? "x" : ex.axis == 1 ? "y" : ex.axis == 2 ? "z" : "?";
+  throw UsageError(what + " (" + num(p_W.x()) + ", " + num(p_W.y()) + ", " + num(p_W.z()) + ") m, " +
+                   num(ex.distance_m) + " m outside the device's workspace along " + axis + " (face at " +
+                   num(ex.limit_m) + " m); expected " + expected + " within " + num(margin) +
+                   " m of the box of " + cfg.source + "'s fulcrums");
 }
 
 }  // namespace
@@ -60,15 +95,29 @@ Action add_position(CLI::App& app) {
                        ") has " + std::to_string(g.n) + " strings; got " +
                        std::to_string(a->lengths.size()) + " lengths");
     }
+    double reach = 0;  // the farthest fulcrum from the frame centre [m]
+    for (int i = 0; i < g.n; ++i) reach = std::max(reach, (g.p_WA[i] - cfg.p_W_centre).norm());
+    const double max_length = kMaxLengthFactor * reach;
+    for (int i = 0; i < g.n; ++i) {
+      const double l = a->lengths[i];
+      if (!(l > 0 && l <= max_length)) {
+        throw UsageError("--lengths: " + finger_label(cfg, f) + ": string " + std::to_string(i) + ": length " +
+                         num(l) + " m; expected more than 0 and at most " + num(max_length) + " m (" +
+                         num(kMaxLengthFactor) + " x its farthest fulcrum from the frame centre)");
+      }
+    }
     auto est = strings::solve_position(g, a->lengths);
     if (!est) {
       throw UsageError("--lengths: finger " + std::to_string(f) + " (" + cfg.fingers[f].name +
                        "): " + est.error().message);
     }
+    require_in_workspace(cfg, est->p_WF, "--lengths: " + finger_label(cfg, f) + ": the lengths put the fingertip at",
+                         "the lengths of a point");
     nlohmann::json j = {{"finger", f},
                         {"position", to_json(est->p_WF)},
                         {"consistent", est->consistent},
                         {"residual", est->residual}};
+    require_finite_json(j, "position output");
     std::cout << j.dump() << "\n";
     return 0;
   };
@@ -93,6 +142,10 @@ Action add_tension(CLI::App& app) {
     const int f = find_finger(cfg, a->finger);
     const Vec3 p = vec3_arg(a->position, "--position");
     const Vec3 force = vec3_arg(a->force, "--force");
+    require_in_workspace(cfg, p, "--position: " + finger_label(cfg, f) + ":", "a point");
+    if (!(force.stableNorm() <= kMaxForceN)) {  // stableNorm: |(1e308, 0, 0)| is 1e308, not inf
+      throw UsageError("--force: " + num(force.stableNorm()) + " N; expected a force of at most " + num(kMaxForceN) + " N");
+    }
     auto sol = strings::solve_tensions(cfg.fingers[f].geometry, p, force, cfg.effective_limits());
     if (!sol) {
       throw UsageError("finger " + std::to_string(f) + " (" + cfg.fingers[f].name +
@@ -104,6 +157,7 @@ Action add_tension(CLI::App& app) {
                         {"tensions", t},
                         {"force", to_json(sol->f_displayed)},
                         {"reachable", sol->reachable}};
+    require_finite_json(j, "tension output");
     std::cout << j.dump() << "\n";
     return 0;
   };

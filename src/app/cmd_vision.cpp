@@ -51,6 +51,7 @@ int extrinsics_only(const CalibrateCameraArgs& a, const std::string& base) {
                             {"intrinsics", {{"kept_from", base.empty() ? "default rig camera" : base}}},
                             {"extrinsics", extr},
                             {"camera_position", to_json(camera.X_WC().p)}};
+  require_finite_json(j, "calibrate-camera output");
   std::cout << j.dump() << "\n";
   return 0;
 }
@@ -135,6 +136,7 @@ Action add_calibrate_camera(CLI::App& app) {
           {"rms_px", cal.rms_px}}},
         {"extrinsics", extr},
         {"camera_position", to_json(p_WC)}};
+    require_finite_json(j, "calibrate-camera output");
     std::cout << j.dump() << "\n";
     return 0;
   };

@@ -191,6 +191,7 @@ int run_haptic_demo(const DemoOptions& o) {
         {"overruns", ss.overruns},
         {"cycle_us_median", ss.cycle_us_median},
         {"faults", device::fault_names(ss.faults)},
+        {"fault_message", ss.fault_message},
         {"force_jump_max_n", jump_max}}},
       {"physics",
        {{"rate_hz", ps.rate_hz},
@@ -198,9 +199,15 @@ int run_haptic_demo(const DemoOptions& o) {
         {"step_ms_p99", ps.step_ms_p99},
         {"steps", ps.steps}}},
       {"fingers", fingers}};
+  require_finite_json(report, (fs::path(o.out) / "report.json").string());
   std::ofstream(fs::path(o.out) / "report.json") << report.dump(2) << "\n";
   std::cout << "wrote " << (fs::path(o.out) / "haptic_trace.csv").string() << " and "
             << (fs::path(o.out) / "report.json").string() << "\n";
+  if (ss.faults != 0) {
+    std::cerr << "spidar-mr demo: the servo loop latched " << device::fault_names(ss.faults) << ": "
+              << ss.fault_message << " (the report is written; exit code " << kExitFault << ")\n";
+    return kExitFault;
+  }
   return 0;
 }
 

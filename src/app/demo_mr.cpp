@@ -18,6 +18,7 @@
 #include "demo.hpp"
 #include "demo_mr_report.hpp"
 #include "progress.hpp"
+#include "signal_scope.hpp"
 #include "session_parts.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/device/sample_interpolation.hpp"
@@ -25,6 +26,7 @@
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/render_geometry.hpp"
+#include "spidar/physics/mujoco_log.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/render/video_output.hpp"
@@ -43,6 +45,8 @@ namespace spidar::app {
 namespace fs = std::filesystem;
 
 int run_mr_demo(const DemoOptions& o) {
+  // Ctrl-C / SIGTERM end the run early but cleanly: the video is finished and the report written.
+  SignalScope signals;
   // --- inputs (all checked before anything starts) ---
   const auto cfg = strings::load_device_config(resolve_data_path(o.config));
   if (cfg.fingers.size() != 8) throw UsageError("--config: the rubiks demo needs 8 fingers");
@@ -199,7 +203,12 @@ int run_mr_demo(const DemoOptions& o) {
   constexpr int kCompareEvery = 5;
   int frame_index = 0;
 
+  std::string ended_by = "completed";
   while (loop.running()) {
+    if (SignalScope::received() != 0) {
+      ended_by = SignalScope::ended_by(ended_by);
+      break;
+    }
     if (!camera_thread->take()) {  // wait for the next frame
       if (core::ns_to_s(core::monotonic_ns() - t_open) > seconds + 1.0) break;
       std::this_thread::sleep_for(std::chrono::microseconds(500));
@@ -341,7 +350,30 @@ int run_mr_demo(const DemoOptions& o) {
   summary.user_hand = hand_path;
   summary.user_length_m = truth_models[0].shape.dimensions.length;
   summary.user_width_m = truth_models[0].shape.dimensions.width;
-  return write_mr_report(o.out, trace, summary, std::cout);
+  summary.ended_by = ended_by;
+  summary.mujoco_warning_kinds = world->warning_counts();
+  const physics::MujocoWarnings mj = physics::mujoco_warnings();
+  summary.mujoco_warnings = mj.count;
+  if (mj.count > 0) {  // MuJoCo's own log, here rather than MUJOCO_LOG.TXT in the working directory
+    const fs::path log = fs::path(o.out) / "mujoco_log.txt";
+    std::ofstream f(log);
+    f << mj.count << " MuJoCo warning(s) in this run; the last " << mj.messages.size() << ":\n";
+    for (const auto& m : mj.messages) f << m << "\n";
+    if (!f) throw SpidarError("cannot write " + log.string());
+    summary.mujoco_log = log.string();
+  }
+  const int code = write_mr_report(o.out, trace, summary, std::cout);
+  if (summary.servo.faults != 0) {
+    std::cerr << "spidar-mr demo: the servo loop latched " << device::fault_names(summary.servo.faults)
+              << ": " << summary.servo.fault_message << " (the report is written; exit code "
+              << kExitFault << ")\n";
+  }
+  if (SignalScope::received() != 0) {
+    std::cerr << "spidar-mr demo: ended by " << ended_by << " after " << trace.frames.size()
+              << " frames (video and report written)\n";
+    return SignalScope::exit_code(code);
+  }
+  return summary.servo.faults != 0 ? kExitFault : code;
 }
 
 }  // namespace spidar::app

@@ -7,6 +7,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
+#include "cli_support.hpp"
 #include "spidar/device/device.hpp"
 #include "spidar/render/plot.hpp"
 #include "spidar/render/video_output.hpp"
@@ -224,6 +225,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   reg["comparison"] = other;
 
   nlohmann::json report = {
+      {"ended_by", s.ended_by},
       {"frames", frames},
       {"seconds", s.seconds},
       {"wall_seconds", s.wall_s},
@@ -240,13 +242,21 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"deadline_misses", s.servo.deadline_misses},
         {"stale_force_cycles", s.servo.stale_force_cycles},
         {"cycle_us_median", s.servo.cycle_us_median},
-        {"faults", device::fault_names(s.servo.faults)}}},
+        {"faults", device::fault_names(s.servo.faults)},
+        {"fault_message", s.servo.fault_message}}},
       {"physics",
        {{"rate_hz", s.physics.rate_hz},
         {"step_ms_median", s.physics.step_ms_median},
         {"step_ms_p99", s.physics.step_ms_p99},
         {"late_steps", s.physics.late_steps},
-        {"realtime_scheduling", s.physics.realtime_scheduling}}},
+        {"realtime_scheduling", s.physics.realtime_scheduling},
+        {"mujoco_warnings", s.mujoco_warnings},
+        {"mujoco_warning_kinds", [&] {
+           nlohmann::json j = nlohmann::json::object();
+           for (const auto& w : s.mujoco_warning_kinds) j[w.kind] = w.count;
+           return j;
+         }()},
+        {"mujoco_log", s.mujoco_log}}},
       {"registration", reg},
       {"composite",
        {{"mode", s.compositor},
@@ -299,6 +309,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
     touching += fmax > 0.5 ? 1 : 0;
   }
   report["haptic"]["force_max_n"] = forces;
+  require_finite_json(report, (dir / "report.json").string());
   std::ofstream(dir / "report.json") << report.dump(2) << "\n";
   write_frames_csv((dir / "frames.csv").string(), t);
   if (frames > 1) write_plots(dir, t);

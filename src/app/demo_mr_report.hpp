@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "spidar/device/servo_loop.hpp"
+#include "spidar/physics/world.hpp"
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
 
@@ -54,6 +55,10 @@ struct MrSummary {
   double user_length_m = 0, user_width_m = 0;  ///< the simulated user's true hand sizes
   bool main_silhouette = false;
   int width = 0, height = 0;
+  std::string ended_by = "completed";  ///< completed | SIGINT | SIGTERM
+  std::uint64_t mujoco_warnings = 0;   ///< MuJoCo warnings in the process (physics::mujoco_warnings)
+  std::vector<physics::World::WarningCount> mujoco_warning_kinds;  ///< the world's, by kind
+  std::string mujoco_log;              ///< OUT/mujoco_log.txt when there were warnings
 };
 
 /// Writes report.json and the plots into `out`, prints the summary; returns the exit code.

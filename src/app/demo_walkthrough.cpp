@@ -337,6 +337,7 @@ int run_strings_demo(const DemoOptions& a) {
       {"force_cones", cones},
       {"fingers", fingers},
       {"solver_ns_per_fingertip", {{"position", pos_ns * per}, {"tension", ten_ns * per}}}};
+  require_finite_json(report, (fs::path(a.out) / "report.json").string());
   std::ofstream(fs::path(a.out) / "report.json") << report.dump(2) << "\n";
   std::cout << "wrote " << (fs::path(a.out) / "walkthrough.csv").string() << " and "
             << (fs::path(a.out) / "report.json").string() << "\n";

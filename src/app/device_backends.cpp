@@ -16,7 +16,7 @@ void add_backend_options(CLI::App& cmd, BackendArgs& a) {
   cmd.add_flag("!--no-link-check", a.check_link_budget,
                "serial: do not refuse a rate whose frames exceed the baud rate (a pseudo-terminal, "
                "or a transport faster than its baud setting)");
-  cmd.add_option("--seed", a.seed, "sim: random seed")->capture_default_str();
+  cmd.add_option("--seed", a.seed, "sim: random seed")->check(seed_check())->capture_default_str();
 }
 
 std::unique_ptr<device::Device> make_simulated(const strings::DeviceConfig& cfg, std::uint64_t seed) {

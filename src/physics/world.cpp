@@ -4,11 +4,15 @@
 
 #include <mujoco/mujoco.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
+
+#include "spidar/physics/mujoco_log.hpp"
 
 namespace spidar::physics {
 namespace {
@@ -22,9 +26,60 @@ std::string read_text(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+int line_at(const std::string& text, std::size_t pos) {
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
+}
+
+/// Where the last real closing worldbody tag starts in an MJCF text: a tiny XML scanner that
+/// skips comments, CDATA sections, processing instructions and declarations, so a
+/// "</worldbody>" inside any of them is not taken for the tag.
+Result<std::size_t> find_worldbody_end(const std::string& xml) {
+  static constexpr std::string_view kTag = "</worldbody";
+  std::size_t found = std::string::npos;
+  std::size_t i = 0;
+  const auto skip_to = [&](std::size_t from, std::string_view close, const char* what) -> Result<std::size_t> {
+    const std::size_t e = xml.find(close, from);
+    if (e == std::string::npos) {
+      return Error{std::string("unterminated ") + what + " starting at line " + std::to_string(line_at(xml, i)) +
+                   " (expected '" + std::string(close) + "')"};
+    }
+    return e + close.size();
+  };
+  while ((i = xml.find('<', i)) != std::string::npos) {
+    const std::string_view rest = std::string_view(xml).substr(i);
+    Result<std::size_t> next = i + 1;
+    if (rest.starts_with("<!--")) {
+      next = skip_to(i + 4, "-->", "comment");
+    } else if (rest.starts_with("<![CDATA[")) {
+      next = skip_to(i + 9, "]]>", "CDATA section");
+    } else if (rest.starts_with("<?")) {
+      next = skip_to(i + 2, "?>", "processing instruction");
+    } else if (rest.starts_with("<!")) {
+      next = skip_to(i + 2, ">", "declaration");
+    } else if (rest.starts_with(kTag)) {
+      std::size_t k = i + kTag.size();
+      while (k < xml.size() && std::isspace(static_cast<unsigned char>(xml[k]))) ++k;
+      if (k < xml.size() && xml[k] == '>') found = i;
+      next = i + kTag.size();
+    }
+    if (!next) return next.error();
+    i = *next;
+  }
+  if (found == std::string::npos) {
+    return Error{"no </worldbody> (outside comments) to add the fingertip proxies to; expected an "
+                 "MJCF scene with a <worldbody>...</worldbody> element"};
+  }
+  return found;
+}
+
+}  // namespace
+
 Result<std::string> inject_proxies(const std::string& mjcf, const ProxyParams& p) {
-  const auto pos = mjcf.rfind("</worldbody>");
-  if (pos == std::string::npos) return Error{"no </worldbody> to add the fingertip proxies to"};
+  const auto found = find_worldbody_end(mjcf);
+  if (!found) return found.error();
+  const std::size_t pos = *found;
   std::ostringstream os;
   os.precision(9);
   os << "\n    <!-- spidar-mr fingertip proxies -->\n";
@@ -49,6 +104,7 @@ Result<std::string> inject_proxies(const std::string& mjcf, const ProxyParams& p
 
 Result<std::unique_ptr<World>> World::Load(const std::string& scene_path, const WorldParams& params) {
   namespace fs = std::filesystem;
+  install_mujoco_warning_handler();  // before MuJoCo's compiler can warn
   if (!fs::exists(scene_path)) {
     return Error{scene_path + ": scene file not found (expected an MJCF .xml file)"};
   }
@@ -123,6 +179,23 @@ World::~World() {
 double World::time() const { return data_->time; }
 double World::timestep() const { return model_->opt.timestep; }
 int World::contact_count() const { return data_->ncon; }
+
+std::vector<World::WarningCount> World::warning_counts() const {
+  static constexpr const char* kKinds[mjNWARNING] = {"inertia",  "contact_full", "constraint_full",
+                                                     "vgeom_full", "bad_qpos", "bad_qvel",
+                                                     "bad_qacc", "bad_ctrl"};
+  std::vector<WarningCount> out;
+  for (int k = 0; k < mjNWARNING; ++k) {
+    if (data_->warning[k].number > 0) out.push_back({kKinds[k], data_->warning[k].number});
+  }
+  return out;
+}
+
+int World::warning_total() const {
+  int n = 0;
+  for (int k = 0; k < mjNWARNING; ++k) n += data_->warning[k].number;
+  return n;
+}
 
 int World::body_id(const std::string& name) const {
   return mj_name2id(model_, mjOBJ_BODY, name.c_str());

@@ -7,6 +7,10 @@
 #include <array>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <signal.h>
+#include <sstream>
+#include <vector>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -214,10 +218,19 @@ bool exists(const std::string& path) {
 TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   const std::string dir = ::testing::TempDir() + "spidar_mr_demo_" + std::to_string(getpid());
   auto r = run("demo --seconds 3 --width 320 --height 240 --out " + dir);
-  ASSERT_EQ(r.code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("registration"), std::string::npos);
   const auto j = read_json(dir + "/report.json");
-  ASSERT_TRUE(j.is_object()) << "no report.json";
+  ASSERT_TRUE(j.is_object()) << "no report.json; exit " << r.code << "\n" << r.err;
+  // Exit code 1 exactly when a servo fault latched; on a loaded machine (or under a sanitizer) a
+  // late physics step or servo cycle can latch a timing fault, nothing else may.
+  const std::string faults = j["haptic"]["faults"];
+  EXPECT_EQ(r.code, faults == "none" ? 0 : 1) << r.err;
+  if (faults != "none") {
+    EXPECT_NE(r.err.find("the servo loop latched"), std::string::npos) << r.err;
+    for (const char* f : {"workspace", "inconsistent", "encoder_glitch", "over_current", "protocol"})
+      EXPECT_EQ(faults.find(f), std::string::npos) << faults;
+  }
+  EXPECT_EQ(j["ended_by"], "completed");
   // 30 fps for 3 s = 90 frames (89 measured); a loaded VM or a sanitizer build drops many (ASan
   // with one core busy elsewhere: 6–8 frames, 2 fps). Speed is the benchmarks' and the demo
   // report's to measure, not this test's: it asks for enough frames to measure registration.
@@ -285,6 +298,194 @@ TEST(Cli, MixedRealityDemoRejectsBadSceneAndHandFiles) {
   r = run("demo --seconds 1 --no-video --user-hand /nonexistent/hands.yaml --out " + dir);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("/nonexistent/hands.yaml"), std::string::npos) << r.err;
+}
+
+}  // namespace
+
+// Issue 17: robustness of the CLI's numbers, JSON outputs, faults and signals.
+namespace {
+
+std::string slurp_file(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+TEST(Cli, NonFiniteAndOutOfRangeNumbersAreRefused) {
+  struct Case {
+    std::string args;
+    std::vector<std::string> expect;
+  };
+  const Case cases[] = {
+      {"demo --seconds nan", {"--seconds: expected 0 to 600 s, got nan"}},
+      {"demo --seconds inf", {"--seconds: expected 0 to 600 s, got inf"}},
+      {"demo --scenario haptic --rate nan", {"--rate: expected 10 to 20000 Hz, got nan"}},
+      {"demo --fps nan", {"--fps: expected 1 to 240 Hz, got nan"}},
+      {"demo --seed -1", {"--seed", "expected a whole number 0 to 4294967295, got '-1'"}},
+      {"demo --seed 1e30", {"--seed", "expected a whole number 0 to 4294967295"}},
+      {"device-test --seed 99999999999999999999", {"--seed", "expected a whole number"}},
+      {"emulate-device --pty --seconds nan", {"--seconds: expected 0 to 86400 s, got nan"}},
+      {"device-test --seconds nan", {"--seconds: expected more than 0 and at most 3600 s, got nan"}},
+      {"position --finger 1 --lengths 1e308 1e308 1e308",
+       {"--lengths: finger 1 (left_index): string 0: length 1e+308 m; expected more than 0 and at most"}},
+      // 10 m strings in a frame of 0.7 m: no point in the frame has them.
+      {"position --finger 1 --lengths 10 10 10", {"--lengths: finger 1 (left_index)", "outside the device's workspace"}},
+      {"tension --finger 0 --position 0 0 0 --force 1e308 0 0", {"--force: 1e+308 N; expected a force of at most 1000 N"}},
+      {"tension --finger 0 --position 0 0 0 --force 0 -2000 0", {"--force: 2000 N"}},
+      {"tension --finger 0 --position 100 0 0 --force 1 2 3", {"--position: finger 0 (left_thumb)", "outside the device's workspace along x"}},
+  };
+  for (const auto& c : cases) {
+    auto r = run(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    for (const auto& e : c.expect) EXPECT_NE(r.err.find(e), std::string::npos) << c.args << "\nstderr: " << r.err;
+    EXPECT_TRUE(r.out.empty()) << c.args << "\nstdout: " << r.out;
+  }
+}
+
+// A fit row with a NaN (a live fit that diverged) is left out of the comparison and counted; the
+// report has no null.
+TEST(Cli, ReplayOfARecordingWithANonFiniteFitWritesNoNull) {
+  namespace fs = std::filesystem;
+  const fs::path d = fs::path(::testing::TempDir()) / ("spidar_nan_fit_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  auto r = run("run --config configs/lab-example.yaml --headless --seconds 1.5 --record " + d.string() +
+               " --record-frames png");
+  ASSERT_TRUE(fs::exists(d / "fits.csv")) << r.err << r.out;
+  std::string fits = slurp_file((d / "fits.csv").string());
+  // fits.csv: frame,hand,...; field 6 is the final cost. Put a NaN there in the first row.
+  const auto row = fits.find('\n') + 1;
+  ASSERT_LT(row, fits.size()) << "no fit rows";
+  std::size_t field = row;
+  for (int k = 0; k < 5; ++k) field = fits.find(',', field) + 1;
+  const std::size_t end = fits.find(',', field);
+  fits.replace(field, end - field, "nan");
+  std::ofstream(d / "fits.csv") << fits;
+
+  auto rp = run("replay " + d.string() + " --no-video --out " + (d / "replay").string());
+  ASSERT_EQ(rp.code, 0) << rp.err;
+  const std::string text = slurp_file((d / "replay" / "report.json").string());
+  EXPECT_EQ(text.find("null"), std::string::npos) << text;
+  EXPECT_EQ(rp.out.find("null"), std::string::npos) << rp.out;
+  const auto j = nlohmann::json::parse(text);
+  EXPECT_EQ(j["reproduction"]["recorded_fits_not_finite"].get<int>(), 1);
+  EXPECT_TRUE(j["reproduction"]["mean_param_diff"].is_number());
+  EXPECT_GT(j["reproduction"]["frames_compared"].get<int>(), 0);
+  fs::remove_all(d);
+}
+
+/// configs/spidar8.yaml with every fulcrum moved 1 m along x: the scripted user's fingertips at
+/// the cube are then far outside the device's workspace, which the servo loop latches.
+std::string shifted_config(const std::string& dir) {
+  std::istringstream in(slurp_file("configs/spidar8.yaml"));
+  std::ostringstream out;
+  const std::regex fulcrum(R"(^(\s*- \[)\s*(-?[0-9.]+)(,.*)$)");
+  std::string line;
+  int shifted = 0;
+  while (std::getline(in, line)) {
+    std::smatch m;
+    if (std::regex_match(line, m, fulcrum)) {
+      out << m[1] << std::stod(m[2]) + 1.0 << m[3] << "\n";
+      ++shifted;
+    } else {
+      out << line << "\n";
+    }
+  }
+  EXPECT_EQ(shifted, 24);
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/shifted.yaml";
+  std::ofstream(path) << out.str();
+  return path;
+}
+
+TEST(Cli, DemoExitsWithCode1WhenTheServoLatchesAFault) {
+  const std::string dir = ::testing::TempDir() + "spidar_demo_fault_" + std::to_string(getpid());
+  const std::string cfg = shifted_config(dir);
+  auto r = run("demo --scenario haptic --config " + cfg + " --out " + dir + "/out");
+  EXPECT_EQ(r.code, 1) << r.err << r.out;
+  EXPECT_NE(r.err.find("the servo loop latched"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("workspace"), std::string::npos) << r.err;
+  const auto j = read_json(dir + "/out/report.json");
+  ASSERT_TRUE(j.is_object()) << "no report.json";
+  EXPECT_NE(j["haptic"]["faults"].get<std::string>().find("workspace"), std::string::npos) << j["haptic"];
+  EXPECT_FALSE(j["haptic"]["fault_message"].get<std::string>().empty());
+}
+
+TEST(Cli, DemoEndsCleanlyOnSigint) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / ("spidar_demo_sigint_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  int err_pipe[2];
+  ASSERT_EQ(pipe(err_pipe), 0);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    dup2(err_pipe[1], STDERR_FILENO);
+    close(err_pipe[0]);
+    close(err_pipe[1]);
+    if (!freopen("/dev/null", "w", stdout)) _exit(99);
+    execl(SPIDAR_MR, SPIDAR_MR, "demo", "--seconds", "20", "--out", dir.c_str(), nullptr);
+    _exit(98);
+  }
+  close(err_pipe[1]);
+  FILE* err = fdopen(err_pipe[0], "r");
+  ASSERT_NE(err, nullptr);
+  // The progress lines go to stderr ("  0%  t 0.0/20.0 s ..."): the run is under way after the
+  // first; a second more puts a few frames into the video.
+  std::string all;
+  std::array<char, 4096> buf{};
+  bool progress = false;
+  while (!progress && fgets(buf.data(), buf.size(), err)) {
+    all += buf.data();
+    progress = std::string(buf.data()).find("%  t ") != std::string::npos;
+  }
+  ASSERT_TRUE(progress) << "no progress line from the demo; stderr:\n" << all;
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  kill(pid, SIGINT);
+  while (fgets(buf.data(), buf.size(), err)) all += buf.data();  // EOF when the demo exits
+  fclose(err);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of exiting; stderr:\n" << all;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << all;
+  const auto j = read_json((dir / "report.json").string());
+  ASSERT_TRUE(j.is_object()) << "no report.json; stderr:\n" << all;
+  EXPECT_EQ(j["ended_by"], "SIGINT");
+  EXPECT_GT(j["frames"].get<int>(), 0);
+  ASSERT_TRUE(fs::exists(dir / "mixed_reality.mp4"));
+  EXPECT_GT(fs::file_size(dir / "mixed_reality.mp4"), 1024u);
+  EXPECT_TRUE(j["physics"]["mujoco_warnings"].is_number());
+  fs::remove_all(dir);
+}
+
+// MuJoCo's warnings (here: a contact buffer of 1 in a scene with many contacts) are counted in
+// the report and written to OUT/mujoco_log.txt, not to MUJOCO_LOG.TXT in the working directory.
+TEST(Cli, DemoReportsMujocoWarningsInItsOutputFolder) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / ("spidar_demo_mjwarn_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string scene = slurp_file("scenes/blocks.xml");
+  const std::string size = "<size nconmax=\"300\"";
+  const auto at = scene.find(size);
+  ASSERT_NE(at, std::string::npos) << "scenes/blocks.xml changed: update this test";
+  scene.replace(at, size.size(), "<size nconmax=\"1\"");
+  std::ofstream(dir / "tiny_contact_buffer.xml") << scene;
+  const bool log_before = fs::exists("MUJOCO_LOG.TXT");
+  const auto size_before = log_before ? fs::file_size("MUJOCO_LOG.TXT") : 0;
+  auto r = run("demo --seconds 1 --no-video --width 320 --height 240 --scene " + (dir / "tiny_contact_buffer.xml").string() +
+               " --out " + (dir / "out").string());
+  const auto j = read_json((dir / "out" / "report.json").string());
+  ASSERT_TRUE(j.is_object()) << "no report.json; exit " << r.code << "\n" << r.err;
+  EXPECT_GE(j["physics"]["mujoco_warnings"].get<int>(), 1);
+  EXPECT_GE(j["physics"]["mujoco_warning_kinds"]["contact_full"].get<int>(), 1) << j["physics"];
+  const std::string log = slurp_file((dir / "out" / "mujoco_log.txt").string());
+  EXPECT_NE(log.find("contact buffer is full"), std::string::npos) << log;
+  EXPECT_EQ(fs::exists("MUJOCO_LOG.TXT"), log_before);
+  if (log_before) {
+    EXPECT_EQ(fs::file_size("MUJOCO_LOG.TXT"), size_before);
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -2,7 +2,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <unistd.h>
 
+#include "spidar/physics/mujoco_log.hpp"
 #include "spidar/physics/passivity.hpp"
 #include "spidar/physics/world.hpp"
 
@@ -201,6 +203,63 @@ TEST(Passivity, ObserverAndControllerOnAKnownPort) {
   EXPECT_LT(observe.stats().min_energy, -0.05);
   EXPECT_GE(control.stats().min_energy, -1e-9);
   EXPECT_GT(control.stats().active_steps, 0u);
+}
+
+// MuJoCo 2.2.2 warns through mju_user_warning; without our handler it prints and appends to
+// MUJOCO_LOG.TXT in the working directory. A proxy placed at 1e20 m makes qpos "huge" (above
+// mjMAXVAL): the next step warns (bad_qpos) and resets the data.
+TEST(World, MujocoWarningsAreCountedInTheProcessNotWrittenToTheWorkingDirectory) {
+  namespace fs = std::filesystem;
+  const fs::path cwd = fs::current_path();
+  const fs::path dir = fs::temp_directory_path() / ("spidar_mujoco_log_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::current_path(dir);
+  {
+    auto w = load("blocks.xml");
+    const MujocoWarnings before = mujoco_warnings();
+    EXPECT_EQ(w->warning_total(), 0);
+    std::vector<Vec3> p = parked();
+    p[0] = Vec3(1e20, 0, 0);
+    w->place_proxies(p);
+    w->step(parked(), {});
+    const MujocoWarnings after = mujoco_warnings();
+    EXPECT_GT(after.count, before.count);
+    ASSERT_FALSE(after.messages.empty());
+    EXPECT_NE(after.messages.back().find("QPOS"), std::string::npos) << after.messages.back();
+    EXPECT_LE(after.messages.size(), kMujocoWarningsKept);
+    EXPECT_GE(w->warning_total(), 1);
+    bool bad_qpos = false;
+    for (const auto& k : w->warning_counts()) bad_qpos = bad_qpos || (k.kind == "bad_qpos" && k.count >= 1);
+    EXPECT_TRUE(bad_qpos);
+    // The world goes on after MuJoCo's reset.
+    w->step(parked(), {});
+    EXPECT_TRUE(w->proxies()[0].p_W.allFinite());
+  }
+  const bool log_written = fs::exists(dir / "MUJOCO_LOG.TXT");
+  fs::current_path(cwd);
+  fs::remove_all(dir);
+  EXPECT_FALSE(log_written) << "MuJoCo wrote MUJOCO_LOG.TXT into the working directory";
+}
+
+// The proxies go before the scene's real </worldbody>, not one inside a comment or CDATA.
+TEST(World, ProxiesIgnoreAWorldbodyTagInsideComments) {
+  const auto path = (std::filesystem::temp_directory_path() / "spidar_commented_scene.xml").string();
+  std::ofstream(path) << "<mujoco>\n  <worldbody>\n    <geom type=\"plane\" size=\"1 1 0.1\"/>\n"
+                         "    <!-- the old floor ended here: </worldbody> -->\n"
+                         "    <body name=\"box\" pos=\"0 0 0.1\"><freejoint/><geom type=\"box\" size=\"0.02 0.02 0.02\"/></body>\n"
+                         "  </worldbody >\n  <!-- </worldbody> after the real one -->\n</mujoco>\n";
+  auto w = World::Load(path);
+  ASSERT_TRUE(w.ok()) << w.error().message;
+  EXPECT_EQ((*w)->proxies().size(), 8u);
+  EXPECT_GE((*w)->body_id("box"), 0);
+  EXPECT_GE((*w)->body_id("proxy_7"), 0);
+
+  const auto unterminated = (std::filesystem::temp_directory_path() / "spidar_unterminated_comment.xml").string();
+  std::ofstream(unterminated) << "<mujoco>\n<worldbody>\n<!-- never closed </worldbody>\n</mujoco>\n";
+  auto r = World::Load(unterminated);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("unterminated comment starting at line 3"), std::string::npos) << r.error().message;
 }
 
 }  // namespace

@@ -62,6 +62,17 @@ class World {
   double time() const;
   double timestep() const;
   int contact_count() const;
+  /// MuJoCo's warnings in this world's data (mjData::warning[]: too many contacts, a bad number
+  /// in qpos/qvel/qacc that made MuJoCo reset the data, …) since it was made or last reset; only
+  /// the kinds that occurred. Read it while the world is not stepping. The messages themselves
+  /// are in mujoco_warnings() (mujoco_log.hpp).
+  struct WarningCount {
+    std::string kind;  ///< "contact_full", "bad_qacc", …
+    int count = 0;
+  };
+  std::vector<WarningCount> warning_counts() const;
+  /// The sum of warning_counts().
+  int warning_total() const;
   const WorldParams& params() const { return params_; }
   const std::string& scene_path() const { return scene_path_; }
 
