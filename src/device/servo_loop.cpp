@@ -290,19 +290,20 @@ void ServoLoop::run() {
     const bool safe = (sample_.faults & kSafeStateFaults) || estop_.load(std::memory_order_acquire) || stale;
     cycle_maths_.command(force_frame_, safe, sample_, commands_);
     // A cycle woken or ended far past its deadline (a stall in the scheduler, the read or the
-    // force source) must not send the forces it computed from old data: minimum tension this
-    // cycle, counted. A stall past the stall limit latches the safe state.
+    // force source) still sends what it computed (from this cycle's reading: a lag, not a jump
+    // in force) and counts; a stall past the stall limit latches the safe state and sends the
+    // minimum (the motors held old commands that long).
     if (const std::int64_t late = std::max(wake, core::monotonic_ns()) - deadline;
         cycle_.load(std::memory_order_relaxed) > 0 && late > late_limit) {
       ++deadline_misses_;
-      std::fill(commands_.begin(), commands_.end(), device_.info().command_min);
-      for (int f = 0; f < sample_.finger_count; ++f) sample_.f_W[f] = {0.0, 0.0, 0.0};
       if (late > stall_limit) {
         device_.request_safe_state();
         latch(kFaultDeadlineMiss,
               "cycle %llu ended %.3f ms after its deadline (bound stall_limit_s %.3f ms); its "
               "commands were replaced by the minimum",
               cycle_no, static_cast<double>(late) * 1e-6, servo_.stall_limit_s * 1e3);
+        std::fill(commands_.begin(), commands_.end(), device_.info().command_min);
+        for (int f = 0; f < sample_.finger_count; ++f) sample_.f_W[f] = {0.0, 0.0, 0.0};
       }
     }
     if (auto st = device_.write(commands_); !st.ok()) {

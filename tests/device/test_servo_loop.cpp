@@ -239,8 +239,8 @@ struct Slow final : ForceSource {
   }
 };
 
-// A cycle that ends far past its deadline sends no force that cycle and counts; no fault.
-TEST(ServoLoop, MissedDeadlineDropsThatCyclesForcesWithoutAFault) {
+// A cycle that ends far past its deadline counts, and the display goes on: no fault, no gap.
+TEST(ServoLoop, MissedDeadlineIsCountedWithoutAFault) {
   Rig rig;
   ServoConfig cfg;
   cfg.rate_hz = 1000;
@@ -258,7 +258,7 @@ TEST(ServoLoop, MissedDeadlineDropsThatCyclesForcesWithoutAFault) {
   FingertipSample samples[1024];
   const std::size_t n = loop.newest_samples(samples, 1024);
   for (std::size_t k = 0; k < n; ++k) {
-    if (samples[k].cycle == 50) EXPECT_EQ(samples[k].f_W[0][2], 0.0) << "the late cycle's force";
+    if (samples[k].cycle >= 50) EXPECT_NE(samples[k].f_W[0][2], 0.0) << "cycle " << samples[k].cycle;
   }
 }
 

@@ -10,8 +10,8 @@
 ///
 /// Safety (docs/realtime.md, "When a fault latches"): commands are clamped to the device limits.
 /// A busy machine degrades the display, it does not stop it: a cycle that wakes or ends more than
-/// `deadline_periods` late sends no force (minimum tension) that cycle and is counted
-/// (`deadline_misses`); forces older than `force_timeout_s` are not displayed (minimum tension)
+/// `deadline_periods` late is counted (`deadline_misses`) and sends what it computed from its own
+/// reading (a lag, not a jump in force); forces older than `force_timeout_s` are not displayed (minimum tension)
 /// until fresh ones come, counted (`stale_force_cycles`). The safe state latches when safety is
 /// at stake: the loop stalled for longer than `stall_limit_s` (the motors held old commands that
 /// long: kFaultDeadlineMiss, or kFaultWatchdog from the monitor thread when the servo thread stops
@@ -57,8 +57,7 @@ struct ServoConfig {
   double rate_hz = 1000.0;
   bool realtime = true;           ///< try SCHED_FIFO (priority 80) and CPU pinning
   int cpu = -1;                   ///< CPU to pin to; -1: the last CPU
-  /// A cycle that wakes or ends this many periods late displays no force that cycle (its data
-  /// is old) and counts as a deadline miss; > 0.
+  /// A cycle that wakes or ends this many periods late counts as a deadline miss; > 0.
   double deadline_periods = 5.0;
   double force_timeout_s = 0.02;  ///< forces older than this are not displayed [s], > 0
   /// A stall this long latches the safe state [s]: the loop late by it (kFaultDeadlineMiss), no
@@ -94,7 +93,7 @@ struct ServoStats {
   double jitter_p50_us = 0, jitter_p99_us = 0, jitter_max_us = 0;  ///< |period − nominal|
   double cycle_us_median = 0, cycle_us_p99 = 0, cycle_us_max = 0;  ///< compute time per cycle
   std::uint64_t overruns = 0;       ///< cycles that ended after the next deadline
-  std::uint64_t deadline_misses = 0;  ///< cycles more than deadline_periods late (no force shown)
+  std::uint64_t deadline_misses = 0;  ///< cycles more than deadline_periods late
   std::uint64_t stale_force_cycles = 0;  ///< cycles whose forces were older than force_timeout_s
   std::uint64_t repeated_readings = 0;  ///< cycles that ran on a repeated (late) device reading
   std::uint64_t longest_repeat = 0;     ///< longest run of consecutive cycles on repeated readings
