@@ -5,10 +5,23 @@
 #include <memory>
 #include <string>
 
+#include "spidar/device/force_source.hpp"
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::device::testing {
+
+inline bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+/// Asks every fingertip for a force, so healthy cycles send commands above the minimum.
+struct Pushing final : ForceSource {
+  void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
+    out.t_ns = in.t_ns;
+    for (int f = 0; f < kMaxFingers; ++f) out.set_force(f, Vec3(0.5, -0.5, 1.0));
+  }
+};
 
 inline const strings::DeviceConfig& spidar8() {
   static const auto cfg =

@@ -28,18 +28,9 @@ namespace {
 
 using testing::ScriptedDevice;
 using testing::spidar8;
+using testing::contains;
+using testing::Pushing;
 
-bool contains(const std::string& s, const std::string& part) {
-  return s.find(part) != std::string::npos;
-}
-
-/// Asks every fingertip for a force, so healthy cycles send commands above the minimum.
-struct Pushing final : ForceSource {
-  void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
-    out.t_ns = in.t_ns;
-    for (int f = 0; f < kMaxFingers; ++f) out.set_force(f, Vec3(0.5, -0.5, 1.0));
-  }
-};
 
 /// Timing faults out of reach: these tests are about the readings.
 ServoConfig calm() {

@@ -18,18 +18,9 @@ namespace spidar::device {
 namespace {
 
 using testing::PtyLink;
+using testing::contains;
+using testing::Pushing;
 
-bool contains(const std::string& s, const std::string& part) {
-  return s.find(part) != std::string::npos;
-}
-
-/// Asks every fingertip for a force, so healthy cycles send commands above the minimum.
-struct Pushing final : ForceSource {
-  void forces(const FingertipSample& in, ForceFrame& out) noexcept override {
-    out.t_ns = in.t_ns;
-    for (int f = 0; f < kMaxFingers; ++f) out.set_force(f, Vec3(0.5, -0.5, 1.0));
-  }
-};
 
 std::int32_t largest(const std::vector<std::int32_t>& v) {
   return v.empty() ? std::numeric_limits<std::int32_t>::min()
