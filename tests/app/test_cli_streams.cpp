@@ -16,7 +16,7 @@ TEST(CliStreams, SchedulingWarningGoesToStderrAndStdoutStaysJson) {
   const spidar::test::Run r = run_cli("device-test --backend sim --seconds 0.3",
                         "setpriv --bounding-set=-sys_nice --inh-caps=-sys_nice ");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NO_THROW((void)nlohmann::json::parse(r.out)) << "stdout: " << r.out.substr(0, 200);
+  EXPECT_TRUE(nlohmann::json::accept(r.out)) << "stdout: " << r.out.substr(0, 200);
   if (r.err.find("SCHED_FIFO") == std::string::npos) {
     GTEST_SKIP() << "real-time priority was granted anyway (no warning to route)";
   }

@@ -258,7 +258,9 @@ TEST(ServoLoop, MissedDeadlineIsCountedWithoutAFault) {
   FingertipSample samples[1024];
   const std::size_t n = loop.newest_samples(samples, 1024);
   for (std::size_t k = 0; k < n; ++k) {
-    if (samples[k].cycle >= 50) EXPECT_NE(samples[k].f_W[0][2], 0.0) << "cycle " << samples[k].cycle;
+    if (samples[k].cycle >= 50) {
+      EXPECT_NE(samples[k].f_W[0][2], 0.0) << "cycle " << samples[k].cycle;
+    }
   }
 }
 
