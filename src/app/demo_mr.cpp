@@ -73,8 +73,9 @@ int run_mr_demo(const DemoOptions& o) {
   fs::create_directories(fs::path(o.out) / "keyframes");
 
   Pose X_cube0;
-  auto task = make_scripted_task(*world, cube, wp.proxy.radius, truth_models, &X_cube0);
-  const double seconds = o.seconds > 0 ? o.seconds : task->params().duration;
+  // The scripted user plays until its task is done (retries included), by --seconds at most.
+  auto task = make_scripted_task(*world, cube, wp.proxy.radius, truth_models, &X_cube0, o.seconds);
+  const double seconds = task->params().deadline;
 
   // --- threads: simulated device ↔ servo loop ↔ physics ---
   device::SimulatedSpidarParams dp;
@@ -195,7 +196,8 @@ int run_mr_demo(const DemoOptions& o) {
   pipeline::FrameResult result, alt_result;
   sim::FrameTruthWorkspace ws;
   MrTrace trace;
-  Progress progress(seconds, std::cerr);
+  Progress progress(task->params().duration, std::cerr);  // in script time (retries replay some)
+  double t_last = 0;  // run time of the last frame [s]
   const std::array<double, 5> keyframe_times{1.9, 3.0, 4.5, 8.5, 10.2};
   std::size_t next_keyframe = 0;
   std::vector<std::pair<std::string, cv::Mat>> keyframes;  // path, montage
@@ -218,7 +220,8 @@ int run_mr_demo(const DemoOptions& o) {
     const sim::SyntheticFrame& frame = filmed.frame;
     const std::int64_t t_exp = filmed.t_exposure_ns;
     const double t_script = filmed.t_script_s;
-    if (t_script > seconds) break;
+    if (t_script > seconds || task->finished(t_script)) break;
+    t_last = t_script;
     const std::size_t ns = loop.newest_samples(servo_buf.data(), servo_buf.size());
     const auto measured = device::interpolate_samples({servo_buf.data(), ns}, t_exp);
     if (!measured) continue;  // no servo samples around the exposure (a stall): skip the frame
@@ -289,7 +292,7 @@ int run_mr_demo(const DemoOptions& o) {
       char name[64];
       std::snprintf(name, sizeof name, "keyframe_%d_t%04.1fs.png", static_cast<int>(next_keyframe) + 1, t_script);
       const std::string caption = "t = " + std::to_string(t_script).substr(0, 4) + " s, " +
-                                  sim::RubiksTask::phase(t_script) + ", IoU " +
+                                  task->phase(t_script) + ", IoU " +
                                   std::to_string(m.truth[0].iou).substr(0, 5);
       // Composed now (the frame's buffers are reused), encoded after the run: a PNG takes tens of
       // milliseconds, which here would drop camera frames.
@@ -301,13 +304,13 @@ int run_mr_demo(const DemoOptions& o) {
     trace.frames.back().output_ms = core::ns_to_s(core::monotonic_ns() - t_out0) * 1e3;
     {
       std::ostringstream st;
-      st << std::fixed << std::setprecision(1) << "t " << t_script << "/" << seconds << " s  "
-         << std::left << std::setw(24) << sim::RubiksTask::phase(t_script) << std::right
+      st << std::fixed << std::setprecision(1) << "t " << t_script << " s  "
+         << std::left << std::setw(24) << task->phase(t_script) << std::right
          << std::setprecision(3) << " IoU " << m.truth[0].iou << std::setprecision(1)
          << "  tip " << 0.5 * (m.truth[0].fingertip_mm[0] + m.truth[0].fingertip_mm[1])
          << " mm  occlusion " << m.truth[0].occlusion_pct << " % (paper "
          << m.truth[0].occlusion_pct_paper << " %)  layer " << m.u_angle_deg << " deg";
-      progress.update(t_script, st.str());
+      progress.update(task->script_time(t_script), st.str());
     }
 
   }
@@ -326,7 +329,7 @@ int run_mr_demo(const DemoOptions& o) {
 
   // --- report ---
   MrSummary summary;
-  summary.seconds = seconds;
+  summary.seconds = t_last;
   summary.wall_s = wall_s;
   summary.dropped = dropped;
   summary.servo = loop.stats();
@@ -335,6 +338,7 @@ int run_mr_demo(const DemoOptions& o) {
     summary.turns = s->turns;
     summary.solved = s->solved;
   }
+  summary.task = task->progress();
   summary.has_cube = cube.has_value();
   summary.facelets = cube ? cube->facelets() : "";
   if (cube) {

@@ -88,9 +88,11 @@ std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
                                                     const std::optional<physics::RubiksCube>& cube,
                                                     double proxy_radius,
                                                     const std::array<hand::HandModel, 2>& user,
-                                                    Pose* X_cube0) {
+                                                    Pose* X_cube0, double deadline_s) {
   sim::RubiksTaskParams tp;
   tp.proxy_radius = proxy_radius;
+  tp.has_cube = cube.has_value();
+  if (deadline_s > 0) tp.deadline = deadline_s;
   *X_cube0 = Pose{};
   if (cube) {
     *X_cube0 = cube->core_pose();
@@ -127,11 +129,11 @@ void CubeMonitor::before_step(physics::World& w) {
   if (cube_->has_value()) {
     const physics::RubiksCube& cube = **cube_;
     const Pose X = cube.core_pose();
-    pose_.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+    turns_.update(cube);
+    pose_.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}, turns_.turns()});
     s.lift = X.p.z() - X_cube0_.p.z();
     s.u_angle = cube.face_angle('U');
     s.d_angle = cube.face_angle('D');
-    turns_.update(cube);
     s.turns = turns_.turns();
     s.solved = cube.is_solved();
   }
