@@ -1,5 +1,6 @@
 #include "spidar/core/units.hpp"
 #include "spidar/sim/rubiks_task.hpp"
+#include "smooth_ramp.hpp"
 
 #include <Eigen/Geometry>
 
@@ -9,12 +10,6 @@
 
 namespace spidar::sim {
 namespace {
-
-/// 0 before t0, 1 after t1, smooth in between.
-double ramp(double t, double t0, double t1) {
-  const double x = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
-  return x * x * (3.0 - 2.0 * x);
-}
 
 Mat3 rot_z(double a) { return Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix(); }
 
