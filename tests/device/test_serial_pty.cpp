@@ -10,10 +10,13 @@
 #include <fstream>
 #include <thread>
 
+#include "device_test_support.hpp"
 #include "pty_link.hpp"
 
 namespace spidar::device {
 namespace {
+
+using testing::contains;
 
 using testing::PtyLink;
 
@@ -21,10 +24,6 @@ std::array<std::int32_t, kMaxDeviceStrings> ramp(std::int32_t base) {
   std::array<std::int32_t, kMaxDeviceStrings> c{};
   for (int i = 0; i < kMaxDeviceStrings; ++i) c[i] = base + (i % 2 ? -1 : 1) * i * 1001;
   return c;
-}
-
-bool contains(const std::string& s, const std::string& part) {
-  return s.find(part) != std::string::npos;
 }
 
 TEST(SerialPort, OpenMissingPathNamesPathAndErrno) {

@@ -2,6 +2,8 @@
 // filmed over the blue screen, registered with the default model hands, composited into a scene.
 #include <gtest/gtest.h>
 
+#include "source_path.hpp"
+
 #include <cstdlib>
 #include <limits>
 #include <opencv2/core.hpp>
@@ -18,7 +20,7 @@
 namespace spidar::pipeline {
 namespace {
 
-std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
+using spidar::test::source;
 
 class FramePipelineTest : public ::testing::Test {
  protected:

@@ -1,6 +1,8 @@
 // The camera → GL conversion against vision::Camera, without a GL context.
 #include <gtest/gtest.h>
 
+#include "render_test_cameras.hpp"
+
 #include <random>
 
 #include "spidar/render/gl_camera.hpp"
@@ -10,16 +12,7 @@
 namespace spidar::render {
 namespace {
 
-vision::Camera odd_camera() {
-  vision::Intrinsics K;
-  K.fx = 500;
-  K.fy = 520;
-  K.cx = 150.2;
-  K.cy = 110.7;
-  K.width = 321;
-  K.height = 243;
-  return vision::Camera(K, vision::look_at(Vec3(0.1, -0.3, 0.25), Vec3(0.01, 0.02, 0.0)));
-}
+using testing::odd_camera;
 
 TEST(GlCamera, ClipSpaceLandsOnCameraProjectAndDepth) {
   std::mt19937 rng(7);

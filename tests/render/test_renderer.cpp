@@ -2,6 +2,8 @@
 // golden images.
 #include <gtest/gtest.h>
 
+#include "render_test_cameras.hpp"
+
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -45,16 +47,7 @@ double ray_box_depth(const vision::Camera& cam, const Pose& X_WB, const Vec3& ha
   return cam.depth(X_WB * (o + t0 * d));
 }
 
-vision::Camera odd_camera() {
-  vision::Intrinsics K;
-  K.fx = 500;
-  K.fy = 520;
-  K.cx = 150.2;
-  K.cy = 110.7;
-  K.width = 321;
-  K.height = 243;
-  return vision::Camera(K, vision::look_at(Vec3(0.1, -0.3, 0.25), Vec3(0.01, 0.02, 0.0)));
-}
+using testing::odd_camera;
 
 class BoxProjection : public ::testing::TestWithParam<int> {};
 

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "source_path.hpp"
+
 #include <thread>
 
 #include "spidar/core/clock.hpp"
@@ -13,7 +15,7 @@
 namespace spidar::sim {
 namespace {
 
-std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
+using spidar::test::source;
 
 /// Largest allowed change of a displayed force between two servo cycles [N]. Contact onset is
 /// the worst case: the fingertip meets a surface the local model learns of only after the next

@@ -4,6 +4,8 @@
 // are checked without the timing of a busy machine.
 #include <gtest/gtest.h>
 
+#include "source_path.hpp"
+
 #include <array>
 #include <string>
 #include <cmath>
@@ -19,7 +21,7 @@
 namespace spidar::sim {
 namespace {
 
-std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
+using spidar::test::source;
 
 struct TaskRun {
   double lift_max_m = 0;

@@ -1,6 +1,8 @@
 // The simulated user of the mixed-reality demo: the two-turn script and the user's real hands.
 #include <gtest/gtest.h>
 
+#include "source_path.hpp"
+
 #include <array>
 #include <string>
 #include <cmath>
@@ -13,7 +15,7 @@
 namespace spidar::sim {
 namespace {
 
-std::string source(const std::string& rel) { return std::string(SPIDAR_SOURCE_DIR) + "/" + rel; }
+using spidar::test::source;
 
 std::array<hand::HandModel, 2> user_models() {
   const auto profiles = hand::load_hand_profiles(source("configs/hands.yaml"));

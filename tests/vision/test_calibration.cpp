@@ -2,6 +2,8 @@
 // and chessboard intrinsics from rendered board images (library and the calibrate-camera CLI).
 #include <gtest/gtest.h>
 
+#include "temp_path.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -258,12 +260,7 @@ std::vector<Pose> board_poses(const ChessboardPattern& p) {
   return out;
 }
 
-std::string temp_dir(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / (name + "_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
-}
+using spidar::test::temp_dir;
 
 std::string write_board_images(const Camera& cam, const ChessboardPattern& p, const std::string& name) {
   const std::string dir = temp_dir(name);

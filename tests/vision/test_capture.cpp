@@ -1,6 +1,8 @@
 // vision::Capture on image sequences and video files written here, and its errors.
 #include <gtest/gtest.h>
 
+#include "temp_path.hpp"
+
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -14,12 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string temp_dir(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / (name + "_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
-}
+using spidar::test::temp_dir;
 
 cv::Mat numbered_frame(int k) {
   cv::Mat img(120, 160, CV_8UC3, cv::Scalar(200, 80, 30));
