@@ -19,7 +19,10 @@
 #include "demo_mr_report.hpp"
 #include "progress.hpp"
 #include "signal_scope.hpp"
-#include "session_parts.hpp"
+#include "spidar/session/cube_monitor.hpp"
+#include "spidar/session/rig_inputs.hpp"
+#include "spidar/session/scripted_task.hpp"
+#include "spidar/session/servo_timing.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/device/sample_interpolation.hpp"
 #include "spidar/device/servo_loop.hpp"
@@ -52,9 +55,9 @@ int run_mr_demo(const DemoOptions& o) {
   if (cfg.fingers.size() != 8) throw UsageError("--config: the rubiks demo needs 8 fingers");
   const std::string scene_path = resolve_data_path(o.scene);
   const std::string hand_path = resolve_data_path(o.user_hand);
-  const auto truth_models = hand_models(hand_path, o.user_profile, true);
-  const auto models = hand_models(resolve_data_path("configs/hands.yaml"), o.model_profile, false);
-  const vision::Camera camera = scaled_camera(
+  const auto truth_models = session::hand_models(hand_path, o.user_profile, true);
+  const auto models = session::hand_models(resolve_data_path("configs/hands.yaml"), o.model_profile, false);
+  const vision::Camera camera = session::scaled_camera(
       vision::load_camera_file(resolve_data_path(o.camera)).camera, o.width, o.height);
   const auto vision_cfg = vision::load_vision_config(resolve_data_path("configs/vision.yaml"));
   const auto reg_root = core::ConfigNode::LoadFile(resolve_data_path("configs/registration.yaml"));
@@ -73,7 +76,7 @@ int run_mr_demo(const DemoOptions& o) {
   fs::create_directories(fs::path(o.out) / "keyframes");
 
   Pose X_cube0;
-  auto task = make_scripted_task(*world, cube, wp.proxy.radius, truth_models, &X_cube0);
+  auto task = session::make_scripted_task(*world, cube, wp.proxy.radius, truth_models, &X_cube0);
   const double seconds = o.seconds > 0 ? o.seconds : task->params().duration;
 
   // --- threads: simulated device ↔ servo loop ↔ physics ---
@@ -89,7 +92,7 @@ int run_mr_demo(const DemoOptions& o) {
   sim::PhysicsThread physics(*world, *bridge);
   physics.set_snapshot_proxies(false);
   physics.set_realtime_priority(60);  // above the rendering threads, below the servo loop
-  CubeMonitor monitor(&cube, X_cube0);
+  session::CubeMonitor monitor(&cube, X_cube0);
   if (cube) task->track(&monitor.pose());  // the user watches the cube
   physics.set_before_step([&monitor](physics::World& w) { monitor.before_step(w); });
   device::ServoLoop loop(dev, cfg, servo, bridge);
@@ -273,7 +276,7 @@ int run_mr_demo(const DemoOptions& o) {
       m.force_n[f] = Vec3(measured->f_W[f][0], measured->f_W[f][1], measured->f_W[f][2]).norm();
     }
     {  // servo timing since the last frame, from the published samples
-      const ServoTiming st = servo_timing_since({servo_buf.data(), ns}, servo.rate_hz, &last_servo_t);
+      const session::ServoTiming st = session::servo_timing_since({servo_buf.data(), ns}, servo.rate_hz, &last_servo_t);
       m.servo_rate_hz = st.rate_hz;
       m.servo_jitter_max_us = st.jitter_max_us;
     }

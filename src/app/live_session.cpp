@@ -179,7 +179,7 @@ class CaptureSource final : public ThreadedSource {
 /// The synthetic camera filming the interactively controlled hands (their commanded posture).
 class InteractiveSource final : public ThreadedSource {
  public:
-  InteractiveSource(const vision::Camera& camera, const InteractiveHands& hands, double fps, std::uint64_t seed)
+  InteractiveSource(const vision::Camera& camera, const session::InteractiveHands& hands, double fps, std::uint64_t seed)
       : camera_(camera), hands_(hands), fps_(fps), seed_(seed) {}
   ~InteractiveSource() override { stop(); }
   Status start(std::int64_t t0_ns) override {
@@ -220,7 +220,7 @@ class InteractiveSource final : public ThreadedSource {
   }
 
   vision::Camera camera_;
-  const InteractiveHands& hands_;
+  const session::InteractiveHands& hands_;
   double fps_;
   std::uint64_t seed_;
 };
@@ -261,9 +261,9 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   if (s->device_config_.fingers.size() != 8)
     throw UsageError(c.device_config + ": the live session needs 8 fingers (thumb, index, middle, "
                      "ring of both hands), got " + std::to_string(s->device_config_.fingers.size()));
-  s->camera_ = scaled_camera(vision::load_camera_file(c.camera_calibration).camera, c.width, c.height);
-  s->models_ = hand_models(c.hands_file, c.model_profile, false);
-  s->user_models_ = hand_models(c.hands_file, c.user_profile, true);
+  s->camera_ = session::scaled_camera(vision::load_camera_file(c.camera_calibration).camera, c.width, c.height);
+  s->models_ = session::hand_models(c.hands_file, c.model_profile, false);
+  s->user_models_ = session::hand_models(c.hands_file, c.user_profile, true);
 
   // --- physics ---
   physics::WorldParams wp;
@@ -272,8 +272,8 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   s->world_ = std::move(world_r).value();
   if (auto cube_r = physics::RubiksCube::Attach(*s->world_)) s->cube_ = std::move(cube_r).value();
   Pose X_cube0;
-  s->task_ = make_scripted_task(*s->world_, s->cube_, wp.proxy.radius, s->user_models_, &X_cube0);
-  s->cube_monitor_ = std::make_unique<CubeMonitor>(&s->cube_, X_cube0);
+  s->task_ = session::make_scripted_task(*s->world_, s->cube_, wp.proxy.radius, s->user_models_, &X_cube0);
+  s->cube_monitor_ = std::make_unique<session::CubeMonitor>(&s->cube_, X_cube0);
   if (s->cube_) s->task_->track(&s->cube_monitor_->pose());
 
   // --- device and servo loop ---
@@ -286,7 +286,7 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
       open[h] = s->task_->nominal(0.0, side);
       closed[h] = s->task_->nominal(2.0, side);
     }
-    s->interactive_ = std::make_shared<InteractiveHands>(s->user_models_, open, closed);
+    s->interactive_ = std::make_shared<session::InteractiveHands>(s->user_models_, open, closed);
   }
   if (c.backend == "sim") {
     device::SimulatedSpidarParams dp;
@@ -314,7 +314,7 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   s->physics_ = std::make_unique<sim::PhysicsThread>(*s->world_, *s->bridge_);
   s->physics_->set_snapshot_proxies(false);
   s->physics_->set_realtime_priority(60);
-  CubeMonitor* monitor = s->cube_monitor_.get();
+  session::CubeMonitor* monitor = s->cube_monitor_.get();
   s->physics_->set_before_step([monitor](physics::World& w) { monitor->before_step(w); });
   s->loop_ = std::make_unique<device::ServoLoop>(*dev, s->device_config_, servo, s->bridge_);
 
@@ -408,7 +408,7 @@ std::optional<DeviceCycleRecord> LiveSession::newest_device_cycle() const {
 
 std::uint64_t LiveSession::camera_frames() const { return source_ ? source_->delivered() : 0; }
 
-std::optional<CubeStatus> LiveSession::cube_status() const { return cube_monitor_->status().read(); }
+std::optional<session::CubeStatus> LiveSession::cube_status() const { return cube_monitor_->status().read(); }
 
 sim::PhysicsThreadStats LiveSession::physics_stats() const { return physics_->stats(); }
 
@@ -441,7 +441,7 @@ bool LiveSession::step() {
   m.pipeline_ms = result_.timings.total_ms;
   m.registration_ms = result_.timings.registration_ms;
   {  // servo timing since the last frame, from the published samples
-    const ServoTiming st = servo_timing_since({servo_buf_.data(), ns}, config_.rate_hz, &last_servo_t_);
+    const session::ServoTiming st = session::servo_timing_since({servo_buf_.data(), ns}, config_.rate_hz, &last_servo_t_);
     m.servo_rate_hz = st.rate_hz;
     m.servo_jitter_max_us = st.jitter_max_us;
   }

@@ -11,9 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "interactive_hands.hpp"
+#include "spidar/session/interactive_hands.hpp"
 #include "live_config.hpp"
-#include "session_parts.hpp"
+#include "spidar/session/cube_monitor.hpp"
+#include "spidar/session/rig_inputs.hpp"
+#include "spidar/session/scripted_task.hpp"
+#include "spidar/session/servo_timing.hpp"
 #include "session_recorder.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
@@ -86,15 +89,15 @@ class LiveSession {
   std::uint64_t camera_frames() const;  ///< frames the camera delivered (processed or dropped)
   device::ServoLoop& servo() { return *loop_; }
   const device::ServoLoop& servo() const { return *loop_; }
-  std::optional<CubeStatus> cube_status() const;
-  CubeMonitor& cube() { return *cube_monitor_; }
+  std::optional<session::CubeStatus> cube_status() const;
+  session::CubeMonitor& cube() { return *cube_monitor_; }
   sim::PhysicsThreadStats physics_stats() const;
   const SessionRecorder* recorder() const { return recorder_.get(); }
   /// The newest servo cycle at the device boundary (raw counts, commands); any thread.
   std::optional<DeviceCycleRecord> newest_device_cycle() const;
   /// The simulated user's hands under interactive control; null unless hands.control is
   /// interactive.
-  InteractiveHands* interactive() { return interactive_.get(); }
+  session::InteractiveHands* interactive() { return interactive_.get(); }
   double seconds() const;  ///< since start()
 
   struct FrameSource;
@@ -108,9 +111,9 @@ class LiveSession {
   std::array<hand::HandModel, 2> models_, user_models_;
   std::unique_ptr<physics::World> world_;
   std::optional<physics::RubiksCube> cube_;
-  std::unique_ptr<CubeMonitor> cube_monitor_;
+  std::unique_ptr<session::CubeMonitor> cube_monitor_;
   std::shared_ptr<sim::RubiksTask> task_;
-  std::shared_ptr<InteractiveHands> interactive_;
+  std::shared_ptr<session::InteractiveHands> interactive_;
   std::unique_ptr<device::Device> device_;
   std::unique_ptr<RecordingDevice> recording_device_;
   std::shared_ptr<sim::HapticForces> bridge_;

@@ -1,0 +1,32 @@
+#include "spidar/session/rig_inputs.hpp"
+
+#include "spidar/core/result.hpp"
+#include "spidar/hand/hand_config.hpp"
+
+namespace spidar::session {
+
+vision::Camera scaled_camera(const vision::Camera& c, int w, int h) {
+  vision::Intrinsics k = c.intrinsics();
+  const double sx = static_cast<double>(w) / k.width, sy = static_cast<double>(h) / k.height;
+  k.fx *= sx;
+  k.fy *= sy;
+  k.cx = (k.cx + 0.5) * sx - 0.5;
+  k.cy = (k.cy + 0.5) * sy - 0.5;
+  k.width = w;
+  k.height = h;
+  return vision::Camera(k, c.X_CW());
+}
+
+std::array<hand::HandModel, 2> hand_models(const std::string& path, const std::string& profile,
+                                           bool first_if_missing) {
+  const hand::HandProfiles profiles = hand::load_hand_profiles(path);  // throws ConfigError
+  const hand::HandProfile* p = profiles.find(profile);
+  if (p == nullptr) {
+    if (!first_if_missing || profiles.profiles.empty())
+      throw SpidarError(path + ": no hand profile '" + profile + "'");
+    p = &profiles.profiles.front();
+  }
+  return {p->model(hand::Side::kLeft), p->model(hand::Side::kRight)};
+}
+
+}  // namespace spidar::session
