@@ -140,7 +140,7 @@ cv::Mat view_image(View view, const LiveSession& s) {
 
 /// The last `n` values of a history field, as floats for ImGui's plots.
 template <typename F>
-std::vector<float> series(const std::vector<LiveFrameStats>& h, std::size_t n, F field) {
+std::vector<float> series(const session::HistoryRing<LiveFrameStats>& h, std::size_t n, F field) {
   std::vector<float> v;
   const std::size_t start = h.size() > n ? h.size() - n : 0;
   v.reserve(h.size() - start);

@@ -1,5 +1,6 @@
 #include "spidar/session/session.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -64,6 +65,7 @@ void Session::warm_up() {
     if (auto st = p->process(blank, tips, s0, &warm); !st) throw SpidarError(st.error().message);
     p->reset();
   }
+  ++warm_ups_;
 }
 
 void Session::start() {
@@ -77,15 +79,15 @@ void Session::start() {
     stop_threads();
     throw SpidarError("servo loop: " + st.error().message);
   }
-  if (auto st = rig_.camera().start(t_open_ns_); !st) {
-    stop_threads();
-    throw SpidarError("camera: " + st.error().message);
-  }
   try {
     for (FrameSink* k : sinks_) k->on_start();
   } catch (...) {
     stop_threads();
     throw;
+  }
+  if (auto st = rig_.camera().start(t_open_ns_); !st) {
+    stop_threads();
+    throw SpidarError("camera: " + st.error().message);
   }
 }
 
@@ -119,9 +121,10 @@ Session::Step Session::step() {
     physics_->snapshots().update();
     snapshot_ = physics_->snapshots().front();
 
+    FrameEvent e;
+    e.cold_start = !pipe_->has_previous();
     if (auto st = pipe_->process(frame_.bgr, measured_, snapshot_, &result_); !st)
       throw SpidarError(st.error().message);
-    FrameEvent e;
     e.t_done_ns = core::monotonic_ns();
     // The comparison registration runs every frame (it must track), its rendering every
     // compare_every-th frame (a sample of the run; it costs as much as the main pipeline).

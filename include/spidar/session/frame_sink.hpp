@@ -38,6 +38,7 @@ struct FrameEvent {
   /// What the synthetic camera filmed (ground truth); null for real cameras.
   const sim::FilmedFrame* filmed = nullptr;
   ServoTiming servo;  ///< the servo loop's rate and jitter since the previous frame
+  bool cold_start = false;  ///< the main fit started from the rest pose, not the previous frame
 };
 
 /// How a session ended.
@@ -54,7 +55,7 @@ struct SessionSummary {
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
-  /// Once, after the threads started and before the first frame.
+  /// Once, after the servo loop and physics started and before the camera (the first frame).
   virtual void on_start() {}
   /// Every processed frame, in order, on the frame thread. An exception stops the session (its
   /// threads are stopped, the device left in its safe state) and propagates to the caller.

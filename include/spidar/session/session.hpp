@@ -88,6 +88,8 @@ class Session {
   double seconds() const;
   std::int64_t t_start_ns() const { return t_open_ns_; }
   std::uint64_t frames() const { return frames_; }
+  /// Warm-ups done: 1 after start() with SessionParams::warm_up, else 0.
+  int warm_ups() const { return warm_ups_; }
   std::uint64_t camera_frames() const;
 
   Rig& rig() { return rig_; }
@@ -119,6 +121,7 @@ class Session {
   std::optional<SessionSummary> summary_;
   std::int64_t t_open_ns_ = 0;
   std::uint64_t frames_ = 0;
+  int warm_ups_ = 0;
   std::int64_t last_servo_t_ = 0;
   std::vector<device::FingertipSample> servo_buf_;
   CameraFrame frame_;
