@@ -403,7 +403,9 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   Gl gl;
   if (!gl.load()) throw SpidarError("window: GL entry points missing (glfwGetProcAddress)");
 
-  auto session = LiveSession::create(cfg, *context, options);
+  LiveSessionOptions no_warm_up = options;  // the window is up: show frames at once
+  no_warm_up.warm_up = false;
+  auto session = LiveSession::create(cfg, *context, no_warm_up);
   // Sticky keys: a tap shorter than one GUI frame (the space bar's emergency stop above all) is
   // still seen by the next glfwGetKey.
   glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);

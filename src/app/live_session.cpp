@@ -108,6 +108,7 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   session::SessionParams sp;
   sp.servo.rate_hz = c.rate_hz;
   sp.servo.force_timeout_s = 0.05;
+  sp.warm_up = options.warm_up;
   const std::array<Vec3, 2> r0 = s->scene_->initial_r_W_hand();
   sp.pipeline = live_pipeline_params(c, r0);
   s->session_ = session::Session::create(*s->rig_, *s->scene_, context, s->camera_, s->models_, sp,

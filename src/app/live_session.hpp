@@ -34,6 +34,10 @@ pipeline::FramePipelineParams live_pipeline_params(const LiveConfig& c,
 struct LiveSessionOptions {
   std::string record_dir;             ///< empty: no recording
   FrameStore record_frames = FrameStore::kVideo;
+  /// The pipeline's warm-up before the clock starts (session::SessionParams::warm_up). The GUI
+  /// skips it: its window is up already, and the warm-up (~0.3 s, seconds on a loaded machine)
+  /// would only delay the first frame the user sees.
+  bool warm_up = true;
 };
 
 class LiveSession {
