@@ -19,16 +19,16 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
                                          const SessionParams& params, device::Device* drive) {
   std::unique_ptr<Session> s(new Session(rig, scene, context, params));
   s->camera_ = camera;
-  s->drive_ = drive != nullptr ? drive : &rig.device();
   // --- the haptic side: servo loop ↔ bridge ↔ physics thread ---
-  s->bridge_ = std::make_shared<sim::HapticForces>(scene.params.coupling, params.servo.rate_hz);
-  s->physics_ = std::make_unique<sim::PhysicsThread>(*scene.world, *s->bridge_);
-  s->physics_->set_snapshot_proxies(false);
-  s->physics_->set_realtime_priority(params.physics_priority);
+  HapticSideParams hp;
+  hp.servo = params.servo;
+  hp.physics_priority = params.physics_priority;
+  hp.snapshot_proxies = false;  // the fitted hands are drawn instead
+  s->haptic_ = std::make_unique<HapticSide>(drive != nullptr ? *drive : rig.device(),
+                                            rig.device_config(), *scene.world,
+                                            scene.params.coupling, hp);
   CubeMonitor* monitor = scene.monitor.get();
-  s->physics_->set_before_step([monitor](physics::World& w) { monitor->before_step(w); });
-  s->loop_ = std::make_unique<device::ServoLoop>(*s->drive_, rig.device_config(), params.servo,
-                                                 s->bridge_);
+  s->haptic_->set_before_step([monitor](physics::World& w) { monitor->before_step(w); });
   // --- the frame side ---
   auto pipe_r = pipeline::FramePipeline::create(context, camera, models, params.pipeline);
   if (!pipe_r) throw SpidarError(pipe_r.error().message);
@@ -71,32 +71,26 @@ void Session::warm_up() {
 void Session::start() {
   if (started_) return;
   if (params_.warm_up) warm_up();
-  if (auto st = drive_->open(); !st) throw SpidarError("device: " + st.error().message);
-  t_open_ns_ = core::monotonic_ns();
+  haptic_->start();  // throws with the haptic side stopped again
   started_ = true;
-  physics_->start();
-  if (auto st = loop_->start(); !st) {
-    stop_threads();
-    throw SpidarError("servo loop: " + st.error().message);
-  }
   try {
     for (FrameSink* k : sinks_) k->on_start();
   } catch (...) {
     stop_threads();
     throw;
   }
-  if (auto st = rig_.camera().start(t_open_ns_); !st) {
+  if (auto st = rig_.camera().start(haptic_->t_open_ns()); !st) {
     stop_threads();
     throw SpidarError("camera: " + st.error().message);
   }
 }
 
 bool Session::running() const {
-  return started_ && !threads_stopped_ && loop_->running() && !rig_.camera().ended();
+  return started_ && !threads_stopped_ && haptic_->loop().running() && !rig_.camera().ended();
 }
 
 double Session::seconds() const {
-  return started_ ? core::ns_to_s(core::monotonic_ns() - t_open_ns_) : 0.0;
+  return started_ ? core::ns_to_s(core::monotonic_ns() - haptic_->t_open_ns()) : 0.0;
 }
 
 std::uint64_t Session::camera_frames() const { return rig_.camera().delivered(); }
@@ -112,14 +106,14 @@ Session::Step Session::step() {
                         "x" + std::to_string(k.height));
     const std::int64_t t_exp = frame_.t_exposure_ns;
     const double t_s = frame_.filmed != nullptr ? frame_.filmed->t_script_s
-                                                : core::ns_to_s(t_exp - t_open_ns_);
+                                                : core::ns_to_s(t_exp - haptic_->t_open_ns());
     if (params_.seconds > 0 && t_s > params_.seconds) return Step::kPastEnd;
-    const std::size_t ns = loop_->newest_samples(servo_buf_.data(), servo_buf_.size());
+    const std::size_t ns = haptic_->loop().newest_samples(servo_buf_.data(), servo_buf_.size());
     const auto measured = device::interpolate_samples({servo_buf_.data(), ns}, t_exp);
     if (!measured) return Step::kSkipped;  // no servo samples around the exposure (a stall)
     measured_ = *measured;
-    physics_->snapshots().update();
-    snapshot_ = physics_->snapshots().front();
+    haptic_->physics().snapshots().update();
+    snapshot_ = haptic_->physics().snapshots().front();
 
     FrameEvent e;
     e.cold_start = !pipe_->has_previous();
@@ -155,7 +149,7 @@ Session::Step Session::step() {
 SessionSummary Session::run(const std::function<std::optional<std::string>()>& interrupted) {
   start();
   std::string ended_by = "completed";
-  while (loop_->running()) {
+  while (haptic_->loop().running()) {
     if (interrupted) {
       if (auto why = interrupted()) {
         ended_by = *why;
@@ -180,9 +174,7 @@ void Session::stop_threads() {
   if (threads_stopped_) return;
   threads_stopped_ = true;
   rig_.camera().stop();
-  if (loop_) loop_->stop();
-  if (physics_) physics_->stop();
-  if (started_) drive_->close();
+  if (haptic_) haptic_->stop();
 }
 
 SessionSummary Session::stop(const std::string& ended_by) {
@@ -194,8 +186,8 @@ SessionSummary Session::stop(const std::string& ended_by) {
   s.wall_s = wall_s;
   s.frames = frames_;
   s.camera_frames = rig_.camera().delivered();
-  s.servo = loop_->stats();
-  s.physics = physics_->stats();
+  s.servo = haptic_->loop().stats();
+  s.physics = haptic_->physics().stats();
   s.camera_error = rig_.camera().error();
   summary_ = s;
   for (FrameSink* k : sinks_) k->on_end(s);

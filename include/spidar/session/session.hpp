@@ -17,6 +17,7 @@
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/session/frame_sink.hpp"
+#include "spidar/session/haptic_side.hpp"
 #include "spidar/session/rig.hpp"
 #include "spidar/session/scene.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
@@ -86,7 +87,7 @@ class Session {
   bool started() const { return started_; }
   /// Seconds since start().
   double seconds() const;
-  std::int64_t t_start_ns() const { return t_open_ns_; }
+  std::int64_t t_start_ns() const { return haptic_->t_open_ns(); }
   std::uint64_t frames() const { return frames_; }
   /// Warm-ups done: 1 after start() with SessionParams::warm_up, else 0.
   int warm_ups() const { return warm_ups_; }
@@ -94,9 +95,9 @@ class Session {
 
   Rig& rig() { return rig_; }
   Scene& scene() { return scene_; }
-  device::ServoLoop& servo() { return *loop_; }
-  const device::ServoLoop& servo() const { return *loop_; }
-  sim::PhysicsThreadStats physics_stats() const { return physics_->stats(); }
+  device::ServoLoop& servo() { return haptic_->loop(); }
+  const device::ServoLoop& servo() const { return haptic_->loop(); }
+  sim::PhysicsThreadStats physics_stats() const { return haptic_->physics().stats(); }
   pipeline::FramePipeline& pipeline() { return *pipe_; }
   const SessionParams& params() const { return params_; }
 
@@ -110,16 +111,12 @@ class Session {
   render::Context& context_;
   SessionParams params_;
   vision::Camera camera_;
-  device::Device* drive_ = nullptr;
-  std::shared_ptr<sim::HapticForces> bridge_;
-  std::unique_ptr<sim::PhysicsThread> physics_;
-  std::unique_ptr<device::ServoLoop> loop_;
+  std::unique_ptr<HapticSide> haptic_;
   std::unique_ptr<pipeline::FramePipeline> pipe_, alt_;
   std::vector<FrameSink*> sinks_;
 
   bool started_ = false, threads_stopped_ = false;
   std::optional<SessionSummary> summary_;
-  std::int64_t t_open_ns_ = 0;
   std::uint64_t frames_ = 0;
   int warm_ups_ = 0;
   std::int64_t last_servo_t_ = 0;
