@@ -32,10 +32,10 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The progress line: script phase, IoU, fingertip error, occlusion, the cube's top layer.
-std::string status_line(const MrFrame& m, double seconds) {
+std::string status_line(const MrFrame& m, const sim::RubiksTask& task) {
   std::ostringstream st;
-  st << std::fixed << std::setprecision(1) << "t " << m.t_s << "/" << seconds << " s  "
-     << std::left << std::setw(24) << sim::RubiksTask::phase(m.t_s) << std::right
+  st << std::fixed << std::setprecision(1) << "t " << m.t_s << " s  "
+     << std::left << std::setw(24) << task.phase(m.t_s) << std::right
      << std::setprecision(3) << " IoU " << m.truth[0].iou << std::setprecision(1)
      << "  tip " << 0.5 * (m.truth[0].fingertip_mm[0] + m.truth[0].fingertip_mm[1])
      << " mm  occlusion " << m.truth[0].occlusion_pct << " % (paper "
@@ -59,13 +59,15 @@ int run_mr_demo(const DemoOptions& o) {
       vision::load_camera_file(resolve_data_path(o.camera)).camera, o.width, o.height);
   auto mode = render::parse_composite_mode(o.compositor);
   if (!mode) throw UsageError("--compositor: " + mode.error().message);
-  auto scene_r = session::Scene::load(scene_path, truth_models);
+  // The scripted user plays until its task is done (retries included), by --seconds at most.
+  auto scene_r = session::Scene::load(scene_path, truth_models, o.seconds);
   if (!scene_r) throw UsageError("--scene: " + scene_r.error().message);
   session::Scene& scene = *scene_r.value();
   const auto& cube = scene.cube;
   fs::create_directories(o.out);
   fs::create_directories(fs::path(o.out) / "keyframes");
-  const double seconds = o.seconds > 0 ? o.seconds : scene.task->params().duration;
+  const sim::RubiksTask& task = *scene.task;
+  const double seconds = task.params().deadline;
 
   session::SessionParams sp;
   sp.servo.rate_hz = o.rate_hz;
@@ -77,6 +79,7 @@ int run_mr_demo(const DemoOptions& o) {
                                          *mode, scene.initial_r_W_hand());
   sp.compare = true;  // the same registration with the silhouette term switched the other way
   sp.seconds = seconds;
+  sp.end_with_script = true;
 
   // --- the rig, the session and its sinks ---
   auto ctx_r = o.window ? render::Context::create_window({o.width, o.height, "spidar-mr demo"})
@@ -101,8 +104,8 @@ int run_mr_demo(const DemoOptions& o) {
   }
   session::KeyframeSink keyframes(
       (fs::path(o.out) / "keyframes").string(), {1.9, 3.0, 4.5, 8.5, 10.2}, *mode, models, camera,
-      [&scorer](const session::FrameEvent& e) {
-        return "t = " + std::to_string(e.t_s).substr(0, 4) + " s, " + sim::RubiksTask::phase(e.t_s) +
+      [&scorer, &task](const session::FrameEvent& e) {
+        return "t = " + std::to_string(e.t_s).substr(0, 4) + " s, " + task.phase(e.t_s) +
                ", IoU " + std::to_string(scorer.trace().frames.back().truth[0].iou).substr(0, 5);
       });
   session::FunctionSink window([&](const session::FrameEvent& e) {
@@ -113,12 +116,12 @@ int run_mr_demo(const DemoOptions& o) {
   outputs.push_back(&keyframes);
   outputs.push_back(&window);
   session::SinkGroup output(outputs);  // timed: the report's output_ms
-  Progress progress(seconds, std::cerr);
+  Progress progress(task.params().duration, std::cerr);  // in script time (retries replay some)
   session::FunctionSink progress_sink(
       [&](const session::FrameEvent&) {
         scorer.set_output_ms(output.last_ms());
         const MrFrame& m = scorer.trace().frames.back();
-        progress.update(m.t_s, status_line(m, seconds));
+        progress.update(task.script_time(m.t_s), status_line(m, task));
       },
       [&](const session::SessionSummary&) { progress.finish(); });
   run->add_sink(scorer);
@@ -146,7 +149,7 @@ int run_mr_demo(const DemoOptions& o) {
 
   // --- report ---
   MrSummary summary;
-  summary.seconds = seconds;
+  summary.seconds = end.t_last_s;
   summary.wall_s = end.wall_s;
   summary.dropped = static_cast<int>(end.camera_frames) - static_cast<int>(trace.frames.size());
   summary.servo = end.servo;
@@ -155,6 +158,7 @@ int run_mr_demo(const DemoOptions& o) {
     summary.turns = s->turns;
     summary.solved = s->solved;
   }
+  summary.task = task.progress();
   summary.has_cube = cube.has_value();
   summary.facelets = cube ? cube->facelets() : "";
   if (cube) {

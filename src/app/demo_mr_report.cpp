@@ -286,6 +286,10 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"cube",
        {{"present", s.has_cube},
         {"turns_completed", s.turns},
+        {"turns_planned", s.task.turns_planned},
+        {"turn_attempts", s.task.attempts},
+        {"retries", {{"turn", s.task.retries_turn}, {"grasp", s.task.retries_grasp}}},
+        {"gave_up", s.task.gave_up},
         {"solved", s.solved},
         {"facelets", s.facelets},
         {"face_angles_deg", [&] {
@@ -341,7 +345,10 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << "; physics step median " << std::setprecision(2) << s.physics.step_ms_median << " ms\n"
      << "  contact        " << touching << " of 8 fingertips felt more than 0.5 N\n"
      << "  cube           "
-     << (s.has_cube ? std::to_string(s.turns) + " layer turns completed, " +
+     << (s.has_cube ? std::to_string(s.turns) + " of " + std::to_string(s.task.turns_planned) +
+                          " layer turns completed (" + std::to_string(s.task.retries_turn) +
+                          " turn and " + std::to_string(s.task.retries_grasp) + " grasp retries" +
+                          (s.task.gave_up ? ", then out of time" : "") + "), " +
                           (s.solved ? "solved" : "not solved")
                     : std::string("none in this scene"))
      << "\n"

@@ -12,6 +12,7 @@
 #include "spidar/session/truth_scorer.hpp"
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
+#include "spidar/sim/rubiks_task.hpp"
 
 namespace spidar::app {
 
@@ -25,6 +26,7 @@ struct MrSummary {
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;
   int turns = 0;
+  sim::TaskProgress task;  ///< the scripted user's plan: turns planned, retries
   bool solved = false, has_cube = false;
   std::map<char, double> face_deg;  ///< each face layer's final angle [deg]
   std::string facelets, video_path, video_format, compositor, scene, user_hand;

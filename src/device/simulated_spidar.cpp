@@ -112,10 +112,15 @@ Status SimulatedSpidar::read(EncoderReading& out) {
     hung_ = true;  // a stalled USB transfer
     std::this_thread::sleep_for(std::chrono::duration<double>(params_.hang_duration_s));
   }
-  const double dt = params_.fixed_step_s > 0 ? params_.fixed_step_s
-                                              : core::ns_to_s(core::monotonic_ns() - last_ns_);
+  // The user's hands move in real time whatever the servo thread does: the simulated device's
+  // time is the time since open, so a late read (a stalled servo thread, a busy machine) catches
+  // up on the motion it missed and the ground truth never lags the wall clock (the camera films
+  // the hands at wall-clock times). Catch-up is bounded (kMaxCatchUp_s of integration per read).
   last_ns_ = core::monotonic_ns();
-  advance(std::min(dt, 0.5));
+  constexpr double kMaxCatchUp_s = 10.0;
+  const double dt = params_.fixed_step_s > 0 ? params_.fixed_step_s
+                                              : core::ns_to_s(last_ns_ - opened_ns_) - t_s_;
+  advance(std::clamp(dt, 0.0, kMaxCatchUp_s));
 
   out.host_time_ns = last_ns_;
   out.device_time_us = static_cast<std::uint32_t>(std::llround(t_s_ * 1e6));

@@ -49,11 +49,11 @@ void CubeMonitor::before_step(physics::World& w) {
   if (cube_->has_value()) {
     const physics::RubiksCube& cube = **cube_;
     const Pose X = cube.core_pose();
-    pose_.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+    turns_.update(cube);
+    pose_.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}, turns_.turns()});
     s.lift = X.p.z() - X_cube0_.p.z();
     s.u_angle = cube.face_angle('U');
     s.d_angle = cube.face_angle('D');
-    turns_.update(cube);
     s.turns = turns_.turns();
     s.solved = cube.is_solved();
   }

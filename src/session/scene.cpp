@@ -5,14 +5,16 @@
 namespace spidar::session {
 
 Result<std::unique_ptr<Scene>> Scene::load(const std::string& path,
-                                           const std::array<hand::HandModel, 2>& user) {
+                                           const std::array<hand::HandModel, 2>& user,
+                                           double deadline_s) {
   auto s = std::make_unique<Scene>();
   auto world_r = physics::World::Load(path, s->params);
   if (!world_r) return world_r.error();
   s->world = std::move(world_r).value();
   if (auto cube_r = physics::RubiksCube::Attach(*s->world)) s->cube = std::move(cube_r).value();
   Pose X_cube0;
-  s->task = make_scripted_task(*s->world, s->cube, s->params.proxy.radius, user, &X_cube0);
+  s->task = make_scripted_task(*s->world, s->cube, s->params.proxy.radius, user, &X_cube0,
+                               deadline_s);
   s->monitor = std::make_unique<CubeMonitor>(&s->cube, X_cube0);
   if (s->cube) s->task->track(&s->monitor->pose());  // the user watches the cube
   return s;

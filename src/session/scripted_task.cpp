@@ -22,9 +22,11 @@ std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
                                                     const std::optional<physics::RubiksCube>& cube,
                                                     double proxy_radius,
                                                     const std::array<hand::HandModel, 2>& user,
-                                                    Pose* X_cube0) {
+                                                    Pose* X_cube0, double deadline_s) {
   sim::RubiksTaskParams tp;
   tp.proxy_radius = proxy_radius;
+  tp.has_cube = cube.has_value();
+  if (deadline_s > 0) tp.deadline = deadline_s;
   *X_cube0 = Pose{};
   if (cube) {
     *X_cube0 = cube->core_pose();

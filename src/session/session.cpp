@@ -107,7 +107,10 @@ Session::Step Session::step() {
     const std::int64_t t_exp = frame_.t_exposure_ns;
     const double t_s = frame_.filmed != nullptr ? frame_.filmed->t_script_s
                                                 : core::ns_to_s(t_exp - haptic_->t_open_ns());
-    if (params_.seconds > 0 && t_s > params_.seconds) return Step::kPastEnd;
+    if ((params_.seconds > 0 && t_s > params_.seconds) ||
+        (params_.end_with_script && scene_.task->finished(t_s)))
+      return Step::kPastEnd;
+    t_last_s_ = t_s;
     const std::size_t ns = haptic_->loop().newest_samples(servo_buf_.data(), servo_buf_.size());
     const auto measured = device::interpolate_samples({servo_buf_.data(), ns}, t_exp);
     if (!measured) return Step::kSkipped;  // no servo samples around the exposure (a stall)
@@ -184,6 +187,7 @@ SessionSummary Session::stop(const std::string& ended_by) {
   SessionSummary s;
   s.ended_by = ended_by;
   s.wall_s = wall_s;
+  s.t_last_s = t_last_s_;
   s.frames = frames_;
   s.camera_frames = rig_.camera().delivered();
   s.servo = haptic_->loop().stats();

@@ -1,5 +1,6 @@
 #include "spidar/core/units.hpp"
 #include "spidar/sim/rubiks_task.hpp"
+#include "smooth_ramp.hpp"
 
 #include <Eigen/Geometry>
 
@@ -9,12 +10,6 @@
 
 namespace spidar::sim {
 namespace {
-
-/// 0 before t0, 1 after t1, smooth in between.
-double ramp(double t, double t0, double t1) {
-  const double x = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
-  return x * x * (3.0 - 2.0 * x);
-}
 
 Mat3 rot_z(double a) { return Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix(); }
 
@@ -77,22 +72,6 @@ Nominal nominal_grasp(hand::Side side) {
 
 }  // namespace
 
-const char* RubiksTask::phase(double t) {
-  if (t < 1.0) return "approach";
-  if (t < 2.0) return "grasp";
-  if (t < 3.0) return "lift";
-  if (t < 5.0) return "turn 1 (top layer)";
-  if (t < 5.7) return "right hand lets go";
-  if (t < 6.5) return "right hand goes back";
-  if (t < 7.2) return "right hand grasps";
-  if (t < 9.2) return "turn 2 (top layer)";
-  if (t < 9.9) return "let go, set the cube down";
-  if (t < 10.6) return "left hand lets go";
-  if (t < 11.3) return "right hand turns back";
-  if (t < 12.0) return "withdraw";
-  return "done";
-}
-
 bool RubiksTask::looks_for_grasp(double t, hand::Side side) {
   // While a hand approaches for a grasp (open, before closing), never while it holds the cube or
   // lets go of it: an open hand that follows the cube could push it along without end.
@@ -125,11 +104,17 @@ RubiksTask::RubiksTask(RubiksTaskParams p) : p_(p) {
     frames_.lift[h] = 0;
   }
   published_.publish(frames_);
+  plan_.progress.turns_planned = p_.has_cube ? std::max(1, p_.turns) : 0;
+  plan_.progress.attempts = p_.has_cube ? 1 : 0;
+  published_plan_.publish(plan_);
 }
 
-void RubiksTask::goals(double t, std::span<Vec3> goal) {
+void RubiksTask::goals(double t_run, std::span<Vec3> goal) {
+  const std::optional<CubePoseSample> cube = cube_ != nullptr ? cube_->read() : std::nullopt;
+  update_plan(t_run, cube);
+  const double t = plan_.schedule.script_time(t_run);  // script time from here on
   if (cube_ != nullptr) {
-    if (const auto c = cube_->read()) {
+    if (const auto& c = cube) {
       // The cube's orientation with its yaw reduced to (−45°, 45°] by its 90° symmetry.
       const Quat q(c->q_WC[0], c->q_WC[1], c->q_WC[2], c->q_WC[3]);
       const Mat3 R = q.normalized().toRotationMatrix();
@@ -139,6 +124,7 @@ void RubiksTask::goals(double t, std::span<Vec3> goal) {
       for (int h = 0; h < 2; ++h) {
         const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
         if (!looks_for_grasp(t, side)) continue;  // holding on or leaving: keep the frame
+        if (!within_reach(*c)) continue;         // gone from the scene: never follow it away
         frames_.p_W[h] = c->p_W;
         frames_.q_WG[h] = {g.w(), g.x(), g.y(), g.z()};
         frames_.lift[h] = state(t, side, 0).lift;
@@ -146,7 +132,19 @@ void RubiksTask::goals(double t, std::span<Vec3> goal) {
       published_.publish(frames_);
     }
   }
-  goals_at(t, frames_, goal);
+  scheduled_goals(plan_, t_run, frames_, goal, true);
+}
+
+void RubiksTask::scheduled_goals(const Plan& plan, double t_run, const GraspFrames& fr,
+                                 std::span<Vec3> goal, bool squeeze) const {
+  const ScriptSegment& seg = plan.schedule.at(t_run);
+  goals_at(plan.schedule.script_time(t_run), fr, goal, squeeze);
+  const double w = blend_weight(seg, t_run);
+  if (w >= 1.0) return;
+  std::array<Vec3, 8> from;
+  const bool newest = &seg == &plan.schedule.newest();
+  goals_at(seg.s_from_s, newest ? plan.from_frames : fr, from, squeeze);
+  for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f) goal[f] = (1.0 - w) * from[f] + w * goal[f];
 }
 
 Vec3 RubiksTask::squeeze_path(double t, int f) const {
@@ -189,8 +187,8 @@ Vec3 RubiksTask::path(double t, int f) const {
   return (1.0 - w) * table[k][f % 4] + w * table[k + 1][f % 4] + squeeze_path(t, f);
 }
 
-void RubiksTask::touch_points(double t, std::span<Vec3> p_W) const {
-  goals_at(t, published_.read().value_or(frames_), p_W, false);
+void RubiksTask::touch_points(double t_run, std::span<Vec3> p_W) const {
+  scheduled_goals(read_plan(), t_run, published_.read().value_or(frames_), p_W, false);
 }
 
 void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal, bool squeeze) const {
@@ -239,9 +237,22 @@ hand::HandParams RubiksTask::script_nominal_local(double t, hand::Side side) con
   return q;
 }
 
-hand::HandParams RubiksTask::nominal(double t, hand::Side side) const {
-  const int h = side == hand::Side::kRight ? 1 : 0;
+hand::HandParams RubiksTask::nominal(double t_run, hand::Side side) const {
+  const Plan plan = read_plan();
   const GraspFrames fr = published_.read().value_or(frames_);
+  const ScriptSegment& seg = plan.schedule.at(t_run);
+  hand::HandParams q = nominal_at(plan.schedule.script_time(t_run), side, fr);
+  const double w = blend_weight(seg, t_run);
+  if (w < 1.0) {  // neighbouring poses of one hand: a linear blend of the parameters is smooth
+    const bool newest = &seg == &plan.schedule.newest();
+    const hand::HandParams from = nominal_at(seg.s_from_s, side, newest ? plan.from_frames : fr);
+    q.q = (1.0 - w) * from.q + w * q.q;
+  }
+  return q;
+}
+
+hand::HandParams RubiksTask::nominal_at(double t, hand::Side side, const GraspFrames& fr) const {
+  const int h = side == hand::Side::kRight ? 1 : 0;
   const Quat qg(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
   const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
   const HandState s = state(t, side, 0);

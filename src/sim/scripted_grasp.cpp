@@ -1,16 +1,11 @@
 #include "spidar/sim/scripted_grasp.hpp"
+#include "smooth_ramp.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace spidar::sim {
 namespace {
-
-/// 0 before t0, 1 after t1, smooth in between.
-double ramp(double t, double t0, double t1) {
-  const double x = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
-  return x * x * (3.0 - 2.0 * x);
-}
 
 Vec3 rotz(const Vec3& v, double a) {
   return {std::cos(a) * v.x() - std::sin(a) * v.y(), std::sin(a) * v.x() + std::cos(a) * v.y(), v.z()};

@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "device_test_support.hpp"
+#include "spidar/core/clock.hpp"
 #include "spidar/strings/motor.hpp"
 #include "spidar/strings/position.hpp"
 
@@ -47,6 +51,27 @@ TEST(SimulatedSpidar, EncodersLocateTheFingertipsAtMinimumTension) {
   }
   EXPECT_NEAR(truth.t_s, 0.5, 1e-9);
   EXPECT_EQ(r.device_time_us, 500000u);
+}
+
+// The user's hands keep moving while the servo thread is stalled: after a late read the
+// simulated device's time (and so the ground truth the camera films) is the time since open,
+// not behind it (it used to advance at most 0.5 s per read, so every stall longer than that
+// left the truth lagging the wall clock for the rest of the run).
+TEST(SimulatedSpidar, DeviceTimeIsTheTimeSinceOpenAfterAStalledRead) {
+  const auto& cfg = spidar8();
+  SimulatedSpidar sim(cfg, SimulatedSpidarParams{}, testing::hovering(cfg));
+  ASSERT_TRUE(sim.open().ok());
+  const std::int64_t t_open = core::monotonic_ns();
+  EncoderReading r;
+  ASSERT_TRUE(sim.read(r).ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  ASSERT_TRUE(sim.read(r).ok());
+  const double since_open_s = core::ns_to_s(core::monotonic_ns() - t_open);
+  // Bounds only (no timing assertion): the read came ≥ 0.8 s after open, and the device's
+  // time cannot be ahead of the wall clock.
+  EXPECT_GE(r.device_time_us, 800000u);
+  EXPECT_LE(r.device_time_us * 1e-6, since_open_s + 1e-3);
+  EXPECT_NEAR(sim.truth().t_s, r.device_time_us * 1e-6, 1e-6);
 }
 
 TEST(SimulatedSpidar, MotorsLagAndSaturateAndSlackStringsSag) {

@@ -50,8 +50,8 @@ TEST(RubiksTask, GoalsAreContinuousAndTheRightHandTurnsTwice) {
   task.goals(7.2, a);
   task.goals(9.2, b);
   for (int f = 0; f < 4; ++f) EXPECT_LT((a[f] - b[f]).norm(), 1e-9);
-  EXPECT_STREQ(RubiksTask::phase(4.0), "turn 1 (top layer)");
-  EXPECT_STREQ(RubiksTask::phase(13.0), "done");
+  EXPECT_EQ(task.phase(4.0), "turn 1 (top layer)");
+  EXPECT_EQ(task.phase(13.0), "done");
 }
 
 /// Worst and mean cap residual over the script: the touching points stand in for the device's

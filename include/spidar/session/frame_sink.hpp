@@ -45,6 +45,7 @@ struct FrameEvent {
 struct SessionSummary {
   std::string ended_by = "completed";  ///< completed | SIGINT | SIGTERM | stopped | camera ended
   double wall_s = 0;                   ///< since the device was opened [s]
+  double t_last_s = 0;                 ///< FrameEvent::t_s of the last frame before the end [s]
   std::uint64_t frames = 0;            ///< processed
   std::uint64_t camera_frames = 0;     ///< delivered by the camera (processed or dropped)
   device::ServoStats servo;

@@ -16,10 +16,12 @@
 namespace spidar::session {
 
 struct Scene {
-  /// Loads `path` (MJCF) and fits the scripted task to the user's hands `user` (left, right).
+  /// Loads `path` (MJCF) and fits the scripted task to the user's hands `user` (left, right);
+  /// `deadline_s` > 0: the run time by which the scripted user must be done (make_scripted_task).
   /// The error says what in the scene is wrong (callers prefix the option or config key).
   static Result<std::unique_ptr<Scene>> load(const std::string& path,
-                                             const std::array<hand::HandModel, 2>& user);
+                                             const std::array<hand::HandModel, 2>& user,
+                                             double deadline_s = 0);
   Scene() = default;
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;

@@ -21,10 +21,11 @@ void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp);
 /// The scripted user's task in a scene: the cube's start pose (`X_cube0`) when it has one, else the
 /// object nearest the frame centre; the script fitted to the user's own hands (`user`), so their
 /// fingers can be where the device's caps are. (One place for the demo and the live session.)
+/// `deadline_s` > 0: the run time by which the user must be done (its retries must fit).
 std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
                                                     const std::optional<physics::RubiksCube>& cube,
                                                     double proxy_radius,
                                                     const std::array<hand::HandModel, 2>& user,
-                                                    Pose* X_cube0);
+                                                    Pose* X_cube0, double deadline_s = 0);
 
 }  // namespace spidar::session

@@ -38,6 +38,8 @@ struct SessionParams {
   bool warm_up = true;
   /// Frames past this time (FrameEvent::t_s) end the run [s]; 0: no limit.
   double seconds = 0;
+  /// The run also ends once the scene's scripted user is done (sim::RubiksTask::finished).
+  bool end_with_script = false;
   int physics_priority = 60;  ///< SCHED_FIFO: above the rendering threads, below the servo loop
 };
 
@@ -67,7 +69,7 @@ class Session {
     kNoFrame,  ///< no new camera frame
     kSkipped,  ///< a frame without servo samples around its exposure (a stall): not processed
     kFrame,    ///< a frame processed and fanned out to the sinks
-    kPastEnd,  ///< a frame past SessionParams::seconds: the run is over
+    kPastEnd,  ///< a frame past SessionParams::seconds or the script's end: the run is over
   };
   /// Processes the newest camera frame if one arrived since the last call. An exception (the
   /// pipeline or a sink) stops the threads (device in its safe state) and propagates.
@@ -119,6 +121,7 @@ class Session {
   std::optional<SessionSummary> summary_;
   std::uint64_t frames_ = 0;
   int warm_ups_ = 0;
+  double t_last_s_ = 0;
   std::int64_t last_servo_t_ = 0;
   std::vector<device::FingertipSample> servo_buf_;
   CameraFrame frame_;

@@ -12,6 +12,17 @@
 ///   9.9 – 10.6 the left hand lets go
 ///  10.6 – 11.3 the right hand turns back 11.3 – 12.0 both hands withdraw
 ///
+/// That is the script at script time s. The user plays it closed loop (script_schedule.hpp): it
+/// watches the cube (track()) and checks what happened where a step should have ended —
+///   - after each turn, once the right hand has let go (s = 5.7, 9.9): did the layer click into
+///     its detent (the published turn count)? Missing turns are tried again by replaying the
+///     regrasp-and-turn stretch 5.7 – 9.9, as long as the rest of the script still fits before
+///     `deadline`; with all `turns` done it goes on to setting the cube down;
+///   - while the cube is held up (s in 3.0 – 9.2): is it still in the hand? A cube that dropped
+///     more than half the lift below where the holding hand carries it, for 0.15 s, is a slipped
+///     grasp: both hands open and approach and grasp it again from s = 0.4, where it lies.
+/// Each jump in s is cross-faded over a fraction of a second, so the fingertips never jump.
+///
 /// It gives the eight fingertip goals (left thumb, index, middle, ring, then right; the simulated
 /// device's FingertipSource) and, per hand, a nominal hand pose that goes with them (wrist pose
 /// and a relaxed grip), which sim::UserHands uses as the prior of the user's hand posture.
@@ -23,7 +34,10 @@
 /// current pose (from the physics thread) as the frame of that grasp, so a cube that tilted or slid
 /// while held is grasped where it is (up to its 90° symmetry about its vertical axis).
 #include <array>
+#include <cstdint>
+#include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "spidar/core/pose.hpp"
@@ -32,6 +46,7 @@
 #include "spidar/device/fingertip_source.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/hand/parameters.hpp"
+#include "spidar/sim/script_schedule.hpp"
 
 namespace spidar::sim {
 
@@ -45,13 +60,27 @@ struct RubiksTaskParams {
   double lift = 0.02;            ///< [m]
   double withdraw = 0.06;        ///< how far the hands start and end away from the grasp [m]
   double turn = 1.75;            ///< [rad] per turn, past 90° so that the detent finishes the click
-  double duration = 12.0;        ///< [s]
+  double duration = 12.0;        ///< the script's length (script time) [s]
+  int turns = 2;                 ///< layer turns to make (≥ 1)
+  double deadline = 20.0;        ///< run time by which the user must be done: retries must fit [s]
+  bool has_cube = true;          ///< a Rubik's cube (false: another object; no turns are counted)
 };
 
 /// The cube's pose as the physics thread publishes it (plain data for core::Latest).
 struct CubePoseSample {
   std::array<double, 3> p_W{};           ///< centre [m]
   std::array<double, 4> q_WC{1, 0, 0, 0};  ///< orientation (w, x, y, z)
+  std::int32_t turns = -1;               ///< completed quarter turns so far (−1: not counted)
+};
+
+/// How the closed-loop user is doing (published for the frame thread and the report).
+struct TaskProgress {
+  std::int32_t turns_planned = 0;  ///< layer turns the user sets out to make
+  std::int32_t turns_seen = 0;     ///< completed turns at the user's last check
+  std::int32_t attempts = 0;       ///< turn attempts started (planned turns + retries)
+  std::int32_t retries_turn = 0;   ///< turns tried again after one that did not click
+  std::int32_t retries_grasp = 0;  ///< grasps made again after the cube slipped
+  bool gave_up = false;            ///< a retry was needed but no longer fitted before the deadline
 };
 
 class RubiksTask final : public device::FingertipSource {
@@ -70,17 +99,22 @@ class RubiksTask final : public device::FingertipSource {
   const std::array<double, 2>& fit_shift_max_m() const { return fit_shift_max_; }
   /// Follow the cube's published pose (must outlive the task); nullptr = the start pose.
   void track(const core::Latest<CubePoseSample>* cube) { cube_ = cube; }
-  /// Goals of the eight fingertips at time t [s] (world, m).
+  /// Goals of the eight fingertips at run time t [s] (world, m). The user's clock: call from one
+  /// thread (the simulated device's); it checks the task and publishes the schedule.
   void goals(double t_s, std::span<Vec3> p_W_goal) override;
   /// Where the eight fingertips touch at time t (world, m): the goals less their squeeze into the
   /// faces (a finger stops at the face), in the grasp frames last published by goals().
   void touch_points(double t_s, std::span<Vec3> p_W) const;
   /// The nominal pose of one hand at time t (wrist in world, relaxed finger angles).
   hand::HandParams nominal(double t_s, hand::Side side) const;
-  /// Name of the phase at time t (progress output).
-  static const char* phase(double t_s);
-  /// Layer turns the script performs (completed when the detent clicks).
-  static constexpr int kTurns = 2;
+  /// Name of the phase at run time t, from the scene ("turn 2 (top layer)" only with a cube).
+  std::string phase(double t_s) const;
+  /// Script time at run time t (the published schedule).
+  double script_time(double t_s) const;
+  /// True once the script has played to its end.
+  bool finished(double t_s) const { return script_time(t_s) >= p_.duration; }
+  /// The user's checks so far.
+  TaskProgress progress() const;
   const RubiksTaskParams& params() const { return p_; }
 
  private:
@@ -96,6 +130,23 @@ class RubiksTask final : public device::FingertipSource {
     std::array<std::array<double, 4>, 2> q_WG{};
     std::array<double, 2> lift{};
   };
+  /// What goals() publishes for the other threads.
+  struct Plan {
+    ScriptSchedule schedule;
+    TaskProgress progress;
+    GraspFrames from_frames;  ///< the grasp frames when the newest segment started (its blend source)
+  };
+  /// The closed loop: checks the task at run time t with the cube as last seen; may start a
+  /// segment of the schedule (servo thread).
+  void update_plan(double t_s, const std::optional<CubePoseSample>& cube);
+  /// After a turn, once the right hand has let go (`first`: after the first turn).
+  void check_turns(double t_s, int turns_seen, bool first);
+  /// Starts a segment at run time t from script time s0, blending from the present script time.
+  void jump(double t_s, double s0, double blend_s, SegmentKind kind, int attempt);
+  Plan read_plan() const;
+  /// True while the cube is where a hand can take it: near its start place (not thrown off the
+  /// table). Hands follow only such a cube.
+  bool within_reach(const CubePoseSample& cube) const;
   HandState state(double t_s, hand::Side side, int finger) const;
   /// 0 = hand open, 1 = closed on the grasp.
   static double closeness(double t_s, hand::Side side);
@@ -103,6 +154,12 @@ class RubiksTask final : public device::FingertipSource {
   static bool looks_for_grasp(double t_s, hand::Side side);
   void goals_at(double t_s, const GraspFrames& frames, std::span<Vec3> p_W_goal,
                 bool squeeze = true) const;
+  /// goals_at at run time t through the schedule (cross-fading during a segment's blend from
+  /// where the previous segment was left, in the grasp frames of then).
+  void scheduled_goals(const Plan& plan, double t_s, const GraspFrames& frames,
+                       std::span<Vec3> p_W_goal, bool squeeze) const;
+  /// nominal() at script time s with these grasp frames.
+  hand::HandParams nominal_at(double s, hand::Side side, const GraspFrames& frames) const;
   /// Finger f's (0..7) goal in its hand's grasp frame before the hand's yaw and lift: the
   /// script's contact path, or the fitted path when fit_to_hands was called.
   Vec3 path(double t_s, int f) const;
@@ -120,6 +177,11 @@ class RubiksTask final : public device::FingertipSource {
   const core::Latest<CubePoseSample>* cube_ = nullptr;
   GraspFrames frames_;                      ///< servo thread's copy
   core::Latest<GraspFrames> published_;     ///< for nominal()
+  Plan plan_;                               ///< servo thread's copy
+  core::Latest<Plan> published_plan_;       ///< for the other threads
+  double prev_s_ = 0;                       ///< script time at the previous goals() call
+  double drop_since_ = -1;                  ///< run time the cube was first seen dropped (−1: not)
+  int turns_at_check_ = 0;                  ///< turns seen at the previous turn check
   /// Fitted fingertip paths (fit_to_hands): per hand, 4 fingertips every fit_dt_ seconds.
   std::array<std::vector<std::array<Vec3, 4>>, 2> fitted_;
   std::array<std::vector<hand::HandParams>, 2> fitted_q_;  ///< the poses that reach them

@@ -1,0 +1,227 @@
+// The scripted user's closed loop: it checks the cube where a step should have ended and retries
+// what did not work, within the run's deadline, without a jump in the fingertips.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <functional>
+
+#include "spidar/core/seqlock.hpp"
+#include "spidar/sim/rubiks_task.hpp"
+
+namespace spidar::sim {
+namespace {
+
+/// The cube as a physics thread would publish it: where the script carries it (at the start
+/// pose, lifted by `lift` m) with `turns` completed turns.
+CubePoseSample cube_at(const RubiksTaskParams& p, double lift, int turns) {
+  CubePoseSample c;
+  c.p_W = {p.p_W_cube.x(), p.p_W_cube.y(), p.p_W_cube.z() + lift};
+  c.turns = turns;
+  return c;
+}
+
+struct Played {
+  double max_step_m = 0;        ///< largest fingertip goal step between 1 ms calls
+  double finished_at_s = -1;    ///< run time the script reached its end (−1: not by the end)
+  double min_script_jump = 0;   ///< most negative script-time step (a jump back)
+};
+
+/// Plays the task from 0 to t_end at 1 kHz; `world(t, s)` says what the cube looks like at run
+/// time t and script time s (published before each call, as the physics thread would).
+Played play(RubiksTask& task, core::Latest<CubePoseSample>& feed, double t_end,
+         const std::function<CubePoseSample(double, double)>& world) {
+  Played r;
+  std::array<Vec3, 8> prev, g;
+  double s_prev = 0;
+  feed.publish(world(0.0, 0.0));
+  task.goals(0.0, prev);
+  for (int k = 1; k <= static_cast<int>(std::lround(t_end * 1000)); ++k) {
+    const double t = k * 1e-3;
+    feed.publish(world(t, task.script_time(t)));
+    task.goals(t, g);
+    for (int f = 0; f < 8; ++f) r.max_step_m = std::max(r.max_step_m, (g[f] - prev[f]).norm());
+    prev = g;
+    const double s = task.script_time(t);
+    r.min_script_jump = std::min(r.min_script_jump, s - s_prev - 1e-3);
+    s_prev = s;
+    if (r.finished_at_s < 0 && task.finished(t)) r.finished_at_s = t;
+  }
+  return r;
+}
+
+/// The lift the script gives the cube at script time s (rubiks_task.hpp: up 2–3 s, held, set
+/// down to a quarter 9.2–9.9).
+double script_lift(const RubiksTaskParams& p, double s) {
+  auto ramp = [](double t, double t0, double t1) {
+    const double x = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    return x * x * (3 - 2 * x);
+  };
+  return p.lift * (ramp(s, 2.0, 3.0) - 0.75 * ramp(s, 9.2, 9.9));
+}
+
+TEST(ClosedLoopUser, EveryTurnClicksSoTheScriptPlaysOnceWithoutRetries) {
+  RubiksTask task({});
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const RubiksTaskParams p = task.params();
+  // The layer clicks at 5.3 s and 9.5 s of script time.
+  const Played r = play(task, feed, 14.0, [&](double, double s) {
+    return cube_at(p, script_lift(p, s), (s >= 5.3) + (s >= 9.5));
+  });
+  const TaskProgress pr = task.progress();
+  EXPECT_EQ(pr.turns_planned, 2);
+  EXPECT_EQ(pr.turns_seen, 2);
+  EXPECT_EQ(pr.attempts, 2);
+  EXPECT_EQ(pr.retries_turn, 0);
+  EXPECT_EQ(pr.retries_grasp, 0);
+  EXPECT_FALSE(pr.gave_up);
+  EXPECT_NEAR(r.finished_at_s, p.duration, 2e-3);  // open loop when all goes well
+  EXPECT_GE(r.min_script_jump, -1e-9);
+  EXPECT_LT(r.max_step_m, 0.0005);
+}
+
+TEST(ClosedLoopUser, ATurnThatDoesNotClickIsTriedAgain) {
+  RubiksTask task({});
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const RubiksTaskParams p = task.params();
+  // The first turn slips (no click); the second attempt clicks, and so does the third.
+  int clicks = 0;
+  double last_s = 0;
+  const Played r = play(task, feed, 22.0, [&](double, double s) {
+    // A click whenever a turn phase (7.2–9.2 script time) has just been played to its end.
+    if (last_s < 9.25 && s >= 9.25) ++clicks;
+    last_s = s;
+    return cube_at(p, script_lift(p, s), clicks);
+  });
+  const TaskProgress pr = task.progress();
+  EXPECT_EQ(pr.turns_seen, 2);
+  EXPECT_EQ(pr.retries_turn, 1);
+  EXPECT_EQ(pr.attempts, 3);
+  EXPECT_FALSE(pr.gave_up);
+  EXPECT_LT(r.min_script_jump, -3.0);  // the regrasp-and-turn stretch was replayed
+  EXPECT_GT(r.finished_at_s, p.duration + 3.0);
+  EXPECT_LE(r.finished_at_s, p.deadline);
+  EXPECT_LT(r.max_step_m, 0.0005);  // cross-faded: no jump in the fingertips
+}
+
+TEST(ClosedLoopUser, RetriesStopAtTheDeadline) {
+  RubiksTaskParams tp;
+  tp.deadline = 14.0;  // room for the script and no retry
+  RubiksTask task(tp);
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const Played r = play(task, feed, 15.0, [&](double, double s) { return cube_at(tp, script_lift(tp, s), 0); });
+  const TaskProgress pr = task.progress();
+  EXPECT_EQ(pr.turns_seen, 0);
+  EXPECT_TRUE(pr.gave_up);
+  EXPECT_LE(r.finished_at_s, tp.deadline);
+  EXPECT_GT(r.finished_at_s, 0);
+}
+
+TEST(ClosedLoopUser, ASlippedGraspIsMadeAgainWhereTheCubeLies) {
+  RubiksTask task({});
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const RubiksTaskParams p = task.params();
+  // At 4 s the cube drops out of the hands to the table, 1 cm to the side; then it is held
+  // where the script carries it from there.
+  bool dropped = false;
+  double regrasp_t = -1;
+  std::string phase_after;
+  const Played r = play(task, feed, 16.0, [&](double t, double s) {
+    if (t >= 4.0 && !dropped && task.progress().retries_grasp == 0) {
+      CubePoseSample c = cube_at(p, 0.0, 0);
+      c.p_W[0] += 0.01;
+      return c;
+    }
+    if (task.progress().retries_grasp > 0 && regrasp_t < 0) {
+      regrasp_t = t;
+      phase_after = task.phase(t + 0.05);
+      dropped = true;
+    }
+    CubePoseSample c = cube_at(p, script_lift(p, s), (s >= 5.3) + (s >= 9.5));
+    if (dropped) c.p_W[0] += 0.01;
+    return c;
+  });
+  const TaskProgress pr = task.progress();
+  EXPECT_EQ(pr.retries_grasp, 1);
+  EXPECT_GT(regrasp_t, 4.25);  // a drop must last 0.3 s
+  EXPECT_LT(regrasp_t, 4.6);
+  EXPECT_EQ(phase_after, "approach the cube again");
+  EXPECT_EQ(pr.turns_seen, 2);
+  EXPECT_LT(r.max_step_m, 0.0015);  // the grasp frames move with the cube: a small step
+  // The grasp follows the cube: after the regrasp the right thumb's goal is 1 cm further in x.
+  std::array<Vec3, 8> g0, g1;
+  RubiksTask ref({});
+  ref.goals(3.0, g0);
+  task.goals(regrasp_t + (3.0 - 0.7), g1);  // script time 3.0 again (s = 0.7 at the regrasp)
+  EXPECT_NEAR(g1[4].x() - g0[4].x(), 0.01, 2e-3);
+}
+
+TEST(ClosedLoopUser, ACubeHeldLowerThanTheScriptLiftsItIsNoSlip) {
+  RubiksTask task({});
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const RubiksTaskParams p = task.params();
+  // Compliant fingertips carry the cube at 40 % of the script's lift.
+  play(task, feed, 14.0, [&](double, double s) {
+    return cube_at(p, 0.4 * script_lift(p, s), (s >= 5.3) + (s >= 9.5));
+  });
+  EXPECT_EQ(task.progress().retries_grasp, 0);
+  EXPECT_EQ(task.progress().turns_seen, 2);
+}
+
+TEST(ClosedLoopUser, ACubeGoneFromTheTableIsNotFollowed) {
+  RubiksTask task({});
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const RubiksTaskParams p = task.params();
+  // At 4 s the cube falls off the table and keeps falling.
+  const Played r = play(task, feed, 12.0, [&](double t, double s) {
+    CubePoseSample c = cube_at(p, script_lift(p, s), 0);
+    if (t >= 4.0) c.p_W[2] -= 0.5 * 9.81 * (t - 4.0) * (t - 4.0) + 0.1;
+    return c;
+  });
+  EXPECT_TRUE(task.progress().gave_up);
+  EXPECT_EQ(task.progress().retries_grasp, 0);
+  EXPECT_LT(r.max_step_m, 0.0005);
+  // No fingertip goal goes below the table's neighbourhood following the falling cube.
+  for (double t = 4.0; t < 12.0; t += 0.05) {
+    std::array<Vec3, 8> g;
+    task.goals(t, g);
+    for (const auto& x : g) EXPECT_GT(x.z(), p.p_W_cube.z() - 0.05) << t;
+  }
+}
+
+TEST(ClosedLoopUser, OnePlannedTurnSkipsTheSecond) {
+  RubiksTaskParams tp;
+  tp.turns = 1;
+  RubiksTask task(tp);
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const Played r = play(task, feed, 14.0, [&](double, double s) { return cube_at(tp, script_lift(tp, s), s >= 5.3); });
+  EXPECT_EQ(task.progress().turns_seen, 1);
+  EXPECT_EQ(task.progress().attempts, 1);
+  EXPECT_LT(r.finished_at_s, tp.duration - 3.0);  // the regrasp and second turn were skipped
+  EXPECT_LT(r.max_step_m, 0.0005);
+}
+
+TEST(ClosedLoopUser, PhasesAreNamedFromTheScene) {
+  RubiksTaskParams with_cube, without;
+  without.has_cube = false;
+  RubiksTask a(with_cube), b(without);
+  EXPECT_EQ(a.phase(0.5), "approach");
+  EXPECT_EQ(a.phase(4.0), "turn 1 (top layer)");
+  EXPECT_EQ(a.phase(8.0), "turn 2 (top layer)");
+  EXPECT_EQ(b.phase(0.5), "reach");
+  EXPECT_EQ(b.phase(4.0), "turn the object");
+  EXPECT_EQ(b.phase(8.0), "turn the object");
+  EXPECT_EQ(b.phase(9.5), "let go, set it down");
+  for (double t = 0; t < 13; t += 0.1) EXPECT_EQ(b.phase(t).find("layer"), std::string::npos) << t;
+  EXPECT_EQ(b.progress().turns_planned, 0);
+}
+
+}  // namespace
+}  // namespace spidar::sim
