@@ -18,7 +18,7 @@
 #include "commands.hpp"
 #include "live_config.hpp"
 #include "live_session.hpp"
-#include "session_parts.hpp"
+#include "spidar/session/rig_inputs.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/device/sample_interpolation.hpp"
 #include "spidar/physics/world.hpp"
@@ -152,8 +152,8 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
   if (!ctx_r) throw SpidarError("OpenGL: " + ctx_r.error().message);
   auto context = std::move(ctx_r).value();
   const vision::Camera camera =
-      scaled_camera(vision::load_camera_file(cfg.camera_calibration).camera, cfg.width, cfg.height);
-  const auto models = hand_models(cfg.hands_file, cfg.model_profile, false);
+      session::scaled_camera(vision::load_camera_file(cfg.camera_calibration).camera, cfg.width, cfg.height);
+  const auto models = session::hand_models(cfg.hands_file, cfg.model_profile, false);
   auto pipe_r = pipeline::FramePipeline::create(*context, camera, models, live_pipeline_params(cfg, r0));
   if (!pipe_r) throw UsageError(pipe_r.error().message);
   auto pipe = std::move(pipe_r).value();

@@ -30,14 +30,8 @@ nlohmann::json summary_json(const LiveSession& s, const std::string& ended_by, d
                 {"jitter_p99_us", st.jitter_p99_us}, {"overruns", st.overruns},
                 {"faults", device::fault_names(st.faults)},
                 {"realtime_scheduling", st.realtime_scheduling}};
-  const auto& h = s.history();
-  double iou = 0, reg = 0;
-  for (const auto& m : h) {
-    iou += m.iou;
-    reg += m.registration_ms;
-  }
-  j["registration"] = {{"iou_vs_silhouette_mean", h.empty() ? 0.0 : iou / static_cast<double>(h.size())},
-                       {"ms_mean", h.empty() ? 0.0 : reg / static_cast<double>(h.size())}};
+  j["registration"] = {{"iou_vs_silhouette_mean", s.view().iou_mean()},
+                       {"ms_mean", s.view().registration_ms_mean()}};
   if (auto c = s.cube_status())
     j["cube"] = {{"turns", c->turns}, {"solved", c->solved}, {"lift_mm", c->lift * 1e3}};
   if (const SessionRecorder* r = s.recorder()) {

@@ -15,7 +15,7 @@
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
-#include "spidar/sim/haptic_bridge.hpp"
+#include "spidar/session/haptic_side.hpp"
 #include "spidar/sim/scripted_grasp.hpp"
 
 namespace spidar::app {
@@ -55,15 +55,14 @@ int run_haptic_demo(const DemoOptions& o) {
   device::SimulatedSpidarParams dp;
   dp.seed = o.seed;
   device::SimulatedSpidar dev(cfg, dp, script);
-  if (auto st = dev.open(); !st.ok()) throw UsageError(st.error().message);
 
-  device::ServoConfig servo;
-  servo.rate_hz = o.rate_hz;
-  servo.force_timeout_s = 0.05;
-  auto bridge = std::make_shared<sim::HapticForces>(wp.coupling, servo.rate_hz);
-  sim::PhysicsThread physics(*world, *bridge);
+  session::HapticSideParams hp;
+  hp.servo.rate_hz = o.rate_hz;
+  hp.servo.force_timeout_s = 0.05;
+  const device::ServoConfig& servo = hp.servo;
+  session::HapticSide haptic(dev, cfg, *world, wp.coupling, hp);
   core::Latest<CubeStatus> cube_status;
-  physics.set_before_step([&](physics::World& w) {
+  haptic.set_before_step([&](physics::World& w) {
     CubeStatus s;
     s.t_s = w.time();
     s.lift = cube.core_pose().p.z() - X_cube0.p.z();
@@ -72,13 +71,12 @@ int run_haptic_demo(const DemoOptions& o) {
     s.contacts = w.contact_count();
     cube_status.publish(s);
   });
-  device::ServoLoop loop(dev, cfg, servo, bridge);
+  device::ServoLoop& loop = haptic.loop();
 
   std::cout << "spidar-mr demo: haptic Rubik's cube on a simulated " << cfg.name << "\n  scene "
             << scene << ", servo " << servo.rate_hz << " Hz, physics in its own thread at "
             << 1.0 / world->timestep() << " Hz, coupling " << wp.coupling.stiffness << " N/m\n\n";
-  physics.start();
-  if (auto st = loop.start(); !st.ok()) throw UsageError(st.error().message);
+  haptic.start();
 
   // Record every servo sample from the lock-free ring while the scenario runs.
   std::vector<device::FingertipSample> trace;
@@ -112,14 +110,12 @@ int run_haptic_demo(const DemoOptions& o) {
     }
     if (t >= seconds) break;
   }
-  loop.stop();
-  physics.stop();
-  dev.close();
+  haptic.stop();
 
   // Summary.
   const auto ss = loop.stats();
-  const auto ps = physics.stats();
-  const auto hs = bridge->stats();
+  const auto ps = haptic.physics().stats();
+  const auto hs = haptic.bridge().stats();
   const auto final_status = cube_status.read().value_or(CubeStatus{});
   std::vector<double> fmax(cfg.fingers.size(), 0.0);
   double jump_max = 0;

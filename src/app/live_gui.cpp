@@ -140,7 +140,7 @@ cv::Mat view_image(View view, const LiveSession& s) {
 
 /// The last `n` values of a history field, as floats for ImGui's plots.
 template <typename F>
-std::vector<float> series(const std::vector<LiveFrameStats>& h, std::size_t n, F field) {
+std::vector<float> series(const session::HistoryRing<LiveFrameStats>& h, std::size_t n, F field) {
   std::vector<float> v;
   const std::size_t start = h.size() > n ? h.size() - n : 0;
   v.reserve(h.size() - start);
@@ -267,8 +267,8 @@ void scene_panel(LiveSession& s) {
 }
 
 /// The simulated user's hands under interactive control: keys move and close them, sliders too.
-void hands_panel(InteractiveHands& ih, GLFWwindow* window, double dt) {
-  HandControls c = ih.controls();
+void hands_panel(session::InteractiveHands& ih, GLFWwindow* window, double dt) {
+  session::HandControls c = ih.controls();
   struct Keys {
     int away, toward, left, right, up, down, yaw_left, yaw_right, close, open;
   };
@@ -403,7 +403,9 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   Gl gl;
   if (!gl.load()) throw SpidarError("window: GL entry points missing (glfwGetProcAddress)");
 
-  auto session = LiveSession::create(cfg, *context, options);
+  LiveSessionOptions no_warm_up = options;  // the window is up: show frames at once
+  no_warm_up.warm_up = false;
+  auto session = LiveSession::create(cfg, *context, no_warm_up);
   // Sticky keys: a tap shorter than one GUI frame (the space bar's emergency stop above all) is
   // still seen by the next glfwGetKey.
   glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);
@@ -517,7 +519,7 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
     camera_calibration.draw(*session);
     ImGui::End();
 
-    if (InteractiveHands* ih = session->interactive()) {
+    if (session::InteractiveHands* ih = session->interactive()) {
       ImGui::SetNextWindowPos(ImVec2(vw + 20, vh + 312), ImGuiCond_FirstUseEver);
       ImGui::SetNextWindowSize(ImVec2(std::max(300.0f, W - vw - 24), 190), ImGuiCond_FirstUseEver);
       ImGui::Begin("Hands (interactive)");
@@ -549,9 +551,9 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
                             {"frames", session->frames()},
                             {"servo_rate_hz", st.rate_hz},
                             {"faults", device::fault_names(st.faults)}};
-  if (InteractiveHands* ih = session->interactive()) {
+  if (session::InteractiveHands* ih = session->interactive()) {
     // Where the keys and sliders left the hands (left, right).
-    for (const HandControl& c : ih->controls())
+    for (const session::HandControl& c : ih->controls())
       summary["hands"].push_back({{"offset_m", c.offset_W}, {"yaw_rad", c.yaw}, {"closeness", c.closeness}});
   }
   std::cout << summary.dump() << "\n";

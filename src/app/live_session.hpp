@@ -1,43 +1,31 @@
 #pragma once
-/// The live mixed-reality session (`spidar-mr run`): built from a LiveConfig, it runs the threads
-/// of DESIGN.md — servo loop (device backend: simulated or serial), physics, camera (synthetic,
-/// V4L2 device or video file) — and, on the caller's thread (the frame thread, GL context
-/// current), takes camera frames through pipeline::FramePipeline: chroma key, bracelets,
-/// registration, render, composite. The caller shows the results (window, GUI) or not (headless).
+/// The live mixed-reality session (`spidar-mr run`): a LiveConfig wired into a rig (the simulated
+/// SPIDAR-8 or a serial device; the synthetic camera, a V4L2 device or a video file), a
+/// session::Session and its sinks — the GUI's view model (session::FrameStatsSink) and, when
+/// asked for, the recorder. The caller steps it on its thread (GL context current) and shows the
+/// results (window, GUI) or not (headless).
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
-#include <vector>
 
-#include "interactive_hands.hpp"
 #include "live_config.hpp"
-#include "session_parts.hpp"
 #include "session_recorder.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/render/context.hpp"
-#include "spidar/sim/haptic_bridge.hpp"
+#include "spidar/session/frame_stats.hpp"
+#include "spidar/session/interactive_hands.hpp"
+#include "spidar/session/rig.hpp"
+#include "spidar/session/scene.hpp"
+#include "spidar/session/session.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::app {
 
-/// Numbers of one processed frame (no ground truth: these are what a live session can measure).
-struct LiveFrameStats {
-  double t_s = 0;             ///< exposure time since the session started [s]
-  double iou = 0;             ///< fitted hands' pixels vs the chroma-key silhouette
-  std::array<registration::TermCosts, 2> terms{};  ///< final registration cost per term, per hand
-  std::array<int, 2> iterations{};
-  double latency_ms = 0;      ///< exposure to composite
-  double pipeline_ms = 0;
-  double registration_ms = 0;
-  double servo_rate_hz = 0;   ///< since the previous frame
-  double servo_jitter_max_us = 0;
-};
-
-/// IoU of the fitted hands (hand-id target, forearm included) against the chroma-key silhouette.
-double silhouette_iou(const pipeline::FrameResult& r, cv::Mat* scratch);
+using LiveFrameStats = session::FrameStats;
+using session::silhouette_iou;
 
 /// The pipeline parameters a live config asks for (shared by run and replay, so both fit alike).
 pipeline::FramePipelineParams live_pipeline_params(const LiveConfig& c,
@@ -46,6 +34,10 @@ pipeline::FramePipelineParams live_pipeline_params(const LiveConfig& c,
 struct LiveSessionOptions {
   std::string record_dir;             ///< empty: no recording
   FrameStore record_frames = FrameStore::kVideo;
+  /// The pipeline's warm-up before the clock starts (session::SessionParams::warm_up). The GUI
+  /// skips it: its window is up already, and the warm-up (~0.3 s, seconds on a loaded machine)
+  /// would only delay the first frame the user sees.
+  bool warm_up = true;
 };
 
 class LiveSession {
@@ -65,72 +57,54 @@ class LiveSession {
   bool step();
   /// False once the servo loop ended (a device fault) or the camera ended (end of a file) or
   /// failed (error() says why).
-  bool running() const;
+  bool running() const { return session_->running(); }
   std::string error() const;
   /// True once the camera has ended (end of a file) or failed.
-  bool camera_ended() const;
+  bool camera_ended() const { return rig_->camera().ended(); }
   /// Stops every thread (device left in its safe state) and finishes the recording. Idempotent.
   void stop();
 
   // --- for the GUI and the report ---
   const LiveConfig& config() const { return config_; }
-  const strings::DeviceConfig& device_config() const { return device_config_; }
+  const strings::DeviceConfig& device_config() const { return rig_->device_config(); }
   const vision::Camera& camera() const { return camera_; }
   const std::array<hand::HandModel, 2>& models() const { return models_; }
-  /// The last processed frame: camera image and pipeline result (valid after step() returned true).
-  const cv::Mat& camera_image() const { return camera_image_; }
-  const pipeline::FrameResult& result() const { return result_; }
-  const device::FingertipSample& measured() const { return measured_; }
-  const std::vector<LiveFrameStats>& history() const { return history_; }
-  std::uint64_t frames() const { return frames_; }
-  std::uint64_t camera_frames() const;  ///< frames the camera delivered (processed or dropped)
-  device::ServoLoop& servo() { return *loop_; }
-  const device::ServoLoop& servo() const { return *loop_; }
-  std::optional<CubeStatus> cube_status() const;
-  CubeMonitor& cube() { return *cube_monitor_; }
-  sim::PhysicsThreadStats physics_stats() const;
+  /// The GUI's view model: the last processed frame, the bounded history, the run's means.
+  const session::FrameStatsSink& view() const { return view_; }
+  /// The last processed frame: camera image and pipeline result (empty before the first).
+  const cv::Mat& camera_image() const { return view_.camera_image(); }
+  const pipeline::FrameResult& result() const { return view_.result() ? *view_.result() : no_result_; }
+  const device::FingertipSample& measured() const { return view_.measured(); }
+  const session::HistoryRing<LiveFrameStats>& history() const { return view_.history(); }
+  std::uint64_t frames() const { return session_->frames(); }
+  std::uint64_t camera_frames() const { return session_->camera_frames(); }
+  device::ServoLoop& servo() { return session_->servo(); }
+  const device::ServoLoop& servo() const { return session_->servo(); }
+  std::optional<session::CubeStatus> cube_status() const { return scene_->monitor->status().read(); }
+  session::CubeMonitor& cube() { return *scene_->monitor; }
+  sim::PhysicsThreadStats physics_stats() const { return session_->physics_stats(); }
   const SessionRecorder* recorder() const { return recorder_.get(); }
   /// The newest servo cycle at the device boundary (raw counts, commands); any thread.
   std::optional<DeviceCycleRecord> newest_device_cycle() const;
   /// The simulated user's hands under interactive control; null unless hands.control is
   /// interactive.
-  InteractiveHands* interactive() { return interactive_.get(); }
-  double seconds() const;  ///< since start()
-
-  struct FrameSource;
+  session::InteractiveHands* interactive() { return rig_->interactive(); }
+  double seconds() const { return session_->seconds(); }
 
  private:
+  class RecorderSink;
   LiveSession() = default;
   LiveConfig config_;
-  LiveSessionOptions options_;
-  strings::DeviceConfig device_config_;
   vision::Camera camera_;
   std::array<hand::HandModel, 2> models_, user_models_;
-  std::unique_ptr<physics::World> world_;
-  std::optional<physics::RubiksCube> cube_;
-  std::unique_ptr<CubeMonitor> cube_monitor_;
-  std::shared_ptr<sim::RubiksTask> task_;
-  std::shared_ptr<InteractiveHands> interactive_;
-  std::unique_ptr<device::Device> device_;
+  std::unique_ptr<session::Scene> scene_;
+  std::unique_ptr<session::Rig> rig_;
   std::unique_ptr<RecordingDevice> recording_device_;
-  std::shared_ptr<sim::HapticForces> bridge_;
-  std::unique_ptr<sim::PhysicsThread> physics_;
-  std::unique_ptr<device::ServoLoop> loop_;
-  std::unique_ptr<FrameSource> source_;
-  std::unique_ptr<pipeline::FramePipeline> pipe_;
   std::unique_ptr<SessionRecorder> recorder_;
-  render::Context* context_ = nullptr;
-
-  std::int64_t t_open_ns_ = 0;
-  bool started_ = false, stopped_ = false;
-  std::vector<device::FingertipSample> servo_buf_;
-  SceneSnapshot scene_;
-  cv::Mat camera_image_, iou_scratch_;
-  pipeline::FrameResult result_;
-  device::FingertipSample measured_;
-  std::vector<LiveFrameStats> history_;
-  std::uint64_t frames_ = 0;
-  std::int64_t last_servo_t_ = 0;
+  std::unique_ptr<RecorderSink> recorder_sink_;
+  session::FrameStatsSink view_;
+  std::unique_ptr<session::Session> session_;
+  pipeline::FrameResult no_result_;
 };
 
 }  // namespace spidar::app

@@ -96,6 +96,7 @@ Result<std::unique_ptr<FramePipeline>> FramePipeline::create(
 FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 FramePipeline::~FramePipeline() = default;
 void FramePipeline::reset() { impl_->have_previous = false; }
+bool FramePipeline::has_previous() const { return impl_->have_previous; }
 Status FramePipeline::present(render::Context& context, const cv::Mat& bgr) {
   return impl_->renderer->present(context, bgr);
 }

@@ -101,6 +101,8 @@ class FramePipeline {
   Status present(render::Context& context, const cv::Mat& bgr);
   /// Forgets the previous frame (the next one is a cold start).
   void reset();
+  /// True once a frame was processed since creation or reset() (the next fit starts from it).
+  bool has_previous() const;
   const FramePipelineParams& params() const;
   const std::array<hand::HandModel, 2>& models() const;
 

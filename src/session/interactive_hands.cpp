@@ -1,4 +1,4 @@
-#include "interactive_hands.hpp"
+#include "spidar/session/interactive_hands.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/rotation_vector.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 namespace {
 
 Vec3 rotation_vector(const Mat3& R) {
@@ -63,4 +63,4 @@ void InteractiveHands::goals(double /*t_s*/, std::span<Vec3> p_W_goal) {
   }
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::session

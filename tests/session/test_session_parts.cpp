@@ -2,13 +2,14 @@
 // (the GUI's scene panel), the turn counter, the camera scaling.
 #include <gtest/gtest.h>
 
-#include "interactive_hands.hpp"
-#include "session_parts.hpp"
+#include "spidar/session/interactive_hands.hpp"
+#include "spidar/session/cube_monitor.hpp"
+#include "spidar/session/rig_inputs.hpp"
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/physics/world.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 namespace {
 
 TEST(CubeMonitor, ScrambleAndResetRunInThePhysicsStepAndAreNotCountedAsTurns) {
@@ -121,4 +122,4 @@ TEST(InteractiveHands, ControlsMoveAndCloseTheHandsAndTheirCapsAreTheDeviceGoals
 }
 
 }  // namespace
-}  // namespace spidar::app
+}  // namespace spidar::session

@@ -11,7 +11,7 @@
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/hand/parameters.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 
 struct HandControl {
   std::array<double, 3> offset_W{};  ///< wrist displacement from its start [m], world
@@ -42,4 +42,4 @@ class InteractiveHands final : public device::FingertipSource {
   core::Latest<HandControls> controls_;
 };
 
-}  // namespace spidar::app
+}  // namespace spidar::session

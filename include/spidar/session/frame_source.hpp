@@ -1,0 +1,65 @@
+#pragma once
+/// Where a session's camera frames come from: the synthetic camera filming the simulated user
+/// (scripted or interactive), a real camera (V4L2 device) or a video file. Each source runs its
+/// own thread; the frame thread takes the newest frame (older ones are dropped, as a camera's are).
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "spidar/core/result.hpp"
+#include "spidar/device/simulated_spidar.hpp"
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/sim/camera_thread.hpp"
+#include "spidar/sim/rubiks_task.hpp"
+#include "spidar/vision/camera.hpp"
+#include "spidar/vision/capture.hpp"
+
+namespace spidar::session {
+
+class InteractiveHands;
+
+/// One camera frame as the frame thread receives it.
+struct CameraFrame {
+  cv::Mat bgr;                     ///< the image (valid until the next take(); clone to keep it)
+  std::int64_t t_exposure_ns = 0;  ///< host monotonic time of the exposure [ns]
+  /// What the synthetic camera filmed (true hand poses, script time, ...); null for real cameras.
+  const sim::FilmedFrame* filmed = nullptr;
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  /// Starts the source's thread; `t0_ns` is the session's start (script time 0) [ns, monotonic].
+  virtual Status start(std::int64_t t0_ns) = 0;
+  /// The newest frame since the last call into `out`; false if none arrived.
+  virtual bool take(CameraFrame* out) = 0;
+  /// True once the source has ended (end of a file) or failed (error() says why).
+  virtual bool ended() const = 0;
+  virtual std::string error() const = 0;
+  /// Frames delivered so far (taken or dropped).
+  virtual std::uint64_t delivered() const = 0;
+  /// Stops the thread. Idempotent.
+  virtual void stop() = 0;
+};
+
+/// The synthetic camera filming the scripted user's true hands (`truth`), whose fingertips the
+/// simulated device `dev` holds (their positions at each exposure come from its truth samples).
+std::unique_ptr<FrameSource> make_synthetic_source(const vision::Camera& camera,
+                                                   const std::array<hand::HandModel, 2>& truth,
+                                                   const sim::RubiksTask& task,
+                                                   device::SimulatedSpidar& dev, double fps,
+                                                   std::uint64_t seed);
+
+/// The synthetic camera filming the interactively controlled hands (their commanded posture).
+std::unique_ptr<FrameSource> make_interactive_source(const vision::Camera& camera,
+                                                     const InteractiveHands& hands, double fps,
+                                                     std::uint64_t seed);
+
+/// A real camera (V4L2 device) or a video file, read in its own thread. A device's frames carry
+/// the host time they were grabbed at; a file's frame k is shown at start + k / fps.
+std::unique_ptr<FrameSource> make_capture_source(vision::Capture capture);
+
+}  // namespace spidar::session

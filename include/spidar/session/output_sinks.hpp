@@ -1,0 +1,54 @@
+#pragma once
+/// Sinks that write a run's pictures: the composite into a video, and keyframes (montages of the
+/// camera image, the fit and the composite at chosen times) as PNGs.
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "spidar/render/video_output.hpp"
+#include "spidar/session/frame_sink.hpp"
+#include "spidar/vision/camera.hpp"
+
+namespace spidar::session {
+
+/// Every frame's composite into `video` (closed at the end). Throws SpidarError if a write fails.
+class VideoSink final : public FrameSink {
+ public:
+  explicit VideoSink(render::VideoOutput& video) : video_(video) {}
+  void on_frame(const FrameEvent& e) override;
+  void on_end(const SessionSummary& s) override;
+
+ private:
+  render::VideoOutput& video_;
+};
+
+/// At each of `times` [s] (ascending), the first frame at or after it: a keyframe montage
+/// (sim::keyframe_montage) captioned by `caption`, composed then (the frame's buffers are reused)
+/// and written as `dir`/keyframe_<n>_t<t>s.png after the run (a PNG takes tens of milliseconds,
+/// which during the run would drop camera frames). Throws SpidarError if a write fails.
+class KeyframeSink final : public FrameSink {
+ public:
+  KeyframeSink(std::string dir, std::vector<double> times, render::CompositeMode mode,
+               const std::array<hand::HandModel, 2>& models, const vision::Camera& camera,
+               std::function<std::string(const FrameEvent&)> caption)
+      : dir_(std::move(dir)), times_(std::move(times)), mode_(mode), models_(models),
+        camera_(camera), caption_(std::move(caption)) {}
+  void on_frame(const FrameEvent& e) override;
+  void on_end(const SessionSummary& s) override;
+  /// The keyframes composed so far (path, montage).
+  const std::vector<std::pair<std::string, cv::Mat>>& keyframes() const { return keyframes_; }
+
+ private:
+  std::string dir_;
+  std::vector<double> times_;
+  render::CompositeMode mode_;
+  std::array<hand::HandModel, 2> models_;
+  vision::Camera camera_;
+  std::function<std::string(const FrameEvent&)> caption_;
+  std::size_t next_ = 0;
+  std::vector<std::pair<std::string, cv::Mat>> keyframes_;
+};
+
+}  // namespace spidar::session

@@ -1,0 +1,133 @@
+#pragma once
+/// One running system (DESIGN.md, "The flow of one session"): the haptic side — the servo loop
+/// driving the rig's device, the physics thread and the bridge between them — and the frame side
+/// — camera frames through pipeline::FramePipeline (and optionally a comparison pipeline), with
+/// the warm-up before the clock starts, the servo samples interpolated at each exposure, and one
+/// FrameEvent per processed frame fanned out to the sinks.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "spidar/device/servo_loop.hpp"
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/render/context.hpp"
+#include "spidar/session/frame_sink.hpp"
+#include "spidar/session/haptic_side.hpp"
+#include "spidar/session/rig.hpp"
+#include "spidar/session/scene.hpp"
+#include "spidar/sim/haptic_bridge.hpp"
+#include "spidar/vision/camera.hpp"
+
+namespace spidar::session {
+
+struct SessionParams {
+  device::ServoConfig servo;            ///< rate, limits, timeouts of the servo loop
+  pipeline::FramePipelineParams pipeline;
+  /// A second registration with the silhouette term switched the other way, fitted every frame
+  /// (it must track) and rendered every `compare_every`-th frame (FrameEvent::compared).
+  bool compare = false;
+  int compare_every = 5;
+  /// One blank frame through each pipeline before the clock starts (GL programs, skins and
+  /// workspaces cost ~130 ms on the first frame; in the run they would drop the camera's first
+  /// frames); the fits are reset after it, so the first real frame is a cold start.
+  bool warm_up = true;
+  /// Frames past this time (FrameEvent::t_s) end the run [s]; 0: no limit.
+  double seconds = 0;
+  /// The run also ends once the scene's scripted user is done (sim::RubiksTask::finished).
+  bool end_with_script = false;
+  int physics_priority = 60;  ///< SCHED_FIFO: above the rendering threads, below the servo loop
+};
+
+class Session {
+ public:
+  /// Builds the servo loop, the physics thread and the pipelines (nothing started). `context`
+  /// must be current on the calling thread (the frame thread) and outlive the session, as must
+  /// the rig and the scene. `drive`: the device the servo loop drives if not the rig's own (a
+  /// wrapper around it, e.g. one that records every cycle). Throws SpidarError saying what failed.
+  static std::unique_ptr<Session> create(Rig& rig, Scene& scene, render::Context& context,
+                                         const vision::Camera& camera,
+                                         const std::array<hand::HandModel, 2>& models,
+                                         const SessionParams& params,
+                                         device::Device* drive = nullptr);
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// Sinks see events in the order they were added; they must outlive the session's run.
+  void add_sink(FrameSink& sink) { sinks_.push_back(&sink); }
+
+  /// The warm-up (if asked for), then opens the device and starts physics, servo loop and camera;
+  /// the sinks' on_start. Throws SpidarError (the threads stopped) if any of them fails.
+  void start();
+
+  enum class Step {
+    kNoFrame,  ///< no new camera frame
+    kSkipped,  ///< a frame without servo samples around its exposure (a stall): not processed
+    kFrame,    ///< a frame processed and fanned out to the sinks
+    kPastEnd,  ///< a frame past SessionParams::seconds or the script's end: the run is over
+  };
+  /// Processes the newest camera frame if one arrived since the last call. An exception (the
+  /// pipeline or a sink) stops the threads (device in its safe state) and propagates.
+  Step step();
+
+  /// Steps until the servo loop stops (a fault), the camera ends, a frame is past `seconds`, no
+  /// frame came for `seconds` + 1 s, or `interrupted()` names a reason (e.g. "SIGINT"); then
+  /// stop(). Returns the summary.
+  SessionSummary run(const std::function<std::optional<std::string>()>& interrupted = {});
+
+  /// Stops the camera, the servo loop (device in its safe state), physics, closes the device and
+  /// calls the sinks' on_end. Idempotent: later calls return the first summary.
+  SessionSummary stop(const std::string& ended_by = "stopped");
+
+  /// False once stopped, or the servo loop ended (a fault), or the camera ended or failed.
+  bool running() const;
+  bool started() const { return started_; }
+  /// Seconds since start().
+  double seconds() const;
+  std::int64_t t_start_ns() const { return haptic_->t_open_ns(); }
+  std::uint64_t frames() const { return frames_; }
+  /// Warm-ups done: 1 after start() with SessionParams::warm_up, else 0.
+  int warm_ups() const { return warm_ups_; }
+  std::uint64_t camera_frames() const;
+
+  Rig& rig() { return rig_; }
+  Scene& scene() { return scene_; }
+  device::ServoLoop& servo() { return haptic_->loop(); }
+  const device::ServoLoop& servo() const { return haptic_->loop(); }
+  sim::PhysicsThreadStats physics_stats() const { return haptic_->physics().stats(); }
+  pipeline::FramePipeline& pipeline() { return *pipe_; }
+  const SessionParams& params() const { return params_; }
+
+ private:
+  Session(Rig& rig, Scene& scene, render::Context& context, const SessionParams& params);
+  void warm_up();
+  void stop_threads();
+
+  Rig& rig_;
+  Scene& scene_;
+  render::Context& context_;
+  SessionParams params_;
+  vision::Camera camera_;
+  std::unique_ptr<HapticSide> haptic_;
+  std::unique_ptr<pipeline::FramePipeline> pipe_, alt_;
+  std::vector<FrameSink*> sinks_;
+
+  bool started_ = false, threads_stopped_ = false;
+  std::optional<SessionSummary> summary_;
+  std::uint64_t frames_ = 0;
+  int warm_ups_ = 0;
+  double t_last_s_ = 0;
+  std::int64_t last_servo_t_ = 0;
+  std::vector<device::FingertipSample> servo_buf_;
+  CameraFrame frame_;
+  SceneSnapshot snapshot_;
+  device::FingertipSample measured_;
+  pipeline::FrameResult result_, alt_result_;
+};
+
+}  // namespace spidar::session

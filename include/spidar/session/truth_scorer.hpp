@@ -1,0 +1,75 @@
+#pragma once
+/// The ground-truth scorer: on the simulated rig, every processed frame measured against what
+/// the synthetic camera filmed (sim::measure_frame), the comparison fit and the model's ceiling
+/// on compared frames, the cube, forces and servo timing — the per-frame trace the demo's report
+/// is made of.
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "spidar/hand/hand_model.hpp"
+#include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/render/context.hpp"
+#include "spidar/session/cube_monitor.hpp"
+#include "spidar/session/frame_sink.hpp"
+#include "spidar/sim/frame_truth.hpp"
+#include "spidar/sim/model_ceiling.hpp"
+#include "spidar/vision/camera.hpp"
+
+namespace spidar::session {
+
+struct TruthFrame {
+  double t_s = 0;              ///< script time of the exposure [s]
+  double latency_ms = 0;       ///< exposure → composite ready [ms]
+  double pipeline_ms = 0;      ///< frame pipeline cost [ms]
+  double registration_ms = 0;  ///< both hands [ms]
+  double preprocess_ms = 0;    ///< chroma key, bracelets, distance transform [ms]
+  pipeline::FrameTimings stages;  ///< the main pipeline's stages [ms]
+  double film_ms = 0;          ///< synthetic camera (simulation cost, not pipeline) [ms]
+  double truth_ms = 0;         ///< ground-truth posture, comparison fit, metrics [ms]
+  double output_ms = 0;        ///< video and keyframes [ms]
+  /// [0]: the main registration, [1]: the comparison (silhouette term switched the other way).
+  std::array<sim::FrameTruthMetrics, 2> truth{};
+  bool compared = false;  ///< truth[1] measured in this frame
+  /// The model's skin at the true pose with the user's sizes vs the real silhouette
+  /// (sim::ModelCeiling); measured on compared frames (ceiling_measured).
+  double ceiling_iou = 0;
+  bool ceiling_measured = false;
+  std::array<int, 2> iterations{};
+  std::array<double, 2> truth_cap_residual_mm{};
+  double lift_mm = 0, u_angle_deg = 0, d_angle_deg = 0;
+  int turns = 0;
+  std::array<double, 8> force_n{};
+  double servo_rate_hz = 0, servo_jitter_max_us = 0;
+};
+
+/// Every scored frame of a run, in order (a run is bounded by its length: the report needs all).
+struct TruthTrace {
+  std::vector<TruthFrame> frames;
+};
+
+class TruthScorer final : public FrameSink {
+ public:
+  /// `context`: current on the frame thread (the ceiling renders there); `params`: the session's
+  /// main pipeline (compositor mode, model skin); `monitor`: the scene's cube. Throws SpidarError.
+  TruthScorer(render::Context& context, const vision::Camera& camera,
+              const std::array<hand::HandModel, 2>& models,
+              const std::array<hand::HandModel, 2>& truth_models,
+              const pipeline::FramePipelineParams& params, CubeMonitor& monitor);
+  /// Throws SpidarError on a frame without ground truth (a real camera).
+  void on_frame(const FrameEvent& e) override;
+  /// The output time of the newest frame (the sinks after this one) [ms].
+  void set_output_ms(double ms);
+  const TruthTrace& trace() const { return trace_; }
+
+ private:
+  vision::Camera camera_;
+  std::array<hand::HandModel, 2> models_, truth_models_;
+  render::CompositeMode mode_;
+  CubeMonitor& monitor_;
+  std::unique_ptr<sim::ModelCeiling> ceiling_;
+  sim::FrameTruthWorkspace ws_;
+  TruthTrace trace_;
+};
+
+}  // namespace spidar::session

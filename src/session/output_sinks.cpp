@@ -1,0 +1,31 @@
+#include "spidar/session/output_sinks.hpp"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "spidar/sim/frame_truth.hpp"
+
+namespace spidar::session {
+
+void VideoSink::on_frame(const FrameEvent& e) {
+  if (auto st = video_.write(e.result->composite); !st) throw SpidarError(st.error().message);
+}
+
+void VideoSink::on_end(const SessionSummary& /*s*/) { video_.close(); }
+
+void KeyframeSink::on_frame(const FrameEvent& e) {
+  if (next_ >= times_.size() || e.t_s < times_[next_]) return;
+  char name[64];
+  std::snprintf(name, sizeof name, "keyframe_%d_t%04.1fs.png", static_cast<int>(next_) + 1, e.t_s);
+  keyframes_.emplace_back((std::filesystem::path(dir_) / name).string(),
+                          sim::keyframe_montage(*e.bgr, *e.result, mode_, models_, camera_, caption_(e)));
+  ++next_;
+}
+
+void KeyframeSink::on_end(const SessionSummary& /*s*/) {
+  for (const auto& [path, montage] : keyframes_) {
+    if (auto st = render::write_png(path, montage); !st) throw SpidarError(st.error().message);
+  }
+}
+
+}  // namespace spidar::session

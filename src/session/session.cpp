@@ -1,0 +1,201 @@
+#include "spidar/session/session.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+#include "spidar/core/clock.hpp"
+#include "spidar/device/sample_interpolation.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+
+namespace spidar::session {
+
+Session::Session(Rig& rig, Scene& scene, render::Context& context, const SessionParams& params)
+    : rig_(rig), scene_(scene), context_(context), params_(params) {}
+
+std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context& context,
+                                         const vision::Camera& camera,
+                                         const std::array<hand::HandModel, 2>& models,
+                                         const SessionParams& params, device::Device* drive) {
+  std::unique_ptr<Session> s(new Session(rig, scene, context, params));
+  s->camera_ = camera;
+  // --- the haptic side: servo loop ↔ bridge ↔ physics thread ---
+  HapticSideParams hp;
+  hp.servo = params.servo;
+  hp.physics_priority = params.physics_priority;
+  hp.snapshot_proxies = false;  // the fitted hands are drawn instead
+  s->haptic_ = std::make_unique<HapticSide>(drive != nullptr ? *drive : rig.device(),
+                                            rig.device_config(), *scene.world,
+                                            scene.params.coupling, hp);
+  CubeMonitor* monitor = scene.monitor.get();
+  s->haptic_->set_before_step([monitor](physics::World& w) { monitor->before_step(w); });
+  // --- the frame side ---
+  auto pipe_r = pipeline::FramePipeline::create(context, camera, models, params.pipeline);
+  if (!pipe_r) throw SpidarError(pipe_r.error().message);
+  s->pipe_ = std::move(pipe_r).value();
+  if (params.compare) {
+    pipeline::FramePipelineParams alt = params.pipeline;
+    alt.registration.silhouette_term = !alt.registration.silhouette_term;
+    auto alt_r = pipeline::FramePipeline::create(context, camera, models, alt);
+    if (!alt_r) throw SpidarError(alt_r.error().message);
+    s->alt_ = std::move(alt_r).value();
+  }
+  s->servo_buf_.resize(1000);
+  return s;
+}
+
+Session::~Session() { stop_threads(); }
+
+void Session::warm_up() {
+  // A blank blue screen with the fingertips where the script starts; both fits are then reset.
+  const auto rgb = sim::SyntheticCameraParams{}.screen_rgb;
+  const vision::Intrinsics& k = camera_.intrinsics();
+  const cv::Mat blank(k.height, k.width, CV_8UC3,
+                      cv::Scalar(255.0 * rgb[2], 255.0 * rgb[1], 255.0 * rgb[0]));
+  std::vector<Vec3> goals(8);
+  scene_.task->goals(0.0, goals);
+  device::FingertipSample tips;
+  tips.finger_count = 8;
+  for (int f = 0; f < 8; ++f) tips.p_W[f] = {goals[f].x(), goals[f].y(), goals[f].z()};
+  SceneSnapshot s0;
+  scene_.world->snapshot(s0, false);
+  pipeline::FrameResult warm;
+  for (pipeline::FramePipeline* p : {pipe_.get(), alt_.get()}) {
+    if (p == nullptr) continue;
+    if (auto st = p->process(blank, tips, s0, &warm); !st) throw SpidarError(st.error().message);
+    p->reset();
+  }
+  ++warm_ups_;
+}
+
+void Session::start() {
+  if (started_) return;
+  if (params_.warm_up) warm_up();
+  haptic_->start();  // throws with the haptic side stopped again
+  started_ = true;
+  try {
+    for (FrameSink* k : sinks_) k->on_start();
+  } catch (...) {
+    stop_threads();
+    throw;
+  }
+  if (auto st = rig_.camera().start(haptic_->t_open_ns()); !st) {
+    stop_threads();
+    throw SpidarError("camera: " + st.error().message);
+  }
+}
+
+bool Session::running() const {
+  return started_ && !threads_stopped_ && haptic_->loop().running() && !rig_.camera().ended();
+}
+
+double Session::seconds() const {
+  return started_ ? core::ns_to_s(core::monotonic_ns() - haptic_->t_open_ns()) : 0.0;
+}
+
+std::uint64_t Session::camera_frames() const { return rig_.camera().delivered(); }
+
+Session::Step Session::step() {
+  if (!started_ || threads_stopped_) return Step::kNoFrame;
+  try {
+    if (!rig_.camera().take(&frame_)) return Step::kNoFrame;
+    const vision::Intrinsics& k = camera_.intrinsics();
+    if (frame_.bgr.cols != k.width || frame_.bgr.rows != k.height)
+      throw SpidarError("camera: a frame of " + std::to_string(frame_.bgr.cols) + "x" +
+                        std::to_string(frame_.bgr.rows) + " px, expected " + std::to_string(k.width) +
+                        "x" + std::to_string(k.height));
+    const std::int64_t t_exp = frame_.t_exposure_ns;
+    const double t_s = frame_.filmed != nullptr ? frame_.filmed->t_script_s
+                                                : core::ns_to_s(t_exp - haptic_->t_open_ns());
+    if ((params_.seconds > 0 && t_s > params_.seconds) ||
+        (params_.end_with_script && scene_.task->finished(t_s)))
+      return Step::kPastEnd;
+    t_last_s_ = t_s;
+    const std::size_t ns = haptic_->loop().newest_samples(servo_buf_.data(), servo_buf_.size());
+    const auto measured = device::interpolate_samples({servo_buf_.data(), ns}, t_exp);
+    if (!measured) return Step::kSkipped;  // no servo samples around the exposure (a stall)
+    measured_ = *measured;
+    haptic_->physics().snapshots().update();
+    snapshot_ = haptic_->physics().snapshots().front();
+
+    FrameEvent e;
+    e.cold_start = !pipe_->has_previous();
+    if (auto st = pipe_->process(frame_.bgr, measured_, snapshot_, &result_); !st)
+      throw SpidarError(st.error().message);
+    e.t_done_ns = core::monotonic_ns();
+    // The comparison registration runs every frame (it must track), its rendering every
+    // compare_every-th frame (a sample of the run; it costs as much as the main pipeline).
+    if (alt_) {
+      const bool render = frames_ % static_cast<std::uint64_t>(std::max(1, params_.compare_every)) == 0;
+      if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !render); !st)
+        throw SpidarError(st.error().message);
+      if (render) e.compared = &alt_result_;
+    }
+    e.index = frames_;
+    e.t_exposure_ns = t_exp;
+    e.t_s = t_s;
+    e.bgr = &frame_.bgr;
+    e.measured = &measured_;
+    e.scene = &snapshot_;
+    e.result = &result_;
+    e.filmed = frame_.filmed;
+    e.servo = servo_timing_since({servo_buf_.data(), ns}, params_.servo.rate_hz, &last_servo_t_);
+    for (FrameSink* sink : sinks_) sink->on_frame(e);
+    ++frames_;
+    return Step::kFrame;
+  } catch (...) {
+    stop_threads();
+    throw;
+  }
+}
+
+SessionSummary Session::run(const std::function<std::optional<std::string>()>& interrupted) {
+  start();
+  std::string ended_by = "completed";
+  while (haptic_->loop().running()) {
+    if (interrupted) {
+      if (auto why = interrupted()) {
+        ended_by = *why;
+        break;
+      }
+    }
+    if (rig_.camera().ended()) {
+      ended_by = "camera ended";
+      break;
+    }
+    const Step st = step();
+    if (st == Step::kPastEnd) break;
+    if (st == Step::kNoFrame) {  // wait for the next frame
+      if (params_.seconds > 0 && seconds() > params_.seconds + 1.0) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+  }
+  return stop(ended_by);
+}
+
+void Session::stop_threads() {
+  if (threads_stopped_) return;
+  threads_stopped_ = true;
+  rig_.camera().stop();
+  if (haptic_) haptic_->stop();
+}
+
+SessionSummary Session::stop(const std::string& ended_by) {
+  if (summary_) return *summary_;
+  const double wall_s = seconds();
+  stop_threads();
+  SessionSummary s;
+  s.ended_by = ended_by;
+  s.wall_s = wall_s;
+  s.t_last_s = t_last_s_;
+  s.frames = frames_;
+  s.camera_frames = rig_.camera().delivered();
+  s.servo = haptic_->loop().stats();
+  s.physics = haptic_->physics().stats();
+  s.camera_error = rig_.camera().error();
+  summary_ = s;
+  for (FrameSink* k : sinks_) k->on_end(s);
+  return s;
+}
+
+}  // namespace spidar::session

@@ -1,0 +1,75 @@
+// The simulated rig's camera: sim::CameraThread filming the scripted user's true hands.
+#include "spidar/device/sample_interpolation.hpp"
+#include "spidar/session/frame_source.hpp"
+
+namespace spidar::session {
+namespace {
+
+class SyntheticSource final : public FrameSource {
+ public:
+  SyntheticSource(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
+                  const sim::RubiksTask& task, device::SimulatedSpidar& dev, double fps,
+                  std::uint64_t seed)
+      : camera_(camera), truth_(truth), task_(task), dev_(dev), fps_(fps), seed_(seed) {}
+  ~SyntheticSource() override { stop(); }
+
+  Status start(std::int64_t t0_ns) override {
+    truth_buf_.resize(1000);
+    // The ground truth comes from the simulated device: where it holds the user's fingertips.
+    sim::TruthAt truth_at = [this](std::int64_t t_ns, std::span<Vec3> out) {
+      const std::size_t n = dev_.truth_samples(truth_buf_.data(), truth_buf_.size());
+      const auto s = device::interpolate_samples({truth_buf_.data(), n}, t_ns);
+      if (!s) return false;
+      for (std::size_t f = 0; f < out.size() && f < 8; ++f)
+        out[f] = Vec3(s->p_W[f][0], s->p_W[f][1], s->p_W[f][2]);
+      return true;
+    };
+    sim::SyntheticCameraParams cp;
+    cp.seed = seed_;
+    sim::CameraThreadParams ctp;
+    ctp.fps = fps_;
+    ctp.t0_ns = t0_ns;
+    auto r = sim::CameraThread::start(camera_, truth_, cp, task_, truth_at, ctp);
+    if (!r) return r.error();
+    thread_ = std::move(r).value();
+    return Ok{};
+  }
+  bool take(CameraFrame* out) override {
+    if (!thread_ || stopped_ || !thread_->take()) return false;
+    const sim::FilmedFrame& f = thread_->frame();
+    out->bgr = f.frame.bgr;  // a header on the thread's buffer: valid until the next take()
+    out->t_exposure_ns = f.t_exposure_ns;
+    out->filmed = &f;
+    return true;
+  }
+  bool ended() const override { return stopped_ && thread_ && !thread_->error().empty(); }
+  std::string error() const override { return stopped_ && thread_ ? thread_->error() : std::string(); }
+  std::uint64_t delivered() const override { return thread_ ? thread_->filmed() : 0; }
+  void stop() override {
+    if (thread_ && !stopped_) thread_->stop();
+    stopped_ = true;
+  }
+
+ private:
+  vision::Camera camera_;
+  std::array<hand::HandModel, 2> truth_;
+  const sim::RubiksTask& task_;
+  device::SimulatedSpidar& dev_;
+  double fps_;
+  std::uint64_t seed_;
+  std::vector<device::FingertipSample> truth_buf_;
+  std::unique_ptr<sim::CameraThread> thread_;
+  bool stopped_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> make_synthetic_source(const vision::Camera& camera,
+                                                   const std::array<hand::HandModel, 2>& truth,
+                                                   const sim::RubiksTask& task,
+                                                   device::SimulatedSpidar& dev, double fps,
+                                                   std::uint64_t seed) {
+  return std::make_unique<SyntheticSource>(camera, truth, task, dev, fps, seed);
+}
+
+}  // namespace spidar::session

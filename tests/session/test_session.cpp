@@ -1,0 +1,179 @@
+// A Session on the simulated rig, headless and short: the fan-out to the sinks, the bounded
+// history, the warm-up, and a sink that throws.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <vector>
+
+#include "spidar/render/context.hpp"
+#include "spidar/session/frame_stats.hpp"
+#include "spidar/session/rig.hpp"
+#include "spidar/session/rig_inputs.hpp"
+#include "spidar/session/session.hpp"
+#include "spidar/strings/device_config.hpp"
+#include "spidar/vision/camera_config.hpp"
+
+namespace spidar::session {
+namespace {
+
+/// Everything a session on the simulated rig needs, at 320×240 and 30 fps.
+struct SimulatedSetup {
+  explicit SimulatedSetup(double seconds, bool warm_up = true) {
+    auto ctx = render::Context::create_headless();
+    if (!ctx) throw SpidarError("OpenGL: " + ctx.error().message);
+    context = std::move(ctx).value();
+    config = strings::load_device_config("configs/spidar8.yaml");
+    user = hand_models("configs/hands.yaml", "user", true);
+    models = hand_models("configs/hands.yaml", "model", false);
+    camera = scaled_camera(vision::load_camera_file("configs/camera.yaml").camera, 320, 240);
+    scene = Scene::load("scenes/rubiks_cube.xml", user).value();
+    SimulatedRigParams rp;
+    rp.seed = 3;
+    rp.fps = 30;
+    rig = std::make_unique<SimulatedRig>(config, *scene, camera, user, rp);
+    SessionParams sp;
+    sp.servo.rate_hz = 1000;
+    sp.servo.force_timeout_s = 0.05;
+    sp.pipeline = pipeline_params("configs/vision.yaml", "configs/registration.yaml", false,
+                                  render::CompositeMode::kDepth, scene->initial_r_W_hand());
+    sp.seconds = seconds;
+    sp.warm_up = warm_up;
+    session = Session::create(*rig, *scene, *context, camera, models, sp);
+  }
+  std::unique_ptr<render::Context> context;
+  strings::DeviceConfig config;
+  std::array<hand::HandModel, 2> user, models;
+  vision::Camera camera;
+  std::unique_ptr<Scene> scene;
+  std::unique_ptr<SimulatedRig> rig;
+  std::unique_ptr<Session> session;
+};
+
+/// Writes down what it sees: the order of the calls, each frame's index and time.
+struct TracingSink final : FrameSink {
+  void on_start() override { calls.push_back('s'); }
+  void on_frame(const FrameEvent& e) override {
+    calls.push_back('f');
+    indices.push_back(e.index);
+    times.push_back(e.t_s);
+    cold.push_back(e.cold_start);
+    truth.push_back(e.filmed != nullptr);
+  }
+  void on_end(const SessionSummary& s) override {
+    calls.push_back('e');
+    summary = s;
+  }
+  std::string calls;
+  std::vector<std::uint64_t> indices;
+  std::vector<double> times;
+  std::vector<bool> cold, truth;
+  SessionSummary summary;
+};
+
+TEST(Session, EverySinkSeesEveryProcessedFrameInOrderWithIncreasingTimes) {
+  SimulatedSetup s(1.5);
+  TracingSink a, b;
+  s.session->add_sink(a);
+  s.session->add_sink(b);
+  const SessionSummary end = s.session->run();
+  ASSERT_GT(end.frames, 5u) << "a 1.5 s run at 30 fps processes frames";
+  EXPECT_EQ(end.ended_by, "completed");
+  EXPECT_TRUE(end.camera_error.empty()) << end.camera_error;
+  EXPECT_GE(end.camera_frames, end.frames);
+  for (const TracingSink* k : {&a, &b}) {
+    EXPECT_EQ(k->calls, "s" + std::string(end.frames, 'f') + "e");
+    ASSERT_EQ(k->indices.size(), end.frames);
+    for (std::size_t i = 0; i < k->indices.size(); ++i) EXPECT_EQ(k->indices[i], i);
+    for (std::size_t i = 1; i < k->times.size(); ++i) EXPECT_GT(k->times[i], k->times[i - 1]) << i;
+    EXPECT_LE(k->times.back(), 1.5) << "frames past SessionParams::seconds end the run";
+    for (bool t : k->truth) EXPECT_TRUE(t) << "the synthetic camera's frames carry the truth";
+    EXPECT_EQ(k->summary.frames, end.frames);
+  }
+  EXPECT_EQ(a.times, b.times);
+  // Stopped: a second stop() returns the same summary and calls no sink again.
+  EXPECT_EQ(s.session->stop().frames, end.frames);
+  EXPECT_EQ(a.calls.back(), 'e');
+  EXPECT_EQ(std::count(a.calls.begin(), a.calls.end(), 'e'), 1);
+  EXPECT_FALSE(s.session->running());
+}
+
+TEST(Session, WarmUpHappensOnceAndTheFirstRealFrameIsAColdStart) {
+  SimulatedSetup s(1.0);
+  TracingSink k;
+  s.session->add_sink(k);
+  s.session->start();
+  s.session->start();  // idempotent: no second warm-up
+  EXPECT_EQ(s.session->warm_ups(), 1);
+  const SessionSummary end = s.session->run();
+  EXPECT_EQ(s.session->warm_ups(), 1);
+  ASSERT_GE(end.frames, 2u);
+  EXPECT_TRUE(k.cold.front()) << "the warm-up's fit was reset: the first frame starts cold";
+  for (std::size_t i = 1; i < k.cold.size(); ++i) EXPECT_FALSE(k.cold[i]) << "frame " << i;
+
+  SimulatedSetup cold(0.5, false);
+  cold.session->start();
+  EXPECT_EQ(cold.session->warm_ups(), 0);
+  cold.session->stop();
+}
+
+TEST(Session, ASinkThatThrowsStopsTheSessionCleanly) {
+  SimulatedSetup s(3.0);
+  TracingSink before, after;
+  FunctionSink thrower([](const FrameEvent& e) {
+    if (e.index == 3) throw std::runtime_error("sink failed at frame 3");
+  });
+  s.session->add_sink(before);
+  s.session->add_sink(thrower);
+  s.session->add_sink(after);
+  EXPECT_THROW(
+      {
+        try {
+          s.session->run();
+        } catch (const std::runtime_error& e) {
+          EXPECT_STREQ(e.what(), "sink failed at frame 3");
+          throw;
+        }
+      },
+      std::runtime_error);
+  EXPECT_FALSE(s.session->running());
+  EXPECT_FALSE(s.session->servo().running()) << "the servo thread is joined";
+  EXPECT_FALSE(s.rig->device().status().open) << "the device is closed (in its safe state)";
+  EXPECT_EQ(before.indices.size(), 4u);
+  EXPECT_EQ(after.indices.size(), 3u) << "sinks after the failing one do not see its frame";
+  EXPECT_EQ(before.calls.find('e'), std::string::npos) << "on_end only for a run that ended";
+}
+
+TEST(FrameStatsSink, HistoryNeverExceedsItsCapacityAndMeansCoverTheWholeRun) {
+  SimulatedSetup s(1.5);
+  FrameStatsSink stats(4);
+  TracingSink k;
+  s.session->add_sink(stats);
+  s.session->add_sink(k);
+  const SessionSummary end = s.session->run();
+  ASSERT_GT(end.frames, 4u);
+  EXPECT_EQ(stats.history().size(), 4u);
+  EXPECT_EQ(stats.history().pushed(), end.frames);
+  for (std::size_t i = 0; i < 4; ++i)  // the newest four, oldest first
+    EXPECT_DOUBLE_EQ(stats.history()[i].t_s, k.times[k.times.size() - 4 + i]);
+  EXPECT_GT(stats.iou_mean(), 0.0);
+  EXPECT_LE(stats.iou_mean(), 1.0);
+}
+
+TEST(HistoryRing, KeepsTheNewestValuesOldestFirst) {
+  HistoryRing<int> r(3);
+  EXPECT_TRUE(r.empty());
+  for (int v = 1; v <= 7; ++v) {
+    r.push(v);
+    EXPECT_LE(r.size(), 3u);
+    EXPECT_EQ(r.back(), v);
+  }
+  EXPECT_EQ(r.pushed(), 7u);
+  EXPECT_EQ(r[0], 5);
+  EXPECT_EQ(r[1], 6);
+  EXPECT_EQ(r[2], 7);
+  EXPECT_THROW(HistoryRing<int>(0), SpidarError);
+}
+
+}  // namespace
+}  // namespace spidar::session
