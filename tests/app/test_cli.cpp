@@ -235,7 +235,10 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   // with one core busy elsewhere: 6–8 frames, 2 fps). Speed is the benchmarks' and the demo
   // report's to measure, not this test's: it asks for enough frames to measure registration.
   EXPECT_GE(j["frames"].get<int>(), 4);
-  EXPECT_DOUBLE_EQ(j["seconds"].get<double>(), 3.0);
+  // The run's length is its last processed frame's time: at most the --seconds asked for.
+  EXPECT_GT(j["seconds"].get<double>(), 0.0);
+  EXPECT_LE(j["seconds"].get<double>(), 3.0 + 1e-6);
+  EXPECT_EQ(j["cube"]["turns_planned"].get<int>(), 2);  // the script's, whatever 3 s got done
   EXPECT_GT(j["haptic"]["rate_hz"].get<double>(), 900.0);
   EXPECT_GT(j["physics"]["step_ms_median"].get<double>(), 0.0);
   const auto& reg = j["registration"];
