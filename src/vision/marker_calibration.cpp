@@ -1,37 +1,25 @@
-#include "marker_calibration.hpp"
+#include "spidar/vision/marker_calibration.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <utility>
 
 #include "spidar/core/units.hpp"
 
-namespace spidar::app {
+namespace spidar::vision {
 
-MarkerCalibration::MarkerCalibration(const vision::Camera& present, const strings::FingerConfig& finger,
-                                     StabilityParams stability)
-    : present_(present), finger_(finger), stability_(stability) {
-  stability_.near_m = 1e9;  // the markers may be anywhere in the workspace
-}
+MarkerCalibration::MarkerCalibration(const Camera& present, std::string measured_with)
+    : present_(present), measured_with_(std::move(measured_with)) {}
 
-void MarkerCalibration::begin_touch() {
-  pending_.reset();
-  check_ = std::make_unique<StabilityCheck>(finger_, Vec3::Zero(), stability_);
-}
-
-void MarkerCalibration::update(double t_s, std::span<const std::int64_t> finger_counts) {
-  if (!check_) return;
-  check_->update(t_s, finger_counts);
-  if (!check_->ready()) return;
-  const auto p_W = fingertip_from_counts(finger_, check_->sample());
-  if (p_W) {
-    CapturedMarker m;
-    m.name = "m" + std::to_string(markers_.size() + 1);
-    m.p_W = *p_W;
-    m.held_spread_m = check_->spread_m();
-    pending_ = m;
-  }
-  check_.reset();  // a failed position (inconsistent strings) needs a new touch
+Status MarkerCalibration::touched(const Vec3& p_W, double held_spread_m) {
+  if (!p_W.allFinite()) return Error{"camera calibration: the measured marker position is not finite"};
+  CapturedMarker m;
+  m.name = "m" + std::to_string(markers_.size() + 1);
+  m.p_W = p_W;
+  m.held_spread_m = held_spread_m;
+  pending_ = m;
+  return Ok{};
 }
 
 Status MarkerCalibration::set_pixel(const Vec2& uv) {
@@ -67,16 +55,16 @@ void MarkerCalibration::remove_last() {
   else if (!markers_.empty()) markers_.pop_back();
 }
 
-Result<vision::MarkerSet> MarkerCalibration::marker_set() const {
+Result<MarkerSet> MarkerCalibration::marker_set() const {
   if (markers_.size() < 3)
     return Error{"camera calibration: " + std::to_string(markers_.size()) +
                  " markers, expected 3 (the paper's three-marker method) or at least 4 (PnP)"};
-  vision::MarkerSet set;
+  MarkerSet set;
   set.by_pixel = markers_.size() >= 4;
   set.source = "the live session's camera calibration";
   for (const CapturedMarker& c : markers_) {
     if (!c.uv) return Error{"camera calibration: " + c.name + " has no pixel (click it in the view)"};
-    vision::Marker m;
+    Marker m;
     m.name = c.name;
     m.p_W = c.p_W;
     if (set.by_pixel) {
@@ -93,9 +81,9 @@ Result<vision::MarkerSet> MarkerCalibration::marker_set() const {
 Result<MarkerCalibration::Solution> MarkerCalibration::solve() const {
   auto set = marker_set();
   if (!set) return set.error();
-  auto r = vision::calibrate_extrinsics(present_.intrinsics(), *set);
+  auto r = calibrate_extrinsics(present_.intrinsics(), *set);
   if (!r) return Error{"camera calibration: " + r.error().message};
-  Solution s{vision::Camera(present_.intrinsics(), r->X_CW), *r, 0, 0};
+  Solution s{Camera(present_.intrinsics(), r->X_CW), *r, 0, 0};
   s.moved_m = (s.camera.X_WC().p - present_.X_WC().p).norm();
   s.turned_deg = present_.X_CW().R.angularDistance(r->X_CW.R) * 180.0 / units::kPi;
   return s;
@@ -105,8 +93,8 @@ std::string MarkerCalibration::markers_yaml() const {
   std::ostringstream o;
   o.precision(6);
   o << std::fixed;
-  o << "# Markers touched with the " << finger_.name
-    << " fingertip cap in the live session (world from the strings,\n"
+  o << "# Markers measured with the " << measured_with_
+    << " in the live session (world from the strings,\n"
        "# pixel clicked in the camera view"
     << (markers_.size() == 3 ? ", camera = ray through the pixel at the measured range" : "")
     << "). For: spidar-mr calibrate-camera --markers FILE\nmarkers:\n";
@@ -124,4 +112,4 @@ std::string MarkerCalibration::markers_yaml() const {
   return o.str();
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::vision
