@@ -18,10 +18,12 @@ std::string keep_previous_version(const std::string& path) {
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
   std::string backup = path + ".bak-" + stamp;
-  for (int k = 2; fs::exists(backup); ++k) backup = path + ".bak-" + stamp + "-" + std::to_string(k);
+  for (int k = 2; fs::exists(backup); ++k)
+    backup = path + ".bak-" + stamp + "-" + std::to_string(k);
   std::error_code ec;
   fs::copy_file(path, backup, ec);
-  if (ec) throw FileError(path, "cannot keep the previous version as " + backup + ": " + ec.message());
+  if (ec)
+    throw FileError(path, "cannot keep the previous version as " + backup + ": " + ec.message());
   return backup;
 }
 

@@ -16,7 +16,9 @@ void CalibrationUser::activate(int finger, const Vec3& p_W_target, double t_s) {
   std::vector<Vec3> now(rest_.size());
   goals(t_s, now);
   finger_ = finger;
-  from_ = finger >= 0 && finger < static_cast<int>(now.size()) ? now[static_cast<std::size_t>(finger)] : Vec3::Zero();
+  from_ = finger >= 0 && finger < static_cast<int>(now.size())
+              ? now[static_cast<std::size_t>(finger)]
+              : Vec3::Zero();
   target_ = p_W_target;
   t_active_ = t_s;
 }
@@ -29,7 +31,8 @@ void CalibrationUser::goals(double t_s, std::span<Vec3> p_W_goal) {
   p_W_goal[static_cast<std::size_t>(finger_)] = from_ + s * (target_ - from_);
 }
 
-std::vector<Vec3> calibration_targets(const strings::DeviceConfig& config, const StringCalibrationParams& params) {
+std::vector<Vec3> calibration_targets(const strings::DeviceConfig& config,
+                                      const StringCalibrationParams& params) {
   if (params.jig > 0) return strings::jig_grid(config.p_W_centre, params.jig_spacing_m, params.jig);
   return {config.p_W_centre};
 }
@@ -51,8 +54,8 @@ Result<std::vector<FingerCalibration>> calibrate_strings(
   const int strings_n = config.string_count();
   if (device.info().string_count != strings_n)
     return Error{"calibrate strings: device " + device.info().name + " has " +
-                 std::to_string(device.info().string_count) + " strings but config " + config.source + " has " +
-                 std::to_string(strings_n)};
+                 std::to_string(device.info().string_count) + " strings but config " +
+                 config.source + " has " + std::to_string(strings_n)};
   for (int f : params.fingers)
     if (f < 0 || f >= static_cast<int>(config.fingers.size()))
       return Error{"calibrate strings: no finger " + std::to_string(f) + " in " + config.source};
@@ -60,7 +63,8 @@ Result<std::vector<FingerCalibration>> calibrate_strings(
     if (progress) progress(line);
   };
   const std::vector<Vec3> targets = calibration_targets(config, params);
-  const std::vector<std::int32_t> commands(static_cast<std::size_t>(strings_n), config.command_range().min);
+  const std::vector<std::int32_t> commands(static_cast<std::size_t>(strings_n),
+                                           config.command_range().min);
   // One unwrapping for the whole run, as the servo cycle does: every sample of every finger is
   // in the same continuous counts.
   UnwrappedCounts counts(strings_n, device.info().counter_bits);
@@ -92,16 +96,18 @@ Result<std::vector<FingerCalibration>> calibrate_strings(
         if (t >= next_note) {
           next_note += 0.25;
           const char* state = check.distance_m() > params.stability.near_m ? "not at the target yet"
-                              : check.held_s() > 0                        ? "holding"
+                              : check.held_s() > 0                         ? "holding"
                                                                            : "moving";
           say(std::string("  ") + state +
-              fmt(": %.0f mm away by the present calibration, held %.0f/%.0f ms", check.distance_m() * 1e3,
-                  check.held_s() * 1e3, params.stability.hold_s * 1e3));
+              fmt(": %.0f mm away by the present calibration, held %.0f/%.0f ms",
+                  check.distance_m() * 1e3, check.held_s() * 1e3, params.stability.hold_s * 1e3));
         }
         if (t - t_step > params.timeout_s)
-          return Error{fc.name + fmt(": the fingertip did not hold still near the target within %.0f s (last: %.1f mm "
-                                     "away, strings moving %.2f mm)",
-                                     params.timeout_s, check.distance_m() * 1e3, check.spread_m() * 1e3)};
+          return Error{
+              fc.name +
+              fmt(": the fingertip did not hold still near the target within %.0f s (last: %.1f mm "
+                  "away, strings moving %.2f mm)",
+                  params.timeout_s, check.distance_m() * 1e3, check.spread_m() * 1e3)};
       }
       samples.push_back({target, check.sample()});
       say(fmt("  sampled after holding %g s", params.stability.hold_s, 0, 0));
@@ -120,7 +126,8 @@ Result<std::vector<FingerCalibration>> calibrate_strings(
       auto ch = strings::pole_calibrate(fc.geometry, fc.channels, pole.counts, pole.p_WF);
       if (!ch) return Error{fc.name + ": " + ch.error().message};
       r.channels = *ch;
-      const auto error_m = [&](std::span<const strings::EncoderChannel> c) -> std::optional<double> {
+      const auto error_m =
+          [&](std::span<const strings::EncoderChannel> c) -> std::optional<double> {
         const auto p_W = strings::fingertip_from_counts(fc, c, pole.counts);
         if (!p_W) return std::nullopt;
         return (*p_W - pole.p_WF).norm();

@@ -64,7 +64,8 @@ std::string with_finger_channels(const std::string& yaml, const std::string& sou
     }
   }
   if (start == lines.size())
-    throw SpidarError(source + ": no finger '" + finger + "' (a line '- name: " + finger + "') to write to");
+    throw SpidarError(source + ": no finger '" + finger + "' (a line '- name: " + finger +
+                      "') to write to");
   auto block_end = [&] {
     std::size_t j = start + 1;
     for (; j < lines.size(); ++j) {
@@ -80,10 +81,13 @@ std::string with_finger_channels(const std::string& yaml, const std::string& sou
   for (const std::string& key : keys) {
     const std::size_t end = block_end();
     for (std::size_t j = start + 1; j < end; ++j) {
-      if (indent_of(lines[j]) != key_indent || lines[j].compare(key_indent, key.size() + 1, key + ":") != 0) continue;
+      if (indent_of(lines[j]) != key_indent ||
+          lines[j].compare(key_indent, key.size() + 1, key + ":") != 0)
+        continue;
       std::size_t k = j + 1;  // a block list continues on deeper-indented lines
       while (k < end && (indent_of(lines[k]) > key_indent || indent_of(lines[k]) < 0)) ++k;
-      lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(j), lines.begin() + static_cast<std::ptrdiff_t>(k));
+      lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(j),
+                  lines.begin() + static_cast<std::ptrdiff_t>(k));
       break;
     }
   }
@@ -99,7 +103,8 @@ std::string with_finger_channels(const std::string& yaml, const std::string& sou
     insert.push_back(list_line(key_indent, "metres_per_count", mpc, "m/count"));
   }
   insert.push_back(list_line(key_indent, "length_at_zero", l0, "m; " + note));
-  lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(start + 1), insert.begin(), insert.end());
+  lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(start + 1), insert.begin(),
+               insert.end());
   std::string out;
   for (const auto& l : lines) out += l + "\n";
   return out;

@@ -7,7 +7,8 @@
 
 namespace spidar::strings {
 
-StabilityCheck::StabilityCheck(const FingerConfig& finger, const Vec3& p_W_target, StabilityParams params)
+StabilityCheck::StabilityCheck(const FingerConfig& finger, const Vec3& p_W_target,
+                               StabilityParams params)
     : finger_(finger), target_(p_W_target), p_(params) {}
 
 void StabilityCheck::update(double t_s, std::span<const std::int64_t> counts) {
@@ -22,7 +23,8 @@ void StabilityCheck::update(double t_s, std::span<const std::int64_t> counts) {
       lo = std::min(lo, c[i]);
       hi = std::max(hi, c[i]);
     }
-    spread_m_ = std::max(spread_m_, static_cast<double>(hi - lo) * finger_.channels[i].metres_per_count);
+    spread_m_ =
+        std::max(spread_m_, static_cast<double>(hi - lo) * finger_.channels[i].metres_per_count);
   }
   // Where the present calibration puts the fingertip.
   const auto p_W = fingertip_from_counts(finger_, counts);

@@ -13,7 +13,8 @@ MarkerCalibration::MarkerCalibration(const Camera& present, std::string measured
     : present_(present), measured_with_(std::move(measured_with)) {}
 
 Status MarkerCalibration::touched(const Vec3& p_W, double held_spread_m) {
-  if (!p_W.allFinite()) return Error{"camera calibration: the measured marker position is not finite"};
+  if (!p_W.allFinite())
+    return Error{"camera calibration: the measured marker position is not finite"};
   CapturedMarker m;
   m.name = "m" + std::to_string(markers_.size() + 1);
   m.p_W = p_W;
@@ -27,8 +28,9 @@ Status MarkerCalibration::set_pixel(const Vec2& uv) {
   const auto& in = present_.intrinsics();
   if (!uv.allFinite() || uv.x() < 0 || uv.y() < 0 || uv.x() >= in.width || uv.y() >= in.height) {
     char b[160];
-    std::snprintf(b, sizeof b, "camera calibration: pixel (%.1f, %.1f) of %s is outside the %dx%d image",
-                  uv.x(), uv.y(), pending_->name.c_str(), in.width, in.height);
+    std::snprintf(b, sizeof b,
+                  "camera calibration: pixel (%.1f, %.1f) of %s is outside the %dx%d image", uv.x(),
+                  uv.y(), pending_->name.c_str(), in.width, in.height);
     return Error{b};
   }
   CapturedMarker m = *pending_;
@@ -44,15 +46,17 @@ Status MarkerCalibration::set_range(std::size_t i, double range_m) {
     return Error{"camera calibration: marker " + std::to_string(i + 1) + " does not exist (have " +
                  std::to_string(markers_.size()) + ")"};
   if (!std::isfinite(range_m) || range_m <= 0.05)
-    return Error{"camera calibration: range of " + markers_[i].name + " must be a distance > 0.05 m, got " +
-                 std::to_string(range_m)};
+    return Error{"camera calibration: range of " + markers_[i].name +
+                 " must be a distance > 0.05 m, got " + std::to_string(range_m)};
   markers_[i].range_m = range_m;
   return Ok{};
 }
 
 void MarkerCalibration::remove_last() {
-  if (pending_) pending_.reset();
-  else if (!markers_.empty()) markers_.pop_back();
+  if (pending_)
+    pending_.reset();
+  else if (!markers_.empty())
+    markers_.pop_back();
 }
 
 Result<MarkerSet> MarkerCalibration::marker_set() const {
@@ -63,7 +67,8 @@ Result<MarkerSet> MarkerCalibration::marker_set() const {
   set.by_pixel = markers_.size() >= 4;
   set.source = "the live session's camera calibration";
   for (const CapturedMarker& c : markers_) {
-    if (!c.uv) return Error{"camera calibration: " + c.name + " has no pixel (click it in the view)"};
+    if (!c.uv)
+      return Error{"camera calibration: " + c.name + " has no pixel (click it in the view)"};
     Marker m;
     m.name = c.name;
     m.p_W = c.p_W;
@@ -101,7 +106,8 @@ std::string MarkerCalibration::markers_yaml() const {
   auto set = marker_set();
   for (std::size_t i = 0; i < markers_.size(); ++i) {
     const CapturedMarker& m = markers_[i];
-    o << "  - name: " << m.name << "\n    world: [" << m.p_W.x() << ", " << m.p_W.y() << ", " << m.p_W.z() << "]\n";
+    o << "  - name: " << m.name << "\n    world: [" << m.p_W.x() << ", " << m.p_W.y() << ", "
+      << m.p_W.z() << "]\n";
     if (set && set->by_pixel) {
       o << "    pixel: [" << m.uv->x() << ", " << m.uv->y() << "]\n";
     } else if (set) {

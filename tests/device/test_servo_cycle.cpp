@@ -51,7 +51,8 @@ EncoderReading ideal_reading(const std::vector<Vec3>& p_W, const Shift& shift = 
   r.string_count = cfg.string_count();
   const Shift c = ideal_counts(p_W);
   for (int k = 0; k < r.string_count; ++k)
-    r.counts[k] = static_cast<std::int32_t>(strings::wrap_counter(c[k] + shift[k], cfg.counter_bits));
+    r.counts[k] =
+        static_cast<std::int32_t>(strings::wrap_counter(c[k] + shift[k], cfg.counter_bits));
   return r;
 }
 
@@ -70,7 +71,8 @@ TEST(ServoCycle, SampleCarriesTheTensionsAndCommandsOfAnIndependentSolve) {
   ASSERT_EQ(s.string_count, 24);
   ForceFrame force;
   // Forces of several sizes and directions, one beyond the strings' reach (clipped to the cone).
-  const Vec3 dirs[] = {{0.5, -0.5, 1.0}, {-2, 0, 0}, {0, 3, -1}, {0, 0, -50}, {1, 1, 1}, {0, 0, 0}, {-1, -1, 4}, {2, -3, 0.5}};
+  const Vec3 dirs[] = {{0.5, -0.5, 1.0}, {-2, 0, 0}, {0, 3, -1},  {0, 0, -50},
+                       {1, 1, 1},        {0, 0, 0},  {-1, -1, 4}, {2, -3, 0.5}};
   for (int f = 0; f < 8; ++f) force.set_force(f, dirs[f]);
   std::vector<std::int32_t> commands(24, -1);
   cycle.command(force, false, s, commands);
@@ -87,7 +89,8 @@ TEST(ServoCycle, SampleCarriesTheTensionsAndCommandsOfAnIndependentSolve) {
       EXPECT_NEAR(s.tension[k], ref.t[i], 1e-6) << "finger " << f << " string " << i;
       EXPECT_EQ(s.command[k], commands[k]) << k;
       EXPECT_EQ(commands[k], std::clamp(strings::tension_to_command(cfg.motor, ref.t[i]).dac,
-                                        spidar8_info().command_min, spidar8_info().command_max)) << k;
+                                        spidar8_info().command_min, spidar8_info().command_max))
+          << k;
       shown += s.tension[k] * U.col(i);
     }
     EXPECT_NEAR((fingertip_force(s, f) - shown).norm(), 0.0, 1e-9) << f;
@@ -130,16 +133,21 @@ TEST(ServoCycle, CountsAreUnwrappedAcrossTheCountersWrap) {
     const auto& fc = cfg.fingers[f];
     for (int i = 0; i < fc.geometry.n; ++i) {
       const int k = cfg.first_string(static_cast<int>(f)) + i;
-      const double dl_true = (fc.geometry.p_WA[i] - truth1[f]).norm() - (fc.geometry.p_WA[i] - truth0[f]).norm();
-      EXPECT_NEAR(cycle.lengths()[static_cast<std::size_t>(k)] - lengths0[static_cast<std::size_t>(k)], dl_true,
-                  2 * fc.channels[i].metres_per_count) << k;
+      const double dl_true =
+          (fc.geometry.p_WA[i] - truth1[f]).norm() - (fc.geometry.p_WA[i] - truth0[f]).norm();
+      EXPECT_NEAR(
+          cycle.lengths()[static_cast<std::size_t>(k)] - lengths0[static_cast<std::size_t>(k)],
+          dl_true, 2 * fc.channels[i].metres_per_count)
+          << k;
     }
   }
   // The same counts, unwrapped by the class calibration uses, are the cycle's.
   UnwrappedCounts u(24, cfg.counter_bits);
   u.update(ideal_reading(rest(), shift));
   u.update(r1);
-  for (int k = 0; k < 24; ++k) EXPECT_EQ(u.counts()[static_cast<std::size_t>(k)], cycle.counts()[static_cast<std::size_t>(k)]) << k;
+  for (int k = 0; k < 24; ++k)
+    EXPECT_EQ(u.counts()[static_cast<std::size_t>(k)], cycle.counts()[static_cast<std::size_t>(k)])
+        << k;
 }
 
 }  // namespace

@@ -42,8 +42,9 @@ struct SimRun {
     EXPECT_TRUE(sim.open().ok());
     std::uint64_t cycle = 0;
     CalibrationClock clock{[&] { return static_cast<double>(cycle) * 1e-3; }, [&] { ++cycle; }};
-    auto r = calibrate_strings(sim, believed, p, clock, [&](const std::string& l) { lines.push_back(l); },
-                               [&](int f, const Vec3& target, double t) { user->activate(f, target, t); });
+    auto r = calibrate_strings(
+        sim, believed, p, clock, [&](const std::string& l) { lines.push_back(l); },
+        [&](int f, const Vec3& target, double t) { user->activate(f, target, t); });
     sim.close();
     return r;
   }
@@ -53,7 +54,8 @@ struct SimRun {
     const auto& fc = truth.fingers[static_cast<std::size_t>(f)];
     std::vector<strings::EncoderChannel> true_channels = fc.channels;
     for (int i = 0; i < fc.geometry.n; ++i)
-      true_channels[static_cast<std::size_t>(i)].length_at_zero = (fc.geometry.p_WA[i] - truth.p_W_centre).norm();
+      true_channels[static_cast<std::size_t>(i)].length_at_zero =
+          (fc.geometry.p_WA[i] - truth.p_W_centre).norm();
     const auto e = strings::position_error_rms(fc.geometry, true_channels, ch,
                                                strings::jig_grid(truth.p_W_centre, 0.05, 3));
     EXPECT_TRUE(e.ok());
@@ -94,7 +96,8 @@ TEST(StringCalibration, JigOverWrappingCountersFitsScaleAndOffset) {
   SimRun r{spidar8(), spidar8(), {}, {}};
   r.truth.counter_bits = r.believed.counter_bits = 10;
   r.params.impedance.stiffness = 20000;  // clamped in the jig
-  r.params.impedance.damping = 2 * std::sqrt(r.params.impedance.stiffness * r.params.impedance.mass);
+  r.params.impedance.damping =
+      2 * std::sqrt(r.params.impedance.stiffness * r.params.impedance.mass);
   StringCalibrationParams p;
   p.fingers = {4};
   p.jig = 2;
@@ -107,7 +110,9 @@ TEST(StringCalibration, JigOverWrappingCountersFitsScaleAndOffset) {
   ASSERT_EQ(fr.channels.size(), 3u);
   for (int i = 0; i < 3; ++i) {
     EXPECT_LT(fr.residual_rms_m[static_cast<std::size_t>(i)], 1e-4) << i;
-    EXPECT_NEAR(fr.channels[static_cast<std::size_t>(i)].metres_per_count, 2.924e-5, 0.005 * 2.924e-5) << i;
+    EXPECT_NEAR(fr.channels[static_cast<std::size_t>(i)].metres_per_count, 2.924e-5,
+                0.005 * 2.924e-5)
+        << i;
   }
   EXPECT_TRUE(any_line_has(r.lines, "jig point 8/8"));
 }
@@ -121,7 +126,8 @@ TEST(StringCalibration, AFingertipThatNeverHoldsStillTimesOutNamingTheFinger) {
   const auto result = r.run(p);
   ASSERT_FALSE(result.ok());
   EXPECT_TRUE(testing::contains(result.error().message, "left_middle")) << result.error().message;
-  EXPECT_TRUE(testing::contains(result.error().message, "did not hold still")) << result.error().message;
+  EXPECT_TRUE(testing::contains(result.error().message, "did not hold still"))
+      << result.error().message;
   p.fingers = {12};
   const auto bad = r.run(p);
   ASSERT_FALSE(bad.ok());

@@ -29,7 +29,8 @@ std::string slurp(const fs::path& p) {
 /// calibration channels, rounded to whole counts).
 std::vector<std::int64_t> counts_at(const FingerConfig& f, const Vec3& p) {
   std::vector<std::int64_t> c;
-  for (int i = 0; i < f.geometry.n; ++i) c.push_back(length_to_counts(f.channels[i], (f.geometry.p_WA[i] - p).norm()));
+  for (int i = 0; i < f.geometry.n; ++i)
+    c.push_back(length_to_counts(f.channels[i], (f.geometry.p_WA[i] - p).norm()));
   return c;
 }
 
@@ -52,7 +53,8 @@ TEST(StabilityCheck, SamplesOnlyAfterHoldingStillNearTheTarget) {
 
   // Moving 2 mm back and forth every 0.2 s: never still long enough.
   StabilityCheck moving(f, Vec3::Zero(), p);
-  for (t = 0; t < 3; t += 0.001) moving.update(t, counts_at(f, Vec3(0.002 * (static_cast<int>(t / 0.2) % 2), 0, 0)));
+  for (t = 0; t < 3; t += 0.001)
+    moving.update(t, counts_at(f, Vec3(0.002 * (static_cast<int>(t / 0.2) % 2), 0, 0)));
   EXPECT_FALSE(moving.ready());
   // Still, but 5 cm from the pole: not the pole.
   StabilityCheck far(f, Vec3::Zero(), p);
@@ -64,8 +66,10 @@ TEST(StabilityCheck, SamplesOnlyAfterHoldingStillNearTheTarget) {
 TEST(ConfigWriteBack, ReplacesTheFingersChannelsAndKeepsTheRest) {
   const std::string text = slurp(source_path("configs/spidar8.yaml"));
   std::vector<EncoderChannel> ch = {{1, 3e-5, 0.41}, {-1, 2.9e-5, 0.42}, {1, 2.95e-5, 0.43}};
-  std::string out = with_finger_channels(text, "spidar8.yaml", "left_ring", ch, false, "pole calibration");
-  out = with_finger_channels(out, "spidar8.yaml", "left_ring", ch, true, "jig");  // replaces, no duplicates
+  std::string out =
+      with_finger_channels(text, "spidar8.yaml", "left_ring", ch, false, "pole calibration");
+  out = with_finger_channels(out, "spidar8.yaml", "left_ring", ch, true,
+                             "jig");  // replaces, no duplicates
   const auto cfg = parse_device_config(core::ConfigNode::Parse(out, "out.yaml"));
   const auto& orig = spidar8();
   for (std::size_t f = 0; f < cfg.fingers.size(); ++f) {
@@ -79,7 +83,8 @@ TEST(ConfigWriteBack, ReplacesTheFingersChannelsAndKeepsTheRest) {
   }
   EXPECT_NE(out.find("# SPIDAR-8: eight fingertips"), std::string::npos);  // comments kept
   EXPECT_EQ(out.find("length_at_zero"), out.rfind("length_at_zero"));      // one block, once
-  EXPECT_THROW(with_finger_channels(text, "spidar8.yaml", "left_pinky", ch, false, ""), SpidarError);
+  EXPECT_THROW(with_finger_channels(text, "spidar8.yaml", "left_pinky", ch, false, ""),
+               SpidarError);
 }
 
 TEST(ConfigWriteBack, KeepsThePreviousVersionAndRefusesABrokenConfig) {
@@ -90,7 +95,8 @@ TEST(ConfigWriteBack, KeepsThePreviousVersionAndRefusesABrokenConfig) {
   fs::copy_file(source_path("configs/spidar8.yaml"), p);
   const std::string before = slurp(p);
   std::vector<EncoderChannel> ch = {{1, 2.924e-5, 0.40}, {1, 2.924e-5, 0.41}, {1, 2.924e-5, 0.42}};
-  const std::string backup = write_device_config(p.string(), with_finger_channels(before, "x", "right_thumb", ch, false, "n"));
+  const std::string backup = write_device_config(
+      p.string(), with_finger_channels(before, "x", "right_thumb", ch, false, "n"));
   EXPECT_EQ(slurp(backup), before);
   EXPECT_EQ(load_device_config(p.string()).fingers[4].channels[2].length_at_zero, 0.42);
   const std::string now = slurp(p);

@@ -2,12 +2,11 @@
 // positions (a few tenths of a millimetre off, as the strings give them), pixels clicked, the
 // paper's three-marker method and PnP; checked against the camera that made the pixels.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-
-#include <unistd.h>
 
 #include "spidar/core/units.hpp"
 #include "spidar/vision/camera_config.hpp"
@@ -30,7 +29,8 @@ struct Rig {
   /// pixel of the cap is clicked (`click_px` off the true projection) and its range measured
   /// `range_error_m` long.
   void touch(MarkerCalibration& cal, const Vec3& p, const Vec2& click_px = Vec2::Zero(),
-             double range_error_m = 0.0, const Vec3& measure_error = Vec3(1e-4, -1e-4, 5e-5)) const {
+             double range_error_m = 0.0,
+             const Vec3& measure_error = Vec3(1e-4, -1e-4, 5e-5)) const {
     ASSERT_TRUE(cal.touched(p + measure_error, 2e-5).ok());
     ASSERT_NE(cal.pending(), nullptr);
     EXPECT_EQ(cal.pending()->name, "m" + std::to_string(cal.markers().size() + 1));
@@ -41,7 +41,9 @@ struct Rig {
   }
 };
 
-double angle_deg(const Pose& a, const Pose& b) { return a.R.angularDistance(b.R) * 180.0 / units::kPi; }
+double angle_deg(const Pose& a, const Pose& b) {
+  return a.R.angularDistance(b.R) * 180.0 / units::kPi;
+}
 double centre_mm(const Camera& a, const Camera& b) {
   return (a.X_WC().p - b.X_WC().p).norm() * 1e3;
 }
@@ -106,7 +108,8 @@ TEST(MarkerCalibration, MarkersFileFeedsCalibrateCameraToTheSamePose) {
   rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06), Vec2(0.4, -0.3));
   rig.touch(cal, c + Vec3(0.12, 0.07, -0.05), Vec2(-0.5, 0.2));
   rig.touch(cal, c + Vec3(0.0, -0.08, 0.10), Vec2(0.3, 0.5));
-  const std::string path = ::testing::TempDir() + "spidar_markers_" + std::to_string(getpid()) + ".yaml";
+  const std::string path =
+      ::testing::TempDir() + "spidar_markers_" + std::to_string(getpid()) + ".yaml";
   std::ofstream(path) << cal.markers_yaml();
   const MarkerSet set = load_markers(path);
   EXPECT_FALSE(set.by_pixel);
@@ -137,11 +140,13 @@ TEST(MarkerCalibration, MissingOrDegenerateInputGivesClearErrors) {
   ASSERT_NE(cal.pending(), nullptr);
   st = cal.set_pixel(Vec2(700, 20));
   ASSERT_FALSE(st.ok());
-  EXPECT_NE(st.error().message.find("outside the 640x480 image"), std::string::npos) << st.error().message;
+  EXPECT_NE(st.error().message.find("outside the 640x480 image"), std::string::npos)
+      << st.error().message;
   // Too few markers.
   auto s = cal.solve();
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.error().message.find("1 markers, expected 3"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("1 markers, expected 3"), std::string::npos)
+      << s.error().message;
   // A bad range names the marker.
   st = cal.set_range(0, -1.0);
   ASSERT_FALSE(st.ok());

@@ -22,11 +22,11 @@
 namespace spidar::device {
 
 struct StringCalibrationParams {
-  std::vector<int> fingers;             ///< config indices, in the order to calibrate
-  int jig = 0;                          ///< 0: pole; N ≥ 2: an N×N×N jig grid
-  double jig_spacing_m = 0.04;          ///< jig point spacing [m]
-  strings::StabilityParams stability;   ///< when a fingertip counts as held still
-  double timeout_s = 30;                ///< give up on a point after this long [s]
+  std::vector<int> fingers;            ///< config indices, in the order to calibrate
+  int jig = 0;                         ///< 0: pole; N ≥ 2: an N×N×N jig grid
+  double jig_spacing_m = 0.04;         ///< jig point spacing [m]
+  strings::StabilityParams stability;  ///< when a fingertip counts as held still
+  double timeout_s = 30;               ///< give up on a point after this long [s]
 };
 
 /// The procedure's clock and pacing: `now_s` gives the time [s] (simulated or real), `pace` is
@@ -69,7 +69,8 @@ struct FingerCalibration {
 };
 
 /// The targets of a calibration: the pole tip (`config.p_W_centre`) or the jig grid around it.
-std::vector<Vec3> calibration_targets(const strings::DeviceConfig& config, const StringCalibrationParams& params);
+std::vector<Vec3> calibration_targets(const strings::DeviceConfig& config,
+                                      const StringCalibrationParams& params);
 
 /// Runs the procedure on an open device (commands at their minimum, strings taut), finger by
 /// finger. `on_target(finger, target, t_s)` is called as each target is announced (to move a

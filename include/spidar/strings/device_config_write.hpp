@@ -13,8 +13,9 @@ namespace spidar::strings {
 /// on the new line notes the calibration (`note`). `source` names the text in messages. Throws
 /// SpidarError if the finger's block (a line `- name: <finger>`) is not found.
 std::string with_finger_channels(const std::string& yaml, const std::string& source,
-                                 const std::string& finger, std::span<const EncoderChannel> channels,
-                                 bool full, const std::string& note);
+                                 const std::string& finger,
+                                 std::span<const EncoderChannel> channels, bool full,
+                                 const std::string& note);
 
 /// Writes `text` to the device config at `path`, keeping the previous file as
 /// `path.bak-YYYYmmdd-HHMMSS` (returned; empty if there was none). The text must parse as a

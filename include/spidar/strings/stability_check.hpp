@@ -27,8 +27,8 @@ class StabilityCheck {
   /// A reading at time t [s] of this finger's strings (config order, unwrapped counts).
   void update(double t_s, std::span<const std::int64_t> counts);
   bool ready() const { return ready_; }
-  double held_s() const { return held_s_; }      ///< how long it has held still so far [s]
-  double spread_m() const { return spread_m_; }  ///< largest string change over the window [m]
+  double held_s() const { return held_s_; }          ///< how long it has held still so far [s]
+  double spread_m() const { return spread_m_; }      ///< largest string change over the window [m]
   double distance_m() const { return distance_m_; }  ///< from the target, present calibration [m]
   const StabilityParams& params() const { return p_; }
   /// The mean counts over the hold window (rounded to counts).

@@ -25,10 +25,10 @@ namespace spidar::vision {
 
 struct CapturedMarker {
   std::string name;
-  Vec3 p_W = Vec3::Zero();      ///< measured world position [m]
-  std::optional<Vec2> uv;       ///< clicked in the camera image [px]
-  double range_m = 0;           ///< camera centre to marker [m] (three-marker method)
-  double held_spread_m = 0;     ///< how still the measuring fingertip was while sampled [m]
+  Vec3 p_W = Vec3::Zero();   ///< measured world position [m]
+  std::optional<Vec2> uv;    ///< clicked in the camera image [px]
+  double range_m = 0;        ///< camera centre to marker [m] (three-marker method)
+  double held_spread_m = 0;  ///< how still the measuring fingertip was while sampled [m]
 };
 
 class MarkerCalibration {
@@ -62,8 +62,8 @@ class MarkerCalibration {
   struct Solution {
     Camera camera;
     ExtrinsicsResult extrinsics;
-    double moved_m = 0;    ///< camera centre moved from the present calibration [m]
-    double turned_deg = 0; ///< camera axes turned from the present calibration [deg]
+    double moved_m = 0;     ///< camera centre moved from the present calibration [m]
+    double turned_deg = 0;  ///< camera axes turned from the present calibration [deg]
   };
   Result<Solution> solve() const;
 
