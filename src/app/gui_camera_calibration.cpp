@@ -25,11 +25,13 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
   std::vector<const char*> names;
   for (const auto& f : cfg.fingers) names.push_back(f.name.c_str());
   if (ImGui::Combo("finger", &finger_, names.data(), static_cast<int>(names.size())) || !cal_) {
-    cal_ = std::make_unique<vision::MarkerCalibration>(s.camera(), cfg.fingers[finger_].name + " fingertip cap");
+    cal_ = std::make_unique<vision::MarkerCalibration>(s.camera(),
+                                                       cfg.fingers[finger_].name + " fingertip cap");
     check_.reset();
     solution_.reset();
   }
-  if (!counts_) counts_ = std::make_unique<device::UnwrappedCounts>(cfg.string_count(), cfg.counter_bits);
+  if (!counts_)
+    counts_ = std::make_unique<device::UnwrappedCounts>(cfg.string_count(), cfg.counter_bits);
   // Every reading the GUI sees is unwrapped, as the servo cycle does, so counts stay continuous.
   const auto rec = s.newest_device_cycle();
   if (rec) counts_->update(rec->reading);
@@ -59,8 +61,8 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
       check_.reset();
     } else {
       ImGui::Text("m%zu: hold the %s cap still on the marker", cal.markers().size() + 1, names[finger_]);
-      ImGui::ProgressBar(static_cast<float>(check_->held_s() / check_->params().hold_s), ImVec2(-1, 0),
-                         "holding still");
+      ImGui::ProgressBar(static_cast<float>(check_->held_s() / check_->params().hold_s),
+                         ImVec2(-1, 0), "holding still");
       ImGui::Text("strings moving %.2f mm", check_->spread_m() * 1e3);
     }
   }

@@ -202,7 +202,8 @@ void device_panel(LiveSession& s) {
       ImGui::TableSetColumnIndex(2);
       for (int i = 0; i < g.n; ++i) {
         // What the servo cycle solved and sent (0 N while the motors are held at their minimum).
-        const double t = first + i < m.string_count ? m.tension[static_cast<std::size_t>(first + i)] : 0.0;
+        const int k = first + i;
+        const double t = k < m.string_count ? m.tension[static_cast<std::size_t>(k)] : 0.0;
         char txt[32];
         std::snprintf(txt, sizeof txt, "%.2f", t);
         ImGui::ProgressBar(static_cast<float>(t / limits.t_max), ImVec2(-1, 0), txt);
@@ -311,8 +312,9 @@ void hands_panel(InteractiveHands& ih, GLFWwindow* window, double dt) {
 }
 
 /// Pole calibration in the window, finger by finger: the fingertip's counts (unwrapped as the
-/// servo cycle does) must hold still for a moment (strings::StabilityCheck), then the offsets are computed and may be written into the device
-/// config (the previous version kept). The running session keeps its calibration until restarted.
+/// servo cycle does) must hold still for a moment (strings::StabilityCheck), then the offsets are
+/// computed and may be written into the device config (the previous version kept). The running
+/// session keeps its calibration until restarted.
 class CalibrationPanel {
  public:
   void draw(LiveSession& s) {
@@ -321,7 +323,8 @@ class CalibrationPanel {
     for (const auto& f : cfg.fingers) names.push_back(f.name.c_str());
     ImGui::Combo("finger", &finger_, names.data(), static_cast<int>(names.size()));
     const strings::FingerConfig& fc = cfg.fingers[finger_];
-    if (!counts_) counts_ = std::make_unique<device::UnwrappedCounts>(cfg.string_count(), cfg.counter_bits);
+    if (!counts_)
+      counts_ = std::make_unique<device::UnwrappedCounts>(cfg.string_count(), cfg.counter_bits);
     const auto rec = s.newest_device_cycle();
     if (rec) counts_->update(rec->reading);
     if (ImGui::Button("Start pole sample")) {
