@@ -3,7 +3,6 @@
 // whose previous version is kept beside it (file.yaml.bak-YYYYmmdd-HHMMSS).
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -14,22 +13,14 @@
 #include "commands.hpp"
 #include "device_backends.hpp"
 #include "spidar/core/clock.hpp"
+#include "spidar/core/config.hpp"
+#include "spidar/core/file_read.hpp"
 #include "spidar/device/simulated_spidar.hpp"
+#include "spidar/device/string_calibration.hpp"
 #include "spidar/strings/calibration.hpp"
-#include "spidar/strings/encoder.hpp"
-#include "spidar/strings/position.hpp"
-#include "string_calibration.hpp"
+#include "spidar/strings/device_config_write.hpp"
 
 namespace spidar::app {
-namespace {
-
-double pole_error_mm(const strings::FingerConfig& f, std::span<const strings::EncoderChannel> ch,
-                     std::span<const std::int64_t> counts, const Vec3& p_W_pole) {
-  const auto p_W = fingertip_from_counts(f, ch, counts);
-  return p_W ? (*p_W - p_W_pole).norm() * 1e3 : NAN;
-}
-
-}  // namespace
 
 Action add_calibrate_strings(CLI::App& app) {
   auto* cmd = app.add_subcommand(
@@ -83,16 +74,13 @@ Action add_calibrate_strings(CLI::App& app) {
       std::string name;
       while (std::getline(ss, name, ',')) fingers.push_back(find_finger(cfg, name));
     }
-    std::vector<Vec3> targets = {cfg.p_W_centre};
-    if (a->jig > 0) targets = strings::jig_grid(cfg.p_W_centre, a->jig_spacing, a->jig);
-
     // The device: the simulated SPIDAR with a simulated user who follows the guidance, stepped
     // 1 ms per reading (simulated time, as fast as it computes), or the hardware in real time.
     const bool sim = a->backend.backend == "sim";
-    std::shared_ptr<CalibrationUser> user;
+    std::shared_ptr<device::CalibrationUser> user;
     std::unique_ptr<device::Device> dev;
     if (sim) {
-      user = std::make_shared<CalibrationUser>(cfg);
+      user = std::make_shared<device::CalibrationUser>(cfg);
       device::SimulatedSpidarParams p;
       p.seed = a->backend.seed;
       p.fixed_step_s = 1e-3;
@@ -109,86 +97,45 @@ Action add_calibrate_strings(CLI::App& app) {
     }
     if (auto st = dev->open(); !st) throw UsageError("device: " + st.error().message);
     dev->clear_safe_state();
-    std::vector<std::int32_t> commands(cfg.string_count(), cfg.command_range().min);  // taut strings
     const std::int64_t t0 = core::monotonic_ns();
     std::uint64_t cycle = 0;
-    auto now_s = [&] { return sim ? static_cast<double>(cycle) * 1e-3 : core::ns_to_s(core::monotonic_ns() - t0); };
-    StabilityParams sp;
-    sp.hold_s = a->hold_s;
-    sp.tolerance_m = a->tolerance_mm * 1e-3;
-    sp.near_m = a->near_mm > 0 ? a->near_mm * 1e-3 : 1e9;
+    device::CalibrationClock clock;
+    clock.now_s = [&] { return sim ? static_cast<double>(cycle) * 1e-3 : core::ns_to_s(core::monotonic_ns() - t0); };
+    clock.pace = [&] {
+      ++cycle;
+      if (!sim) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    };
+    device::StringCalibrationParams cp;
+    cp.fingers = fingers;
+    cp.jig = a->jig;
+    cp.jig_spacing_m = a->jig_spacing;
+    cp.stability.hold_s = a->hold_s;
+    cp.stability.tolerance_m = a->tolerance_mm * 1e-3;
+    cp.stability.near_m = a->near_mm > 0 ? a->near_mm * 1e-3 : 1e9;
+    cp.timeout_s = a->timeout_s;
+    auto on_target = [&](int f, const Vec3& target, double t_s) {
+      if (user) user->activate(f, target, t_s);
+    };
+    const auto result = device::calibrate_strings(
+        *dev, cfg, cp, clock, [](const std::string& line) { std::cerr << line << "\n"; }, on_target);
+    dev->close();
+    if (!result) throw UsageError(result.error().message);
 
     nlohmann::json report;
     report["method"] = a->jig > 0 ? "multi-point jig" : "pole";
     report["config"] = path;
     if (sim) report["simulated_fingertip"] = a->jig > 0 ? "clamped in the jig" : "held at the pole by hand";
-    std::ifstream in(path);
-    std::stringstream text_ss;
-    text_ss << in.rdbuf();
-    std::string text = text_ss.str();
+    std::string text = core::read_file_bounded(path, core::kMaxConfigFileBytes, "a config file");
     const std::string note = std::string(a->jig > 0 ? "multi-point jig" : "pole") + " calibration (" +
                              (sim ? "simulated device" : "device " + a->backend.port) + ")";
-
-    for (int f : fingers) {
-      const strings::FingerConfig& fc = cfg.fingers[f];
-      std::vector<strings::JigSample> samples;
-      std::vector<std::int64_t> pole_counts;
-      for (std::size_t k = 0; k < targets.size(); ++k) {
-        const Vec3& target = targets[k];
-        std::cerr << fc.name << ": " << (a->jig > 0 ? "place the fingertip cap on jig point " + std::to_string(k + 1) + "/" + std::to_string(targets.size())
-                                                     : std::string("touch the pole tip with the fingertip cap"))
-                  << " and hold still\n";
-        const double t_step = now_s();
-        if (user) user->activate(f, target, t_step);
-        StabilityCheck check(fc, target, sp);
-        double next_note = t_step + 0.25;
-        device::EncoderReading reading;
-        while (!check.ready()) {
-          if (auto st = dev->read(reading); !st) {
-            dev->close();
-            throw UsageError("device: " + st.error().message);
-          }
-          (void)dev->write(commands);
-          ++cycle;
-          const double t = now_s();
-          check.update(t, finger_counts(cfg, f, reading));
-          if (t >= next_note) {
-            next_note += 0.25;
-            std::cerr << "  " << (check.distance_m() > sp.near_m ? "not at the target yet" : check.held_s() > 0 ? "holding" : "moving")
-                      << ": " << std::lround(check.distance_m() * 1e3) << " mm away by the present calibration, held "
-                      << std::lround(check.held_s() * 1e3) << "/" << std::lround(sp.hold_s * 1e3) << " ms\n";
-          }
-          if (t - t_step > a->timeout_s) {
-            dev->close();
-            throw UsageError(fc.name + ": the fingertip did not hold still near the target within " +
-                             std::to_string(static_cast<int>(a->timeout_s)) + " s (last: " +
-                             std::to_string(check.distance_m() * 1e3) + " mm away, strings moving " +
-                             std::to_string(check.spread_m() * 1e3) + " mm)");
-          }
-          if (!sim) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        }
-        const auto s = check.sample();
-        std::cerr << "  sampled after holding " << sp.hold_s << " s\n";
-        if (a->jig > 0) samples.push_back({target, s});
-        else pole_counts = s;
-      }
+    for (const device::FingerCalibration& fr : *result) {
+      const strings::FingerConfig& fc = cfg.fingers[static_cast<std::size_t>(fr.finger)];
+      const auto& channels = fr.channels;
       nlohmann::json jf;
       jf["finger"] = fc.name;
-      std::vector<strings::EncoderChannel> channels;
-      if (a->jig > 0) {
-        auto fit = strings::fit_multipoint(fc.geometry, samples);
-        if (!fit) throw UsageError(fc.name + ": " + fit.error().message);
-        for (const auto& sf : *fit) {
-          channels.push_back(sf.channel);
-          jf["residual_rms_mm"].push_back(sf.residual_rms * 1e3);
-        }
-      } else {
-        auto ch = strings::pole_calibrate(fc.geometry, fc.channels, pole_counts, cfg.p_W_centre);
-        if (!ch) throw UsageError(fc.name + ": " + ch.error().message);
-        channels = *ch;
-        jf["pole_error_before_mm"] = pole_error_mm(fc, fc.channels, pole_counts, cfg.p_W_centre);
-        jf["pole_error_after_mm"] = pole_error_mm(fc, channels, pole_counts, cfg.p_W_centre);
-      }
+      for (double r : fr.residual_rms_m) jf["residual_rms_mm"].push_back(r * 1e3);
+      if (fr.pole_error_before_m) jf["pole_error_before_mm"] = *fr.pole_error_before_m * 1e3;
+      if (fr.pole_error_after_m) jf["pole_error_after_mm"] = *fr.pole_error_after_m * 1e3;
       for (std::size_t i = 0; i < channels.size(); ++i) {
         jf["length_at_zero_before"].push_back(fc.channels[i].length_at_zero);
         jf["length_at_zero"].push_back(channels[i].length_at_zero);
@@ -204,14 +151,13 @@ Action add_calibrate_strings(CLI::App& app) {
         if (auto e = strings::position_error_rms(fc.geometry, truth, fc.channels, test)) jf["sim_position_error_before_mm"] = *e * 1e3;
         if (auto e = strings::position_error_rms(fc.geometry, truth, channels, test)) jf["sim_position_error_after_mm"] = *e * 1e3;
       }
-      text = with_finger_channels(text, path, fc.name, channels, a->jig > 0, note);
+      text = strings::with_finger_channels(text, path, fc.name, channels, a->jig > 0, note);
       report["fingers"].push_back(jf);
     }
-    dev->close();
     if (a->dry_run) {
       report["written"] = false;
     } else {
-      report["backup"] = write_config_with_backup(path, text);
+      report["backup"] = strings::write_device_config(path, text);
       report["written"] = true;
       std::cerr << "wrote " << path << " (previous version: " << report["backup"].get<std::string>() << ")\n";
     }

@@ -64,9 +64,18 @@ Action add_device_test(CLI::App& app) {
     device::FingertipSample last;
     if (loop.newest_samples(&last, 1) == 1) {
       for (int f = 0; f < last.finger_count; ++f) {
+        // What the last cycle computed and sent, read from its sample (not solved again).
+        nlohmann::json tensions = nlohmann::json::array(), commands = nlohmann::json::array();
+        for (int i = 0, k = cfg.first_string(f); i < cfg.fingers[f].geometry.n && k < last.string_count; ++i, ++k) {
+          tensions.push_back(last.tension[static_cast<std::size_t>(k)]);
+          commands.push_back(last.command[static_cast<std::size_t>(k)]);
+        }
         fingers.push_back({{"finger", f},
                            {"name", cfg.fingers[f].name},
-                           {"position", {last.p_W[f][0], last.p_W[f][1], last.p_W[f][2]}},
+                           {"position", to_json(device::fingertip_position(last, f))},
+                           {"force_n", to_json(device::fingertip_force(last, f))},
+                           {"tensions_n", tensions},
+                           {"commands", commands},
                            {"consistent", ((last.consistent >> f) & 1u) != 0}});
       }
     }

@@ -5,8 +5,8 @@
 #include <memory>
 
 #include "cli_support.hpp"
+#include "spidar/core/file_write.hpp"
 #include "commands.hpp"
-#include "string_calibration.hpp"
 #include "spidar/vision/camera_config.hpp"
 #include "spidar/vision/chessboard.hpp"
 #include "spidar/vision/markers.hpp"
@@ -40,7 +40,7 @@ int extrinsics_only(const CalibrateCameraArgs& a, const std::string& base) {
   notes.extrinsics_rms_px = r->rms_px;
   notes.extrinsics_rms_m = r->rms_m;
   const vision::Camera camera(kept.camera.intrinsics(), r->X_CW);
-  const std::string backup = keep_previous_version(a.out);
+  const std::string backup = core::keep_previous_version(a.out);
   if (auto s = vision::save_camera_file(a.out, camera, notes); !s.ok()) throw UsageError("--out " + s.error().message);
   nlohmann::json extr = {{"method", r->method}, {"markers", set.markers.size()}};
   if (r->rms_px) extr["rms_px"] = *r->rms_px;
@@ -116,7 +116,7 @@ Action add_calibrate_camera(CLI::App& app) {
       notes.method = "chessboard";
     }
     const vision::Camera camera(cal.intrinsics, X_CW);
-    const std::string backup = keep_previous_version(a->out);  // the previous calibration stays
+    const std::string backup = core::keep_previous_version(a->out);  // the previous calibration stays
     if (auto s = vision::save_camera_file(a->out, camera, notes); !s.ok()) {
       throw UsageError("--out " + s.error().message);
     }

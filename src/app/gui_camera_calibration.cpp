@@ -5,8 +5,9 @@
 #include <fstream>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/core/file_write.hpp"
+#include "spidar/strings/calibration.hpp"
 #include "spidar/vision/camera_config.hpp"
-#include "string_calibration.hpp"
 
 namespace spidar::app {
 
@@ -24,27 +25,48 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
   std::vector<const char*> names;
   for (const auto& f : cfg.fingers) names.push_back(f.name.c_str());
   if (ImGui::Combo("finger", &finger_, names.data(), static_cast<int>(names.size())) || !cal_) {
-    cal_ = std::make_unique<MarkerCalibration>(s.camera(), cfg.fingers[finger_]);
+    cal_ = std::make_unique<vision::MarkerCalibration>(s.camera(),
+                                                       cfg.fingers[finger_].name + " fingertip cap");
+    check_.reset();
     solution_.reset();
   }
-  MarkerCalibration& cal = *cal_;
-  if (!cal.touching() && !cal.pending()) {
+  if (!counts_)
+    counts_ = std::make_unique<device::UnwrappedCounts>(cfg.string_count(), cfg.counter_bits);
+  // Every reading the GUI sees is unwrapped, as the servo cycle does, so counts stay continuous.
+  const auto rec = s.newest_device_cycle();
+  if (rec) counts_->update(rec->reading);
+  vision::MarkerCalibration& cal = *cal_;
+  const strings::FingerConfig& fc = cfg.fingers[finger_];
+  if (!check_ && !cal.pending()) {
     if (ImGui::Button("Touch next marker")) {
-      cal.begin_touch();
+      strings::StabilityParams p;
+      p.near_m = 1e9;  // the markers may be anywhere in the workspace
+      check_ = std::make_unique<strings::StabilityCheck>(fc, Vec3::Zero(), p);
       message_.clear();
     }
   }
-  if (cal.touching()) {
-    if (const auto rec = s.newest_device_cycle())
-      cal.update(core::ns_to_s(rec->reading.host_time_ns), finger_counts(cfg, finger_, rec->reading));
-    if (const StabilityCheck* c = cal.check()) {
+  if (check_) {
+    if (rec) {
+      check_->update(core::ns_to_s(rec->reading.host_time_ns),
+                     counts_->counts(cfg.first_string(finger_), fc.geometry.n));
+    }
+    if (check_->ready()) {
+      // The marker's world position from the mean counts; a failed position (inconsistent
+      // strings) needs a new touch.
+      if (const auto p_W = strings::fingertip_from_counts(fc, check_->sample())) {
+        if (auto st = cal.touched(*p_W, check_->spread_m()); !st) message_ = st.error().message;
+      } else {
+        message_ = "the strings of " + fc.name + " gave no position: touch the marker again";
+      }
+      check_.reset();
+    } else {
       ImGui::Text("m%zu: hold the %s cap still on the marker", cal.markers().size() + 1, names[finger_]);
-      ImGui::ProgressBar(static_cast<float>(c->held_s() / StabilityParams{}.hold_s), ImVec2(-1, 0),
-                         "holding still");
-      ImGui::Text("strings moving %.2f mm", c->spread_m() * 1e3);
+      ImGui::ProgressBar(static_cast<float>(check_->held_s() / check_->params().hold_s),
+                         ImVec2(-1, 0), "holding still");
+      ImGui::Text("strings moving %.2f mm", check_->spread_m() * 1e3);
     }
   }
-  if (const CapturedMarker* p = cal.pending()) {
+  if (const vision::CapturedMarker* p = cal.pending()) {
     ImGui::TextColored(ImVec4(1, 0.9f, 0.2f, 1), "%s at (%.3f, %.3f, %.3f) m: click the cap in the view",
                        p->name.c_str(), p->p_W.x(), p->p_W.y(), p->p_W.z());
   }
@@ -55,7 +77,7 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
     ImGui::TableSetupColumn("range [m]");
     ImGui::TableHeadersRow();
     for (std::size_t i = 0; i < cal.markers().size(); ++i) {
-      const CapturedMarker& m = cal.markers()[i];
+      const vision::CapturedMarker& m = cal.markers()[i];
       ImGui::TableNextRow();
       ImGui::TableSetColumnIndex(0);
       ImGui::TextUnformatted(m.name.c_str());
@@ -112,11 +134,11 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
         notes.method = (notes.intrinsics_rms_px ? "chessboard + " : "") + e.method + " (GUI, fingertip caps)";
         notes.extrinsics_rms_px = e.rms_px;
         notes.extrinsics_rms_m = e.rms_m;
-        const std::string backup = keep_previous_version(path);
+        const std::string backup = core::keep_previous_version(path);
         if (auto st = vision::save_camera_file(path, vision::Camera(file.camera.intrinsics(), e.X_CW), notes); !st)
           throw SpidarError(st.error().message);
         const std::string markers = path + ".markers.yaml";
-        keep_previous_version(markers);
+        core::keep_previous_version(markers);
         std::ofstream(markers) << cal.markers_yaml();
         message_ = "wrote " + path + " (previous: " + (backup.empty() ? "none" : backup) + ") and " + markers +
                    "; restart run to use it";
@@ -134,11 +156,11 @@ void CameraCalibrationPanel::on_view(const LiveSession& s, const ImVec2& image_m
   auto screen = [&](const Vec2& uv) {
     return ImVec2(image_min.x + static_cast<float>(uv.x()) * scale, image_min.y + static_cast<float>(uv.y()) * scale);
   };
-  for (const CapturedMarker& m : cal_->markers()) {
+  for (const vision::CapturedMarker& m : cal_->markers()) {
     dl->AddCircle(screen(*m.uv), 6, IM_COL32(60, 255, 60, 255), 16, 2);
     dl->AddText(ImVec2(screen(*m.uv).x + 8, screen(*m.uv).y - 8), IM_COL32(60, 255, 60, 255), m.name.c_str());
   }
-  if (const CapturedMarker* p = cal_->pending()) {
+  if (const vision::CapturedMarker* p = cal_->pending()) {
     // Where the present calibration sees the sampled fingertip: a hint for the click.
     dl->AddCircle(screen(s.camera().project(p->p_W)), 10, IM_COL32(255, 230, 50, 255), 16, 1.5f);
     if (ImGui::IsItemClicked(ImGuiMouseButton_Left)) {

@@ -1,6 +1,7 @@
 #pragma once
 /// The GUI's camera calibration step (window "Camera calibration"): the extrinsics from markers
-/// touched with a fingertip cap and clicked in the camera view (MarkerCalibration), written back
+/// touched with a fingertip cap (held still: strings::StabilityCheck on the unwrapped counts) and
+/// clicked in the camera view (vision::MarkerCalibration), written back
 /// to the session's camera file (previous version kept) and optionally as a markers file for
 /// `calibrate-camera --markers`.
 #include <imgui.h>
@@ -10,7 +11,9 @@
 #include <string>
 
 #include "live_session.hpp"
-#include "marker_calibration.hpp"
+#include "spidar/device/unwrapped_counts.hpp"
+#include "spidar/strings/stability_check.hpp"
+#include "spidar/vision/marker_calibration.hpp"
 
 namespace spidar::app {
 
@@ -28,8 +31,10 @@ class CameraCalibrationPanel {
 
  private:
   int finger_ = -1;
-  std::unique_ptr<MarkerCalibration> cal_;
-  std::optional<MarkerCalibration::Solution> solution_;
+  std::unique_ptr<vision::MarkerCalibration> cal_;
+  std::unique_ptr<strings::StabilityCheck> check_;  ///< while a marker is being touched
+  std::unique_ptr<device::UnwrappedCounts> counts_;
+  std::optional<vision::MarkerCalibration::Solution> solution_;
   std::string message_;
 };
 

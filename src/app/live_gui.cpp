@@ -22,12 +22,15 @@
 #include "gui_camera_calibration.hpp"
 #include "spidar/core/units.hpp"
 #include "spidar/core/clock.hpp"
+#include "spidar/core/config.hpp"
+#include "spidar/core/file_read.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/render/overlay.hpp"
 #include "spidar/render/video_output.hpp"
+#include "spidar/device/unwrapped_counts.hpp"
 #include "spidar/strings/calibration.hpp"
-#include "spidar/strings/tension.hpp"
-#include "string_calibration.hpp"
+#include "spidar/strings/device_config_write.hpp"
+#include "spidar/strings/stability_check.hpp"
 
 #ifndef GL_BGR
 #define GL_BGR 0x80E0
@@ -128,8 +131,8 @@ cv::Mat view_image(View view, const LiveSession& s) {
       const auto& m = s.measured();
       std::vector<Vec3> p, f;
       for (int i = 0; i < m.finger_count; ++i) {
-        p.emplace_back(m.p_W[i][0], m.p_W[i][1], m.p_W[i][2]);
-        f.emplace_back(m.f_W[i][0], m.f_W[i][1], m.f_W[i][2]);
+        p.push_back(device::fingertip_position(m, i));
+        f.push_back(device::fingertip_force(m, i));
       }
       render::draw_force_arrows(out, s.camera(), p, f);
       return out;
@@ -184,10 +187,9 @@ void device_panel(LiveSession& s) {
     ImGui::TableHeadersRow();
     for (int f = 0; f < m.finger_count && f < static_cast<int>(cfg.fingers.size()); ++f) {
       const auto& g = cfg.fingers[f].geometry;
-      const Vec3 p(m.p_W[f][0], m.p_W[f][1], m.p_W[f][2]);
-      const Vec3 force(m.f_W[f][0], m.f_W[f][1], m.f_W[f][2]);
-      const auto lengths = strings::string_lengths(g, p);
-      const auto tensions = strings::solve_tensions(g, p, force, limits);
+      const Vec3 force = device::fingertip_force(m, f);
+      const auto lengths = strings::string_lengths(g, device::fingertip_position(m, f));
+      const int first = cfg.first_string(f);
       ImGui::TableNextRow();
       ImGui::TableSetColumnIndex(0);
       ImGui::TextUnformatted(cfg.fingers[f].name.c_str());
@@ -199,7 +201,9 @@ void device_panel(LiveSession& s) {
       }
       ImGui::TableSetColumnIndex(2);
       for (int i = 0; i < g.n; ++i) {
-        const double t = tensions ? tensions->t[i] : 0.0;
+        // What the servo cycle solved and sent (0 N while the motors are held at their minimum).
+        const int k = first + i;
+        const double t = k < m.string_count ? m.tension[static_cast<std::size_t>(k)] : 0.0;
         char txt[32];
         std::snprintf(txt, sizeof txt, "%.2f", t);
         ImGui::ProgressBar(static_cast<float>(t / limits.t_max), ImVec2(-1, 0), txt);
@@ -307,9 +311,10 @@ void hands_panel(session::InteractiveHands& ih, GLFWwindow* window, double dt) {
   ih.set(c);
 }
 
-/// Pole calibration in the window, finger by finger: the fingertip's counts must hold still for a
-/// moment (StabilityCheck), then the offsets are computed and may be written into the device
-/// config (the previous version kept). The running session keeps its calibration until restarted.
+/// Pole calibration in the window, finger by finger: the fingertip's counts (unwrapped as the
+/// servo cycle does) must hold still for a moment (strings::StabilityCheck), then the offsets are
+/// computed and may be written into the device config (the previous version kept). The running
+/// session keeps its calibration until restarted.
 class CalibrationPanel {
  public:
   void draw(LiveSession& s) {
@@ -318,18 +323,23 @@ class CalibrationPanel {
     for (const auto& f : cfg.fingers) names.push_back(f.name.c_str());
     ImGui::Combo("finger", &finger_, names.data(), static_cast<int>(names.size()));
     const strings::FingerConfig& fc = cfg.fingers[finger_];
+    if (!counts_)
+      counts_ = std::make_unique<device::UnwrappedCounts>(cfg.string_count(), cfg.counter_bits);
+    const auto rec = s.newest_device_cycle();
+    if (rec) counts_->update(rec->reading);
     if (ImGui::Button("Start pole sample")) {
-      StabilityParams p;
+      strings::StabilityParams p;
       p.hold_s = 1.0;
       p.near_m = 1e9;  // before a first calibration the counters may be zeroed anywhere
-      check_ = std::make_unique<StabilityCheck>(fc, cfg.p_W_centre, p);
+      check_ = std::make_unique<strings::StabilityCheck>(fc, cfg.p_W_centre, p);
       check_finger_ = finger_;
       result_.clear();
       message_.clear();
     }
     if (check_ && !check_->ready()) {
-      if (const auto rec = s.newest_device_cycle()) {
-        check_->update(core::ns_to_s(rec->reading.host_time_ns), finger_counts(cfg, check_finger_, rec->reading));
+      if (rec) {
+        check_->update(core::ns_to_s(rec->reading.host_time_ns),
+                       counts_->counts(cfg.first_string(check_finger_), cfg.fingers[check_finger_].geometry.n));
         if (check_->ready()) {
           sample_ = check_->sample();
           auto ch = strings::pole_calibrate(cfg.fingers[check_finger_].geometry, cfg.fingers[check_finger_].channels,
@@ -350,12 +360,10 @@ class CalibrationPanel {
         ImGui::Text("  string %zu: %.4f -> %.4f", i + 1, old[i].length_at_zero, result_[i].length_at_zero);
       if (ImGui::Button("Write to the device config")) {
         try {
-          std::ifstream in(cfg.source);
-          std::stringstream text;
-          text << in.rdbuf();
-          const std::string out = with_finger_channels(text.str(), cfg.source, cfg.fingers[check_finger_].name,
-                                                       result_, false, "pole calibration (GUI)");
-          const std::string backup = write_config_with_backup(cfg.source, out);
+          const std::string text = core::read_file_bounded(cfg.source, core::kMaxConfigFileBytes, "a config file");
+          const std::string out = strings::with_finger_channels(text, cfg.source, cfg.fingers[check_finger_].name,
+                                                                result_, false, "pole calibration (GUI)");
+          const std::string backup = strings::write_device_config(cfg.source, out);
           message_ = "wrote " + cfg.source + " (previous: " + backup + "); restart run to use it";
         } catch (const std::exception& e) {
           message_ = e.what();
@@ -369,7 +377,8 @@ class CalibrationPanel {
 
  private:
   int finger_ = 0, check_finger_ = 0;
-  std::unique_ptr<StabilityCheck> check_;
+  std::unique_ptr<strings::StabilityCheck> check_;
+  std::unique_ptr<device::UnwrappedCounts> counts_;
   std::vector<std::int64_t> sample_;
   std::vector<strings::EncoderChannel> result_;
   std::string message_;

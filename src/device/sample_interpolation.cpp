@@ -33,6 +33,10 @@ std::optional<FingertipSample> interpolate_samples(std::span<const FingertipSamp
       out.f_W[f][k] = a.f_W[f][k] + w * (b.f_W[f][k] - a.f_W[f][k]);
     }
   }
+  // Tensions interpolate like forces; commands are the ones in effect at t (a's).
+  if (a.string_count == b.string_count) {
+    for (int k = 0; k < out.string_count; ++k) out.tension[k] = a.tension[k] + w * (b.tension[k] - a.tension[k]);
+  }
   return out;
 }
 

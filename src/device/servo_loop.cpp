@@ -302,8 +302,7 @@ void ServoLoop::run() {
               "cycle %llu ended %.3f ms after its deadline (bound stall_limit_s %.3f ms); its "
               "commands were replaced by the minimum",
               cycle_no, static_cast<double>(late) * 1e-6, servo_.stall_limit_s * 1e3);
-        std::fill(commands_.begin(), commands_.end(), device_.info().command_min);
-        for (int f = 0; f < sample_.finger_count; ++f) sample_.f_W[f] = {0.0, 0.0, 0.0};
+        cycle_maths_.command_minimum(sample_, commands_);
       }
     }
     if (auto st = device_.write(commands_); !st.ok()) {

@@ -8,7 +8,7 @@
 namespace spidar::hand {
 namespace {
 
-// FACTS.md: segment lengths in units of 0.0959 m for a 0.19 m hand.
+// A published set of proportions: segment lengths in units of 0.0959 m for a 0.19 m hand.
 constexpr double kUnitPerHandLength = 0.0959 / 0.19;
 
 struct FingerProportions {
@@ -29,7 +29,7 @@ constexpr std::array<FingerProportions, 4> kFingers = {{
 // The metacarpal bases sit closer together than the MCPs (the metacarpals fan out).
 constexpr double kBaseSpreadFraction = 0.7;
 
-// Thumb: metacarpal/proximal/distal (FACTS.md); the rest are our modelling choices: CMC joint
+// Thumb: metacarpal/proximal/distal (the published set); the rest are our modelling choices: CMC joint
 // on the radial, palmar side of the carpus; the metacarpal points 30° from y toward the radial
 // side and is pronated 50° about its own axis so the thumb pad faces the fingers.
 constexpr std::array<double, 3> kThumbLength = {0.390, 0.311, 0.232};

@@ -176,7 +176,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     registration::HandObservation obs;
     for (int f = 0; f < hand::kFingertipCount; ++f) {
       const int d = p.fingers[h][f];
-      const Vec3 x(tips.p_W[d][0], tips.p_W[d][1], tips.p_W[d][2]);
+      const Vec3 x = device::fingertip_position(tips, d);
       obs.p_W_fingertip[f] = x;
       obs.fingertip_valid[f] = d < tips.finger_count && x.allFinite();
     }

@@ -114,7 +114,8 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
   const RegistrationParams& rp = *pr.params;
   const HandObservation& obs = *pr.observation;
 
-  // Fingertips from the strings, 3D.
+  // Fingertips from the strings, 3D (with the projected wrist below: the paper's Q, linearised
+  // Q(θ+Δθ) ≈ Q(θ) + J_Q Δθ, paper eqs 23–38).
   const double w_tip = 1.0 / rp.fingertip_sigma_m;
   for (int i = 0; i < hand::kFingertipCount; ++i) {
     if (!obs.fingertip_valid[i] || !obs.p_W_fingertip[i].allFinite()) continue;
@@ -153,7 +154,8 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
       add_projected(Term::kWrist, p, Vec2::Zero(), *obs.wrist_px, w);
     }
 
-    // Joint-balls (eq. 21): the projected joint toward its frozen target P̃.
+    // Joint-balls (eq. 21): the projected joint toward its frozen target P̃; the P of the paper,
+    // linearised P(θ+Δθ) ≈ P(θ) + J_P Δθ (paper eqs 23–38).
     const double w_ball = 1.0 / rp.joint_ball_sigma_px;
     for (int j = 0; j < hand::kJointCount; ++j) {
       const JointBall& b = tg.balls[j];
@@ -202,7 +204,8 @@ struct CostSink {
   void add_prior(int, double r, double) { costs.prior += r * r; }
 };
 
-/// The normal equations A = Σ JᵀJ, b = −Σ Jᵀr and the costs.
+/// The normal equations A = Σ JᵀJ, b = −Σ Jᵀr and the costs: the paper's A = J_QᵀJ_Q + c J_PᵀJ_P
+/// and b = J_Qᵀ(Q̃ − Q) + c J_Pᵀ(P̃ − P) (paper eqs 23–38), with every term weighted by its σ.
 struct NormalEquationsSink {
   Eigen::Matrix<double, hand::kParamCount, hand::kParamCount> A =
       Eigen::Matrix<double, hand::kParamCount, hand::kParamCount>::Zero();

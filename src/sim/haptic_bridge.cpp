@@ -31,8 +31,8 @@ void HapticForces::forces(const device::FingertipSample& in, device::ForceFrame&
   target.t_ns = in.t_ns;
   target.finger_count = n;
   for (int f = 0; f < n; ++f) {
-    const Vec3 p = vec(in.p_W[f]);
-    if (have_prev_) v_[f] += alpha_ * ((p - vec(prev_.p_W[f])) / dt - v_[f]);
+    const Vec3 p = device::fingertip_position(in, f);
+    if (have_prev_) v_[f] += alpha_ * ((p - device::fingertip_position(prev_, f)) / dt - v_[f]);
     target.p_W[f] = xyz(p);
     target.v_W[f] = xyz(v_[f]);
   }
@@ -59,7 +59,8 @@ void HapticForces::forces(const device::FingertipSample& in, device::ForceFrame&
     }
     const Vec3 p_proxy = physics::local_proxy_position(local, std::min(since, 0.01));
     // The user feels the opposite of the coupling force on the proxy.
-    const Vec3 f_user = -physics::coupling_force(coupling_, vec(in.p_W[f]), v_[f], p_proxy, local.v_W);
+    const Vec3 f_user = -physics::coupling_force(coupling_, device::fingertip_position(in, f), v_[f],
+                                                 p_proxy, local.v_W);
     const Vec3 shown = ports_[f].step(f_user, v_[f], dt);
     stats_.ports[f] = ports_[f].stats();
     out.set_force(f, shown);

@@ -4,7 +4,21 @@
 #include <cmath>
 #include <sstream>
 
+#include "spidar/strings/position.hpp"
+
 namespace spidar::strings {
+
+std::optional<Vec3> fingertip_from_counts(const FingerConfig& finger,
+                                          std::span<const EncoderChannel> channels,
+                                          std::span<const std::int64_t> counts) {
+  const int n = finger.geometry.n;
+  if (static_cast<int>(channels.size()) < n || static_cast<int>(counts.size()) < n) return std::nullopt;
+  std::vector<double> lengths(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) lengths[i] = counts_to_length(channels[i], counts[i]);
+  const auto est = solve_position(finger.geometry, lengths);
+  if (!est) return std::nullopt;
+  return est->p_WF;
+}
 
 Result<std::vector<EncoderChannel>> pole_calibrate(const PointGeometry& g,
                                                    std::span<const EncoderChannel> channels,
@@ -79,13 +93,6 @@ Result<std::vector<StringFit>> fit_multipoint(const PointGeometry& g,
   }
   return fits;
 }
-
-}  // namespace spidar::strings
-
-#include "spidar/strings/device_config.hpp"
-#include "spidar/strings/position.hpp"
-
-namespace spidar::strings {
 
 Result<double> position_error_rms(const PointGeometry& g,
                                   std::span<const EncoderChannel> true_channels,

@@ -62,6 +62,12 @@ int DeviceConfig::string_count() const {
   return n;
 }
 
+int DeviceConfig::first_string(int finger) const {
+  int n = 0;
+  for (int f = 0; f < finger; ++f) n += fingers[static_cast<std::size_t>(f)].geometry.n;
+  return n;
+}
+
 TensionLimits DeviceConfig::effective_limits() const {
   return {std::max(tension.t_min, min_drive_tension(motor)),
           std::min(tension.t_max, max_drive_tension(motor))};

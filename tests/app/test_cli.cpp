@@ -139,6 +139,14 @@ TEST(Cli, DeviceTestOnTheSimulatedDeviceReportsLoopStatistics) {
   EXPECT_LE(j["jitter_p50_us"].get<double>(), j["jitter_p99_us"].get<double>());
   ASSERT_EQ(j["fingertips"].size(), 8u);
   EXPECT_EQ(j["fingertips"][3]["name"], "left_ring");
+  // The last cycle's tensions and commands, from its sample: zero desired force keeps every
+  // string at least at its minimum tension (0.35 N in spidar8.yaml).
+  for (const auto& f : j["fingertips"]) {
+    ASSERT_EQ(f["tensions_n"].size(), 3u) << f.dump();
+    ASSERT_EQ(f["commands"].size(), 3u) << f.dump();
+    for (const auto& t : f["tensions_n"]) EXPECT_GE(t.get<double>(), 0.35 - 1e-9) << f.dump();
+    for (const auto& c : f["commands"]) EXPECT_GT(c.get<int>(), 0) << f.dump();
+  }
 }
 
 TEST(Cli, DeviceTestRejectsBadOptions) {

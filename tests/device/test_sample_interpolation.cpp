@@ -22,6 +22,9 @@ std::vector<FingertipSample> linear_samples(int n) {
       x.p_W[f] = {0.001 * k + f, -0.002 * k, 0.5};
       x.f_W[f] = {0.1 * k, 0.0, -1.0 * f};
     }
+    x.string_count = 2;
+    x.tension = {0.35 + 0.2 * k, 3.0};
+    x.command = {100 + k, 7};
     s.push_back(x);
   }
   return s;
@@ -37,6 +40,9 @@ TEST(SampleInterpolation, LinearBetweenNeighbours) {
     EXPECT_NEAR(x->p_W[1][0], 0.001 * k + 1, 1e-9);
     EXPECT_NEAR(x->p_W[0][1], -0.002 * k, 1e-9);
     EXPECT_NEAR(x->f_W[0][0], 0.1 * k, 1e-9);
+    EXPECT_NEAR(x->tension[0], 0.35 + 0.2 * k, 1e-9);
+    EXPECT_NEAR(x->tension[1], 3.0, 1e-12);
+    EXPECT_EQ(x->command[0], 100 + static_cast<int>(k));  // the command in effect at t
     EXPECT_EQ(x->cycle, static_cast<std::uint64_t>(k));
   }
 }

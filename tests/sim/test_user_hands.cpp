@@ -7,6 +7,7 @@
 #include <string>
 #include <cmath>
 
+#include "spidar/core/units.hpp"
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/sim/rubiks_task.hpp"
@@ -41,9 +42,9 @@ TEST(RubiksTask, GoalsAreContinuousAndTheRightHandTurnsTwice) {
     return std::atan2(d.y(), d.x());
   };
   const double a0 = yaw(2.9);
-  EXPECT_NEAR(std::remainder(yaw(5.0) - a0, 2 * M_PI), task.params().turn, 0.02);
-  EXPECT_NEAR(std::remainder(yaw(7.2) - a0, 2 * M_PI), 0.0, 0.02);
-  EXPECT_NEAR(std::remainder(yaw(9.2) - a0, 2 * M_PI), task.params().turn, 0.02);
+  EXPECT_NEAR(std::remainder(yaw(5.0) - a0, 2 * units::kPi), task.params().turn, 0.02);
+  EXPECT_NEAR(std::remainder(yaw(7.2) - a0, 2 * units::kPi), 0.0, 0.02);
+  EXPECT_NEAR(std::remainder(yaw(9.2) - a0, 2 * units::kPi), task.params().turn, 0.02);
   // The left hand holds still while the right hand turns (in the air, then on the table).
   std::array<Vec3, 8> a, b;
   task.goals(3.1, a);

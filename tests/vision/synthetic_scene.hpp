@@ -11,12 +11,13 @@
 #include <vector>
 
 #include "spidar/core/types.hpp"
+#include "spidar/core/units.hpp"
 
 namespace spidar::vision::test {
 
 struct DrawnHand {
   cv::Point2d wrist;        // band centre [px]
-  double angle = -M_PI / 2;  // direction wrist → fingers [rad] in the image (−π/2 = up)
+  double angle = -units::kPi / 2;  // direction wrist → fingers [rad] in the image (−π/2 = up)
   double length = 150;      // wrist to fingertips [px]
   bool bracelet = true;
   double hidden_fraction = 0;  // part of the band (from its end_b side) covered by skin
@@ -78,7 +79,7 @@ inline void draw_hand_mask(cv::Mat& mask, const DrawnHand& h) {
   // Palm.
   const cv::Point2d palm = h.wrist + 0.32 * L * d;
   cv::ellipse(mask, sp(palm.x, palm.y), cv::Size(static_cast<int>(0.3 * L * kSuper * 16), static_cast<int>(0.27 * L * kSuper * 16)),
-              h.angle * 180 / M_PI, 0, 360, cv::Scalar(255), -1, cv::LINE_8, 4);
+              h.angle * 180 / units::kPi, 0, 360, cv::Scalar(255), -1, cv::LINE_8, 4);
   // Four fingers and a thumb.
   const double spread[4] = {-0.17, -0.06, 0.05, 0.16};
   const double flen[4] = {0.42, 0.47, 0.44, 0.34};

@@ -68,8 +68,8 @@ TEST(Bracelet, WristErrorOverManyPosesAndLights) {
   double sum = 0, worst = 0;
   int n = 0;
   for (int trial = 0; trial < 6; ++trial) {
-    const std::vector<DrawnHand> hands = {{{180 + dx(rng), 380 + dx(rng) / 2}, -M_PI / 2 + ang(rng), len(rng)},
-                                          {{460 + dx(rng), 380 + dx(rng) / 2}, -M_PI / 2 + ang(rng), len(rng)}};
+    const std::vector<DrawnHand> hands = {{{180 + dx(rng), 380 + dx(rng) / 2}, -units::kPi / 2 + ang(rng), len(rng)},
+                                          {{460 + dx(rng), 380 + dx(rng) / 2}, -units::kPi / 2 + ang(rng), len(rng)}};
     SceneOptions o;
     o.seed = 100 + static_cast<unsigned>(trial);
     o.light_min = light(rng);
@@ -134,7 +134,7 @@ TEST(Bracelet, MissingBraceletIsNotTakenFromTheOtherHand) {
 TEST(Bracelet, TwoHandsBandsInLineAreNotMergedIntoOne) {
   // Both wrists side by side, bands in line with a 6 px gap: thin enough together to pass for one
   // band split by a finger, but twice as long as a band can be.
-  const std::vector<DrawnHand> hands = {{{260, 420}, -M_PI / 2, 170}, {{340, 420}, -M_PI / 2, 170}};
+  const std::vector<DrawnHand> hands = {{{260, 420}, -units::kPi / 2, 170}, {{340, 420}, -units::kPi / 2, 170}};
   const auto scene = test::draw_scene(hands);
   BraceletPrediction pred;
   pred.wrist_px = {Vec2(262, 418), Vec2(338, 422)};

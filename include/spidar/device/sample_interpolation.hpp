@@ -1,7 +1,7 @@
 #pragma once
 /// Fingertip samples at a given time, e.g. a camera frame's exposure: the servo loop publishes a
 /// sample per cycle (host time of its encoder reading); the frame pipeline interpolates the two
-/// samples around the exposure time, linearly in positions and forces.
+/// samples around the exposure time, linearly in positions, forces and tensions.
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -12,8 +12,9 @@ namespace spidar::device {
 
 /// The sample at `t_ns` [ns, host monotonic] from samples given newest first (as
 /// ServoLoop::newest_samples returns them; consecutive, strictly decreasing times).
-/// - t between two samples: linear interpolation of p_W and f_W (t_ns = t, cycle of the earlier
-///   sample, faults and `consistent` of both OR-ed / AND-ed);
+/// - t between two samples: linear interpolation of p_W, f_W and (when both have the same
+///   strings) the tensions; the commands and cycle of the earlier sample (in effect at t); t_ns = t;
+///   faults and `consistent` of both OR-ed / AND-ed;
 /// - t after the newest sample by at most `max_hold_ns`: the newest sample, held;
 /// - otherwise (older than the oldest, too new, no samples): nullopt.
 std::optional<FingertipSample> interpolate_samples(std::span<const FingertipSample> newest_first,

@@ -10,7 +10,7 @@
 #include "spidar/device/device.hpp"
 #include "spidar/device/servo_types.hpp"
 #include "spidar/strings/device_config.hpp"
-#include "spidar/strings/encoder.hpp"
+#include "spidar/device/unwrapped_counts.hpp"
 
 namespace spidar::device {
 
@@ -24,17 +24,20 @@ class ServoCycle {
   /// `inconsistent()`. What was measured stays readable below until the next call.
   void measure(const EncoderReading& reading, FingertipSample& sample);
 
-  /// Forces → motor commands (clamped to the device's range) and the displayed forces into
-  /// `sample.f_W`. In the safe state, or for a non-finite force, the motors get their minimum.
+  /// Forces → tensions → motor commands (clamped to the device's range). The sample gets what
+  /// was computed: displayed forces `f_W`, tensions and commands. In the safe state, or for a
+  /// non-finite force or position, a finger's motors get their minimum (tensions 0).
   void command(const ForceFrame& force, bool safe, FingertipSample& sample,
                std::span<std::int32_t> commands) const;
+  /// Every motor at its minimum, and the sample says so (no force, tensions 0, the commands).
+  void command_minimum(FingertipSample& sample, std::span<std::int32_t> commands) const;
 
-  int string_count() const { return static_cast<int>(unwrap_.size()); }
+  int string_count() const { return counts_.string_count(); }
   std::uint64_t inconsistent() const { return inconsistent_; }
 
   // --- the last `measure`, per device string k (0 … string_count−1) or finger f ---
   /// Unwrapped encoder counts of each string.
-  std::span<const std::int64_t> counts() const { return counts_; }
+  std::span<const std::int64_t> counts() const { return counts_.counts(); }
   /// Length of each string [m].
   std::span<const double> lengths() const { return lengths_; }
   /// RMS length residual of each finger's solve [m]; NaN if its lengths were invalid or the
@@ -47,10 +50,9 @@ class ServoCycle {
   const strings::DeviceConfig& config_;
   DeviceInfo device_;
   strings::TensionLimits limits_;
-  std::vector<strings::CounterUnwrapper> unwrap_;
+  UnwrappedCounts counts_;
   std::vector<int> string_offset_;  // first string index of each finger
   std::uint64_t inconsistent_ = 0;
-  std::vector<std::int64_t> counts_;  // per string, unwrapped
   std::vector<double> lengths_;       // per string [m]
   std::vector<double> residual_;      // per finger [m]
 };

@@ -9,7 +9,7 @@
 /// same numbers mirrored in x (x_H of the left hand points to its thumb side), so with R_WH = I
 /// it too lies palm down, fingers away from the user.
 ///
-/// Proportions (FACTS.md): segment lengths are fractions of a 0.0959 m unit for a 0.19 m hand
+/// Proportions (a published set): segment lengths are fractions of a 0.0959 m unit for a 0.19 m hand
 /// (unit = 0.5047 × hand length), e.g. index metacarpal/proximal/middle/distal
 /// 0.66/0.366/0.232/0.202. Lengths along the digits scale with the hand length; positions across
 /// the palm and the capsule radii scale with the hand width. The carpal offset (wrist to the

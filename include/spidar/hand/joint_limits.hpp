@@ -1,9 +1,9 @@
 #pragma once
 /// Joint ranges of the hand and the parameter box they imply.
 ///
-/// Defaults are the common anatomical ranges (FACTS.md): MCP flexion −15…90°, MCP abduction
+/// Defaults are the common anatomical ranges: MCP flexion −15…90°, MCP abduction
 /// ±20°, PIP 0…110°, DIP 0…90°, thumb CMC flexion ±60°, CMC abduction 0…70°; thumb MCP 0…60° and
-/// IP 0…80° are our own choice (not in FACTS.md). The coupled distal parameter is limited so
+/// IP 0…80° are our own choice (not among those common ranges). The coupled distal parameter is limited so
 /// that both coupled joints stay in range: θ1 ∈ [dip.lo, min(dip.hi, θ1 where θ2 = pip.hi)].
 /// With the paper's quadratic the PIP angle dips to −0.018 rad for small θ1, slightly below a
 /// PIP range starting at 0: that is the printed relation and is accepted.

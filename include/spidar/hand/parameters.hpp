@@ -31,7 +31,7 @@ namespace spidar::hand {
 inline constexpr int kParamCount = 17;
 using ParamVec = Eigen::Matrix<double, kParamCount, 1>;
 
-/// Index 0 = left, 1 = right (DESIGN.md).
+/// Index 0 = left, 1 = right (everywhere in spidar).
 enum class Side : int { kLeft = 0, kRight = 1 };
 
 enum Param : int {

@@ -1,5 +1,5 @@
 #pragma once
-/// The frame thread's work for one camera frame (DESIGN.md, "The flow of one session"):
+/// The frame thread's work for one camera frame (the camera-rate side of a session):
 ///
 ///   camera frame ─► chroma key (matte, silhouette) ─► bracelets (projected wrists)
 ///                                  │                       │

@@ -1,8 +1,8 @@
 #pragma once
 /// The simulated user's real hand as the synthetic camera films it: an anatomical skin of its own,
 /// deliberately independent of the registration model's skin (render/hand_skin.hpp), so that the
-/// rig does not film the estimator's own geometry (DESIGN.md, "The simulated world is not the
-/// model").
+/// rig does not film the estimator's own geometry (the simulated world is not the model: it must
+/// not be produced by the estimator it tests).
 ///
 /// Shape (built once per hand from the user's skeleton, hand::HandModel at the rest pose):
 ///   - a palm with thickness (fuller on the palmar side), the thenar (thumb side) and hypothenar

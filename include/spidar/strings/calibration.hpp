@@ -8,14 +8,27 @@
 /// string, ‖A_i − p_j‖ = l0_i + s_i k_i c_ij is a straight line in the count, so offset l0_i and
 /// metres-per-count k_i (with its sign) come from linear least squares, with residuals.
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "spidar/core/result.hpp"
+#include "spidar/strings/device_config.hpp"
 #include "spidar/strings/encoder.hpp"
 #include "spidar/strings/point_geometry.hpp"
 
 namespace spidar::strings {
+
+/// Where calibration `channels` put a finger's fingertip for its (unwrapped) `counts` [m], world;
+/// nullopt if the string lengths do not give a position.
+std::optional<Vec3> fingertip_from_counts(const FingerConfig& finger,
+                                          std::span<const EncoderChannel> channels,
+                                          std::span<const std::int64_t> counts);
+/// The same with the finger's own channels.
+inline std::optional<Vec3> fingertip_from_counts(const FingerConfig& finger,
+                                                 std::span<const std::int64_t> counts) {
+  return fingertip_from_counts(finger, finger.channels, counts);
+}
 
 /// Channels with `length_at_zero` set so that the lengths at `counts` equal ‖A_i − p_W_pole‖.
 /// Sign and metres-per-count are kept.

@@ -30,6 +30,9 @@ struct DeviceConfig {
   std::vector<FingerConfig> fingers;
 
   int string_count() const;
+  /// Index of finger `finger`'s first string among the device's strings (they are numbered
+  /// finger by finger in config order: its strings are first_string(f) … + geometry.n − 1).
+  int first_string(int finger) const;
   /// Limits the drive can actually deliver: [max(t_min, drive min), min(t_max, drive max)].
   TensionLimits effective_limits() const;
   /// Motor commands [DAC counts] for the effective minimum and maximum tension.

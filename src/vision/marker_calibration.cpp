@@ -1,37 +1,26 @@
-#include "marker_calibration.hpp"
+#include "spidar/vision/marker_calibration.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <utility>
 
 #include "spidar/core/units.hpp"
 
-namespace spidar::app {
+namespace spidar::vision {
 
-MarkerCalibration::MarkerCalibration(const vision::Camera& present, const strings::FingerConfig& finger,
-                                     StabilityParams stability)
-    : present_(present), finger_(finger), stability_(stability) {
-  stability_.near_m = 1e9;  // the markers may be anywhere in the workspace
-}
+MarkerCalibration::MarkerCalibration(const Camera& present, std::string measured_with)
+    : present_(present), measured_with_(std::move(measured_with)) {}
 
-void MarkerCalibration::begin_touch() {
-  pending_.reset();
-  check_ = std::make_unique<StabilityCheck>(finger_, Vec3::Zero(), stability_);
-}
-
-void MarkerCalibration::update(double t_s, std::span<const std::int64_t> finger_counts) {
-  if (!check_) return;
-  check_->update(t_s, finger_counts);
-  if (!check_->ready()) return;
-  const auto p_W = fingertip_from_counts(finger_, check_->sample());
-  if (p_W) {
-    CapturedMarker m;
-    m.name = "m" + std::to_string(markers_.size() + 1);
-    m.p_W = *p_W;
-    m.held_spread_m = check_->spread_m();
-    pending_ = m;
-  }
-  check_.reset();  // a failed position (inconsistent strings) needs a new touch
+Status MarkerCalibration::touched(const Vec3& p_W, double held_spread_m) {
+  if (!p_W.allFinite())
+    return Error{"camera calibration: the measured marker position is not finite"};
+  CapturedMarker m;
+  m.name = "m" + std::to_string(markers_.size() + 1);
+  m.p_W = p_W;
+  m.held_spread_m = held_spread_m;
+  pending_ = m;
+  return Ok{};
 }
 
 Status MarkerCalibration::set_pixel(const Vec2& uv) {
@@ -39,8 +28,9 @@ Status MarkerCalibration::set_pixel(const Vec2& uv) {
   const auto& in = present_.intrinsics();
   if (!uv.allFinite() || uv.x() < 0 || uv.y() < 0 || uv.x() >= in.width || uv.y() >= in.height) {
     char b[160];
-    std::snprintf(b, sizeof b, "camera calibration: pixel (%.1f, %.1f) of %s is outside the %dx%d image",
-                  uv.x(), uv.y(), pending_->name.c_str(), in.width, in.height);
+    std::snprintf(b, sizeof b,
+                  "camera calibration: pixel (%.1f, %.1f) of %s is outside the %dx%d image", uv.x(),
+                  uv.y(), pending_->name.c_str(), in.width, in.height);
     return Error{b};
   }
   CapturedMarker m = *pending_;
@@ -56,27 +46,30 @@ Status MarkerCalibration::set_range(std::size_t i, double range_m) {
     return Error{"camera calibration: marker " + std::to_string(i + 1) + " does not exist (have " +
                  std::to_string(markers_.size()) + ")"};
   if (!std::isfinite(range_m) || range_m <= 0.05)
-    return Error{"camera calibration: range of " + markers_[i].name + " must be a distance > 0.05 m, got " +
-                 std::to_string(range_m)};
+    return Error{"camera calibration: range of " + markers_[i].name +
+                 " must be a distance > 0.05 m, got " + std::to_string(range_m)};
   markers_[i].range_m = range_m;
   return Ok{};
 }
 
 void MarkerCalibration::remove_last() {
-  if (pending_) pending_.reset();
-  else if (!markers_.empty()) markers_.pop_back();
+  if (pending_)
+    pending_.reset();
+  else if (!markers_.empty())
+    markers_.pop_back();
 }
 
-Result<vision::MarkerSet> MarkerCalibration::marker_set() const {
+Result<MarkerSet> MarkerCalibration::marker_set() const {
   if (markers_.size() < 3)
     return Error{"camera calibration: " + std::to_string(markers_.size()) +
                  " markers, expected 3 (the paper's three-marker method) or at least 4 (PnP)"};
-  vision::MarkerSet set;
+  MarkerSet set;
   set.by_pixel = markers_.size() >= 4;
   set.source = "the live session's camera calibration";
   for (const CapturedMarker& c : markers_) {
-    if (!c.uv) return Error{"camera calibration: " + c.name + " has no pixel (click it in the view)"};
-    vision::Marker m;
+    if (!c.uv)
+      return Error{"camera calibration: " + c.name + " has no pixel (click it in the view)"};
+    Marker m;
     m.name = c.name;
     m.p_W = c.p_W;
     if (set.by_pixel) {
@@ -93,9 +86,9 @@ Result<vision::MarkerSet> MarkerCalibration::marker_set() const {
 Result<MarkerCalibration::Solution> MarkerCalibration::solve() const {
   auto set = marker_set();
   if (!set) return set.error();
-  auto r = vision::calibrate_extrinsics(present_.intrinsics(), *set);
+  auto r = calibrate_extrinsics(present_.intrinsics(), *set);
   if (!r) return Error{"camera calibration: " + r.error().message};
-  Solution s{vision::Camera(present_.intrinsics(), r->X_CW), *r, 0, 0};
+  Solution s{Camera(present_.intrinsics(), r->X_CW), *r, 0, 0};
   s.moved_m = (s.camera.X_WC().p - present_.X_WC().p).norm();
   s.turned_deg = present_.X_CW().R.angularDistance(r->X_CW.R) * 180.0 / units::kPi;
   return s;
@@ -105,15 +98,16 @@ std::string MarkerCalibration::markers_yaml() const {
   std::ostringstream o;
   o.precision(6);
   o << std::fixed;
-  o << "# Markers touched with the " << finger_.name
-    << " fingertip cap in the live session (world from the strings,\n"
+  o << "# Markers measured with the " << measured_with_
+    << " in the live session (world from the strings,\n"
        "# pixel clicked in the camera view"
     << (markers_.size() == 3 ? ", camera = ray through the pixel at the measured range" : "")
     << "). For: spidar-mr calibrate-camera --markers FILE\nmarkers:\n";
   auto set = marker_set();
   for (std::size_t i = 0; i < markers_.size(); ++i) {
     const CapturedMarker& m = markers_[i];
-    o << "  - name: " << m.name << "\n    world: [" << m.p_W.x() << ", " << m.p_W.y() << ", " << m.p_W.z() << "]\n";
+    o << "  - name: " << m.name << "\n    world: [" << m.p_W.x() << ", " << m.p_W.y() << ", "
+      << m.p_W.z() << "]\n";
     if (set && set->by_pixel) {
       o << "    pixel: [" << m.uv->x() << ", " << m.uv->y() << "]\n";
     } else if (set) {
@@ -124,4 +118,4 @@ std::string MarkerCalibration::markers_yaml() const {
   return o.str();
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::vision

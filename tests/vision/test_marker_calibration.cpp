@@ -1,67 +1,61 @@
-// The camera's extrinsic calibration with fingertip caps as markers (the GUI's step): world
-// positions from the strings after a stability check, pixels clicked, the paper's three-marker
-// method and PnP; checked against the camera that made the pixels.
+// The camera's extrinsic calibration from touched markers (the GUI's step): measured world
+// positions (a few tenths of a millimetre off, as the strings give them), pixels clicked, the
+// paper's three-marker method and PnP; checked against the camera that made the pixels.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
-#include "marker_calibration.hpp"
-#include "ideal_counts.hpp"
-#include "spidar/strings/device_config.hpp"
+#include "spidar/core/units.hpp"
 #include "spidar/vision/camera_config.hpp"
+#include "spidar/vision/marker_calibration.hpp"
 #include "spidar/vision/markers.hpp"
 
-namespace spidar::app {
+namespace spidar::vision {
 namespace {
 
-using test::counts_at;
-
 struct Rig {
-  strings::DeviceConfig device = strings::load_device_config("configs/spidar8.yaml");
-  vision::Camera truth = vision::load_camera_file("configs/camera.yaml").camera;
-  vision::Camera present = truth;  // the calibration in use: 4 cm and 3° off
-  const strings::FingerConfig* finger = nullptr;
+  Vec3 centre = Vec3(0, 0, 0);  // the SPIDAR frame's centre [m], world
+  Camera truth = load_camera_file(std::string(SPIDAR_SOURCE_DIR) + "/configs/camera.yaml").camera;
+  Camera present = truth;  // the calibration in use: 4 cm and 3° off
   Rig() {
-    for (const auto& f : device.fingers)
-      if (f.name == "right_index") finger = &f;
     const Pose X_WC = truth.X_WC();
     const Pose off = Pose::FromRotationVector(Vec3(0.02, -0.045, 0.01), Vec3(0.03, -0.02, 0.02));
     present.set_X_CW((X_WC * off).inverse());
   }
-  /// The user touches p and holds still for `hold_s`, then the pixel of the cap is clicked
-  /// (`click_px` off the true projection), its range measured `range_error_m` long.
-  void touch(MarkerCalibration& cal, const Vec3& p, double& t, const Vec2& click_px = Vec2::Zero(),
-             double range_error_m = 0.0) const {
-    cal.begin_touch();
-    // The approach: the fingertip still moving, 1 mm per 10 ms.
-    for (int k = 0; k < 30; ++k, t += 0.01) cal.update(t, counts_at(*finger, p + Vec3(0.001 * (30 - k), 0, 0)));
-    ASSERT_EQ(cal.pending(), nullptr) << "sampled while the fingertip was still moving";
-    for (int k = 0; k < 700 && !cal.pending(); ++k, t += 0.001) cal.update(t, counts_at(*finger, p));
-    ASSERT_NE(cal.pending(), nullptr) << "no sample after holding still 0.7 s";
-    EXPECT_LT((cal.pending()->p_W - p).norm(), 2e-4);  // counts are quantised
+  /// A marker at p is measured `measure_error` off (the strings' quantisation), then the
+  /// pixel of the cap is clicked (`click_px` off the true projection) and its range measured
+  /// `range_error_m` long.
+  void touch(MarkerCalibration& cal, const Vec3& p, const Vec2& click_px = Vec2::Zero(),
+             double range_error_m = 0.0,
+             const Vec3& measure_error = Vec3(1e-4, -1e-4, 5e-5)) const {
+    ASSERT_TRUE(cal.touched(p + measure_error, 2e-5).ok());
+    ASSERT_NE(cal.pending(), nullptr);
+    EXPECT_EQ(cal.pending()->name, "m" + std::to_string(cal.markers().size() + 1));
     ASSERT_TRUE(cal.set_pixel(truth.project(p) + click_px).ok());
+    EXPECT_EQ(cal.pending(), nullptr);
     const std::size_t i = cal.markers().size() - 1;
     ASSERT_TRUE(cal.set_range(i, truth.to_camera(p).norm() + range_error_m).ok());
   }
 };
 
-double angle_deg(const Pose& a, const Pose& b) { return a.R.angularDistance(b.R) * 180.0 / M_PI; }
-double centre_mm(const vision::Camera& a, const vision::Camera& b) {
+double angle_deg(const Pose& a, const Pose& b) {
+  return a.R.angularDistance(b.R) * 180.0 / units::kPi;
+}
+double centre_mm(const Camera& a, const Camera& b) {
   return (a.X_WC().p - b.X_WC().p).norm() * 1e3;
 }
 
 TEST(MarkerCalibration, ThreeTouchedMarkersGiveThePapersExtrinsics) {
   const Rig rig;
-  ASSERT_NE(rig.finger, nullptr);
-  MarkerCalibration cal(rig.present, *rig.finger);
-  const Vec3 c = rig.device.p_W_centre;
-  double t = 0;
+  MarkerCalibration cal(rig.present, "right_index fingertip cap");
+  const Vec3 c = rig.centre;
   // Half-pixel clicks and millimetre ranges, as a person with a tape measure would get.
-  rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06), t, Vec2(0.4, -0.3), 0.001);
-  rig.touch(cal, c + Vec3(0.12, 0.07, -0.05), t, Vec2(-0.5, 0.2), -0.001);
-  rig.touch(cal, c + Vec3(0.0, -0.08, 0.10), t, Vec2(0.3, 0.5), 0.0005);
+  rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06), Vec2(0.4, -0.3), 0.001);
+  rig.touch(cal, c + Vec3(0.12, 0.07, -0.05), Vec2(-0.5, 0.2), -0.001);
+  rig.touch(cal, c + Vec3(0.0, -0.08, 0.10), Vec2(0.3, 0.5), 0.0005);
   ASSERT_EQ(cal.markers().size(), 3u);
   const auto s = cal.solve();
   ASSERT_TRUE(s.ok()) << s.error().message;
@@ -74,7 +68,7 @@ TEST(MarkerCalibration, ThreeTouchedMarkersGiveThePapersExtrinsics) {
   EXPECT_NEAR(s->moved_m * 1e3, centre_mm(rig.present, rig.truth), 6.0);
   // Without measuring the ranges (the present camera's) the pose stays near the present one:
   // the ranges are what the method measures.
-  MarkerCalibration lazy(rig.present, *rig.finger);
+  MarkerCalibration lazy(rig.present, "right_index fingertip cap");
   for (const auto& m : cal.markers()) {
     CapturedMarker copy = m;
     copy.range_m = rig.present.to_camera(m.p_W).norm();
@@ -87,15 +81,14 @@ TEST(MarkerCalibration, ThreeTouchedMarkersGiveThePapersExtrinsics) {
 
 TEST(MarkerCalibration, FourOrMoreMarkersUsePnpFromThePixelsAlone) {
   const Rig rig;
-  MarkerCalibration cal(rig.present, *rig.finger);
-  const Vec3 c = rig.device.p_W_centre;
-  double t = 0;
+  MarkerCalibration cal(rig.present, "right_index fingertip cap");
+  const Vec3 c = rig.centre;
   const Vec3 spots[] = {{-0.12, 0.05, -0.06}, {0.12, 0.07, -0.05}, {0.0, -0.08, 0.10},
                         {-0.08, -0.06, 0.08}, {0.09, -0.02, 0.12}, {0.02, 0.1, -0.1}};
   int k = 0;
   for (const Vec3& d : spots) {
     // Clicks up to half a pixel off; ranges badly wrong (5 cm): PnP must not use them.
-    rig.touch(cal, c + d, t, Vec2(0.5 * std::sin(k), 0.5 * std::cos(k)), 0.05);
+    rig.touch(cal, c + d, Vec2(0.5 * std::sin(k), 0.5 * std::cos(k)), 0.05);
     ++k;
   }
   const auto s = cal.solve();
@@ -110,17 +103,17 @@ TEST(MarkerCalibration, FourOrMoreMarkersUsePnpFromThePixelsAlone) {
 
 TEST(MarkerCalibration, MarkersFileFeedsCalibrateCameraToTheSamePose) {
   const Rig rig;
-  MarkerCalibration cal(rig.present, *rig.finger);
-  const Vec3 c = rig.device.p_W_centre;
-  double t = 0;
-  rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06), t, Vec2(0.4, -0.3));
-  rig.touch(cal, c + Vec3(0.12, 0.07, -0.05), t, Vec2(-0.5, 0.2));
-  rig.touch(cal, c + Vec3(0.0, -0.08, 0.10), t, Vec2(0.3, 0.5));
-  const std::string path = ::testing::TempDir() + "spidar_markers_" + std::to_string(getpid()) + ".yaml";
+  MarkerCalibration cal(rig.present, "right_index fingertip cap");
+  const Vec3 c = rig.centre;
+  rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06), Vec2(0.4, -0.3));
+  rig.touch(cal, c + Vec3(0.12, 0.07, -0.05), Vec2(-0.5, 0.2));
+  rig.touch(cal, c + Vec3(0.0, -0.08, 0.10), Vec2(0.3, 0.5));
+  const std::string path =
+      ::testing::TempDir() + "spidar_markers_" + std::to_string(getpid()) + ".yaml";
   std::ofstream(path) << cal.markers_yaml();
-  const vision::MarkerSet set = vision::load_markers(path);
+  const MarkerSet set = load_markers(path);
   EXPECT_FALSE(set.by_pixel);
-  const auto from_file = vision::calibrate_extrinsics(rig.present.intrinsics(), set);
+  const auto from_file = calibrate_extrinsics(rig.present.intrinsics(), set);
   ASSERT_TRUE(from_file.ok()) << from_file.error().message;
   const auto s = cal.solve();
   ASSERT_TRUE(s.ok());
@@ -131,36 +124,35 @@ TEST(MarkerCalibration, MarkersFileFeedsCalibrateCameraToTheSamePose) {
 
 TEST(MarkerCalibration, MissingOrDegenerateInputGivesClearErrors) {
   const Rig rig;
-  MarkerCalibration cal(rig.present, *rig.finger);
-  const Vec3 c = rig.device.p_W_centre;
+  MarkerCalibration cal(rig.present, "right_index fingertip cap");
+  const Vec3 c = rig.centre;
   // A click with no touched marker.
   auto st = cal.set_pixel(Vec2(100, 100));
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().message.find("no marker waits"), std::string::npos) << st.error().message;
-  // A fingertip that never holds still gives no marker.
-  cal.begin_touch();
-  double t = 0;
-  for (int k = 0; k < 3000; ++k, t += 0.001)
-    cal.update(t, counts_at(*rig.finger, c + Vec3(0.002 * ((k / 200) % 2), 0, 0)));
+  // A position that is not finite is refused.
+  st = cal.touched(Vec3(NAN, 0, 0), 0);
+  ASSERT_FALSE(st.ok());
   EXPECT_EQ(cal.pending(), nullptr);
   // A click outside the image names the pixel and the image size.
-  rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06), t);
-  cal.begin_touch();
-  for (int k = 0; k < 700; ++k, t += 0.001) cal.update(t, counts_at(*rig.finger, c + Vec3(0.12, 0.07, -0.05)));
+  rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06));
+  ASSERT_TRUE(cal.touched(c + Vec3(0.12, 0.07, -0.05), 0).ok());
   ASSERT_NE(cal.pending(), nullptr);
   st = cal.set_pixel(Vec2(700, 20));
   ASSERT_FALSE(st.ok());
-  EXPECT_NE(st.error().message.find("outside the 640x480 image"), std::string::npos) << st.error().message;
+  EXPECT_NE(st.error().message.find("outside the 640x480 image"), std::string::npos)
+      << st.error().message;
   // Too few markers.
   auto s = cal.solve();
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.error().message.find("1 markers, expected 3"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("1 markers, expected 3"), std::string::npos)
+      << s.error().message;
   // A bad range names the marker.
   st = cal.set_range(0, -1.0);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().message.find("m1"), std::string::npos) << st.error().message;
   // Three markers on one line.
-  MarkerCalibration line(rig.present, *rig.finger);
+  MarkerCalibration line(rig.present, "right_index fingertip cap");
   for (int k = 0; k < 3; ++k) {
     CapturedMarker m;
     m.name = "m" + std::to_string(k + 1);
@@ -175,4 +167,4 @@ TEST(MarkerCalibration, MissingOrDegenerateInputGivesClearErrors) {
 }
 
 }  // namespace
-}  // namespace spidar::app
+}  // namespace spidar::vision
