@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_support.hpp"
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/core/config.hpp"
 #include "spidar/strings/encoder.hpp"
 #include "spidar/strings/position.hpp"
@@ -215,18 +216,10 @@ std::string keep_previous_version(const std::string& path) {
 }
 
 std::string write_config_with_backup(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
   (void)strings::parse_device_config(core::ConfigNode::Parse(text, path));  // throws ConfigError
   const std::string backup = keep_previous_version(path);
-  std::error_code ec;
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << text;
-    if (!f) throw UsageError(tmp + ": cannot write");
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) throw UsageError(path + ": cannot replace: " + ec.message());
+  // Whole or not at all, and through a symbolic link to the file it names (the link stays).
+  core::write_file_atomic(path, text);
   return backup;
 }
 

@@ -91,7 +91,9 @@ std::string with_finger_channels(const std::string& yaml, const std::string& sou
 std::string keep_previous_version(const std::string& path);
 
 /// Writes `text` to `path`, keeping the previous file as `path.bak-YYYYmmdd-HHMMSS` (returned).
-/// The text must parse as a device config first. Throws UsageError / core::ConfigError.
+/// The text must parse as a device config first. The file is replaced whole or not at all
+/// (core::write_file_atomic), through a symbolic link to the file it names. Throws UsageError,
+/// core::ConfigError or core::FileError (naming the path).
 std::string write_config_with_backup(const std::string& path, const std::string& text);
 
 }  // namespace spidar::app
