@@ -5,6 +5,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -231,13 +232,32 @@ TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {
   std::ofstream(d / "session.json") << session_json;
   auto incomplete = run("replay " + d.string());
   EXPECT_EQ(incomplete.code, 2);
-  EXPECT_NE(incomplete.err.find("recording incomplete, 2."), std::string::npos) << incomplete.err;
+  const auto at = incomplete.err.find("recording incomplete, ");
+  ASSERT_NE(at, std::string::npos) << incomplete.err;
+  const double held_s = std::atof(incomplete.err.c_str() + at + 22);  // "N.N s": the 2 s run, give or take
+  EXPECT_GT(held_s, 1.0) << incomplete.err;
+  EXPECT_LT(held_s, 4.0) << incomplete.err;
   // A damaged recording: a clear error naming the file (and line), never a crash.
   std::ofstream(d / "session.json") << "{\"format\": 3}";
   auto damaged = run("replay " + d.string());
   EXPECT_EQ(damaged.code, 2);
   EXPECT_NE(damaged.err.find("session.json:"), std::string::npos) << damaged.err;
   EXPECT_EQ(damaged.err.find("internal error"), std::string::npos) << damaged.err;
+}
+
+TEST(LiveRecording, AWriteErrorFailsTheRunNamingTheFileAndTheRecordingStaysIncomplete) {
+  // fingertips.csv is a link to /dev/full, where every write fails with ENOSPC (a full disk).
+  const fs::path d = temp_dir("rec_full") / "session";
+  fs::create_directories(d);
+  fs::create_symlink("/dev/full", d / "fingertips.csv");
+  auto r = run("run --config configs/lab-example.yaml --headless --seconds 1 --record " + d.string());
+  EXPECT_EQ(r.code, 2) << r.err << r.out;
+  EXPECT_NE(r.err.find((d / "fingertips.csv").string() + ": write failed: No space left on device"), std::string::npos)
+      << r.err;
+  EXPECT_NE(slurp(d / "session.json").find("\"complete\": false"), std::string::npos);
+  auto rp = run("replay " + d.string());
+  EXPECT_EQ(rp.code, 2);
+  EXPECT_NE(rp.err.find("recording incomplete"), std::string::npos) << rp.err;
 }
 
 TEST(CalibrateStrings, PoleCalibrationOnTheSimulatedDeviceFixesWrongOffsets) {
