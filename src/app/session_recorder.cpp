@@ -169,7 +169,10 @@ void SessionRecorder::stop() {
   if (video_) video_->close();
   note_error(writer_->error());
   // The completion marker only when every file was written whole.
-  if (!error_.empty()) return;
+  if (!error_.empty()) {
+    writer_->close_incomplete();
+    return;
+  }
   try {
     writer_->finish();
   } catch (const std::exception& e) {

@@ -176,6 +176,15 @@ std::string RecordingWriter::error() const {
   return "";
 }
 
+void RecordingWriter::close_incomplete() {
+  for (auto* f : {device_.get(), fingertips_.get(), frames_.get(), scene_.get(), fits_.get()}) {
+    try {
+      f->close();
+    } catch (const core::FileError&) {  // error() keeps it
+    }
+  }
+}
+
 void RecordingWriter::finish() {
   if (finished_) return;
   // Every file is closed (so none stays open), the first failure is thrown.

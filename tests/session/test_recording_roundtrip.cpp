@@ -177,6 +177,20 @@ TEST(RecordingWriter, AFullDiskFailsNamingTheFileAndLeavesNoCompletionMarker) {
   }
 }
 
+TEST(RecordingWriter, CloseIncompleteKeepsTheRowsWithoutTheMarker) {
+  // A recording that failed elsewhere (a frame image not written): the rows are flushed so that
+  // replay can say how long it is, but it is not complete.
+  TempFolder d("incomplete");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  RecordingWriter w(dir.string(), t.meta, "");
+  for (const auto& s : t.fingertips) ASSERT_TRUE(w.write_fingertip(s));
+  w.close_incomplete();
+  EXPECT_EQ(lines_of(dir / "fingertips.csv").size(), t.fingertips.size() + 1);
+  EXPECT_FALSE(parse_session_json(slurp(dir / "session.json"), "session.json").complete);
+  EXPECT_DOUBLE_EQ(recorded_seconds(dir.string()), 2.375);
+}
+
 TEST(RecordingWriter, AFullDiskAtCloseFailsToo) {
   // Fewer rows than the buffer holds: nothing is written before finish(), whose flush fails.
   TempFolder d("full_close");

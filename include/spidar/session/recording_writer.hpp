@@ -46,6 +46,9 @@ class RecordingWriter {
   /// completion marker. Throws core::FileError naming the file on the first failure (the
   /// recording then has no marker). Idempotent once it succeeded.
   void finish();
+  /// Closes the CSVs (what they hold is flushed) without the completion marker: for a recording
+  /// that failed elsewhere (a frame image that could not be written). Never throws.
+  void close_incomplete();
 
   /// The first write failure ("PATH: write failed: No space left on device"), empty if none.
   std::string error() const;
