@@ -154,15 +154,18 @@ Action add_calibrate_strings(CLI::App& app) {
       text = strings::with_finger_channels(text, path, fc.name, channels, a->jig > 0, note);
       report["fingers"].push_back(jf);
     }
-    if (a->dry_run) {
-      report["written"] = false;
-    } else {
-      report["backup"] = strings::write_device_config(path, text);
-      report["written"] = true;
-      std::cerr << "wrote " << path << " (previous version: " << report["backup"].get<std::string>() << ")\n";
-    }
+    // The measurement is printed before the config is touched: should the write fail (a
+    // read-only folder, a full disk), the result is on stdout and nothing is lost.
+    report["dry_run"] = a->dry_run;
     require_finite_json(report, "calibrate-strings report");
-    std::cout << report.dump(2) << "\n";
+    std::cout << report.dump(2) << "\n" << std::flush;
+    if (a->dry_run) return 0;
+    try {
+      const std::string backup = strings::write_device_config(path, text);
+      std::cerr << "wrote " << path << " (previous version: " << backup << ")\n";
+    } catch (const SpidarError& e) {
+      throw UsageError(std::string(e.what()) + " (the calibration is printed above; the config is unchanged)");
+    }
     return 0;
   };
 }

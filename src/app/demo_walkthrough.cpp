@@ -13,6 +13,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "demo.hpp"
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/core/units.hpp"
 #include "spidar/strings/calibration.hpp"
 #include "spidar/strings/position.hpp"
@@ -338,7 +339,7 @@ int run_strings_demo(const DemoOptions& a) {
       {"fingers", fingers},
       {"solver_ns_per_fingertip", {{"position", pos_ns * per}, {"tension", ten_ns * per}}}};
   require_finite_json(report, (fs::path(a.out) / "report.json").string());
-  std::ofstream(fs::path(a.out) / "report.json") << report.dump(2) << "\n";
+  core::write_file_atomic((fs::path(a.out) / "report.json").string(), report.dump(2) + "\n");
   std::cout << "wrote " << (fs::path(a.out) / "walkthrough.csv").string() << " and "
             << (fs::path(a.out) / "report.json").string() << "\n";
   return 0;

@@ -567,6 +567,10 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   }
   std::cout << summary.dump() << "\n";
   if (!session->error().empty()) std::cerr << "spidar-mr run: " << session->error() << "\n";
+  if (const SessionRecorder* r = session->recorder(); r != nullptr && !r->error().empty()) {
+    std::cerr << "spidar-mr: error: --record: " << r->error() << " (the recording is incomplete)\n";
+    return kExitBadInput;
+  }
   return st.faults != 0 || ended_by == "device stopped" || !session->error().empty() ? 1 : 0;
 }
 

@@ -5,14 +5,16 @@
 ///                    written after it go into a lock-free ring (no allocation, no lock in the
 ///                    servo thread);
 ///   SessionRecorder  a writer thread drains that ring and the servo loop's fingertip samples into
-///                    CSV files, and writes each processed camera frame (video or PNG), the scene
-///                    poses, the fingertip sample the frame was registered with and the fit.
+///                    the recording's CSVs, and writes each processed camera frame (video or PNG),
+///                    the scene poses, the fingertip sample the frame was registered with and the
+///                    fit. The files and their columns are session::RecordingWriter's
+///                    (include/spidar/session/recording_schema.hpp); this is the threads and the
+///                    frame images around it.
 #include <array>
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
-#include <fstream>
 #include <memory>
 #include <mutex>
 #include <opencv2/core/mat.hpp>
@@ -27,16 +29,12 @@
 #include "spidar/hand/parameters.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/render/video_output.hpp"
+#include "spidar/session/recording_writer.hpp"
 
 namespace spidar::app {
 
-/// One servo cycle at the device boundary.
-struct DeviceCycleRecord {
-  std::uint64_t seq = 0;  ///< 1, 2, 3, ... per write
-  device::EncoderReading reading;
-  int command_count = 0;
-  std::array<std::int32_t, device::kMaxDeviceStrings> commands{};
-};
+/// One servo cycle at the device boundary (a device.csv row).
+using DeviceCycleRecord = session::DeviceCycleRecord;
 
 /// A Device that forwards everything to another and records reads and writes.
 class RecordingDevice final : public device::Device {
@@ -85,40 +83,45 @@ struct FrameRecord {
   std::array<registration::FitReport, 2> fits;
 };
 
-/// How camera frames are stored: H.264 video (small, lossy), Motion-JPEG (larger, nearly lossless)
-/// or PNG files (lossless: replay reproduces the live fits exactly).
-enum class FrameStore { kVideo, kMjpg, kPng };
+/// How camera frames are stored (session/recording_schema.hpp).
+using FrameStore = session::FrameStore;
 
 class SessionRecorder {
  public:
-  /// Creates DIR (it must not hold a recording already) and writes config.yaml and session.json.
-  /// Throws UsageError naming the folder on failure.
+  /// Creates DIR (it must not hold a recording already) and writes config.yaml and session.json
+  /// (without its completion marker). Throws SpidarError naming the path on failure.
   SessionRecorder(const std::string& dir, FrameStore store, const RecordingMeta& meta);
   ~SessionRecorder();
   /// Starts the writer thread polling `device` and `servo` (both must outlive stop()).
   void start(const RecordingDevice* device, const device::ServoLoop* servo);
   /// Frame thread: queues a frame for writing (blocks while 16 frames wait).
   void add_frame(FrameRecord frame);
-  /// Drains everything and closes the files. Call after the servo loop has stopped.
+  /// Drains everything, closes the files and, if every write succeeded, writes the completion
+  /// marker (session.json "complete": true). Call after the servo loop has stopped. A failure
+  /// is kept in error(), never thrown.
   void stop();
   const std::string& dir() const { return dir_; }
   std::uint64_t device_records() const { return device_written_; }
   std::uint64_t fingertip_records() const { return samples_written_; }
   std::uint64_t frames() const { return frames_written_; }
   std::uint64_t lost() const { return lost_; }  ///< ring entries overwritten before written
+  /// The first write failure, naming the file ("DIR/device.csv: write failed: No space left on
+  /// device"); empty if none. Set by the writer thread: read it after stop().
   const std::string& error() const { return error_; }
 
  private:
   void run();
   void drain();
   void write_frame(FrameRecord& f);
+  /// Keeps the first error.
+  void note_error(const std::string& e);
 
   std::string dir_;
   FrameStore store_;
   RecordingMeta meta_;
   const RecordingDevice* device_ = nullptr;
   const device::ServoLoop* servo_ = nullptr;
-  std::ofstream device_csv_, fingertip_csv_, frames_csv_, scene_csv_, fits_csv_;
+  std::unique_ptr<session::RecordingWriter> writer_;
   std::unique_ptr<render::VideoOutput> video_;
   std::vector<DeviceCycleRecord> dev_buf_;
   std::vector<device::FingertipSample> sample_buf_;

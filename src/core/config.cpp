@@ -60,7 +60,9 @@ decltype(auto) guarded(const ConfigNode& node, std::string_view expectation, Bod
 }  // namespace
 
 ConfigError::ConfigError(std::string file, int line, std::string key, std::string expectation)
-    : SpidarError(format_location(file, line, key) + ' ' + expectation),
+    // One line whatever the key or file name holds: control characters (a key may hold any byte)
+    // are written as \xNN.
+    : SpidarError(printable_for_message(format_location(file, line, key) + ' ' + expectation)),
       file_(std::move(file)),
       line_(line),
       key_(std::move(key)),

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/core/file_read.hpp"
 
 namespace spidar::core {
@@ -28,17 +29,10 @@ std::string keep_previous_version(const std::string& path) {
 }
 
 std::string replace_file_keeping_previous(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const std::string backup = keep_previous_version(path);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << text;
-    if (!f) throw FileError(tmp, "cannot write");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw FileError(path, "cannot replace: " + ec.message());
+  // The previous version beside the file a symbolic link names; the new one written whole or
+  // not at all, through the link (the link stays a link).
+  const std::string backup = keep_previous_version(resolve_symlinks(path));
+  write_file_atomic(path, text);
   return backup;
 }
 

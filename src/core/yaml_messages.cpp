@@ -24,8 +24,9 @@ bool is_plain_word(std::string_view text) {
   return true;
 }
 
-// yaml-cpp's parser messages that are fixed text (nothing from the input is appended).
-constexpr std::array<const char*, 34> kFixedParserMessages = {
+// yaml-cpp's parser messages that are fixed text (nothing from the input is appended). const, not
+// constexpr: clang (make fuzz) does not take yaml-cpp's `const char* const` as constant expressions.
+const std::array<const char*, 34> kFixedParserMessages = {
     YAML::ErrorMsg::YAML_DIRECTIVE_ARGS,
     YAML::ErrorMsg::YAML_MAJOR_VERSION,
     YAML::ErrorMsg::REPEATED_YAML_DIRECTIVE,
@@ -63,7 +64,7 @@ constexpr std::array<const char*, 34> kFixedParserMessages = {
 };
 
 // Messages that end in `: ` followed by text from the input; only the fixed part is kept.
-constexpr std::array<const char*, 3> kPrefixParserMessages = {
+const std::array<const char*, 3> kPrefixParserMessages = {
     YAML::ErrorMsg::YAML_VERSION,
     YAML::ErrorMsg::INVALID_UNICODE,
     YAML::ErrorMsg::INVALID_ESCAPE,

@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/core/units.hpp"
 
 namespace spidar::vision {
@@ -142,11 +143,12 @@ Status save_camera_file(const std::string& path, const Camera& camera,
   std::error_code ec;
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) fs::create_directories(parent, ec);
-  std::ofstream f(path);
-  if (!f) return Error{path + ": cannot write camera file: " + std::strerror(errno)};
-  f << camera_file_yaml(camera, notes);
-  f.close();
-  if (!f) return Error{path + ": error while writing camera file"};
+  // Whole or not at all (temporary file, then rename), through a symbolic link to its target.
+  try {
+    core::write_file_atomic(path, camera_file_yaml(camera, notes));
+  } catch (const core::FileError& e) {
+    return Error{std::string(e.what()) + " (writing the camera file)"};
+  }
   return Ok{};
 }
 

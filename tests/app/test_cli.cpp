@@ -354,8 +354,9 @@ TEST(Cli, NonFiniteAndOutOfRangeNumbersAreRefused) {
   }
 }
 
-// A fit row with a NaN (a live fit that diverged) is left out of the comparison and counted; the
-// report has no null.
+// A live fit that diverged is recorded as finite = 0 with empty numbers (session/recording_schema.hpp):
+// replay leaves it out of the comparison and counts it, and the report has no null. A "nan" in a
+// fit row is damage: refused with exit 2 naming fits.csv, line and column.
 TEST(Cli, ReplayOfARecordingWithANonFiniteFitWritesNoNull) {
   namespace fs = std::filesystem;
   const fs::path d = fs::path(::testing::TempDir()) / ("spidar_nan_fit_" + std::to_string(getpid()));
@@ -363,15 +364,34 @@ TEST(Cli, ReplayOfARecordingWithANonFiniteFitWritesNoNull) {
   auto r = run("run --config configs/lab-example.yaml --headless --seconds 1.5 --record " + d.string() +
                " --record-frames png");
   ASSERT_TRUE(fs::exists(d / "fits.csv")) << r.err << r.out;
-  std::string fits = slurp_file((d / "fits.csv").string());
-  // fits.csv: frame,hand,...; field 6 is the final cost. Put a NaN there in the first row.
+  const std::string fits = slurp_file((d / "fits.csv").string());
+  // fits.csv: frame,hand,iterations,converged,finite,cost_initial,cost_final,...
   const auto row = fits.find('\n') + 1;
   ASSERT_LT(row, fits.size()) << "no fit rows";
-  std::size_t field = row;
-  for (int k = 0; k < 5; ++k) field = fits.find(',', field) + 1;
-  const std::size_t end = fits.find(',', field);
-  fits.replace(field, end - field, "nan");
-  std::ofstream(d / "fits.csv") << fits;
+  const auto row_end = fits.find('\n', row);
+  auto field_start = [&](int k) {
+    std::size_t at = row;
+    for (int i = 0; i < k; ++i) at = fits.find(',', at) + 1;
+    return at;
+  };
+  // "nan" as the final cost of the first row: refused.
+  {
+    std::string bad = fits;
+    const std::size_t at = field_start(6);
+    bad.replace(at, fits.find(',', at) - at, "nan");
+    std::ofstream(d / "fits.csv") << bad;
+    auto rp = run("replay " + d.string() + " --no-video --out " + (d / "replay").string());
+    EXPECT_EQ(rp.code, 2) << rp.err;
+    const std::string where = (d / "fits.csv").string() + ":2:" + std::to_string(at - row + 1) + ": cost_final";
+    EXPECT_NE(rp.err.find(where), std::string::npos) << rp.err;
+  }
+  // The first row marked not finite, its numbers empty: counted, not compared.
+  std::string marked = fits.substr(0, field_start(4)) + "0";
+  const std::size_t numbers = fits.find(',', field_start(4));
+  for (std::size_t i = numbers; i < row_end; ++i)
+    if (fits[i] == ',') marked += ',';
+  marked += fits.substr(row_end);
+  std::ofstream(d / "fits.csv") << marked;
 
   auto rp = run("replay " + d.string() + " --no-video --out " + (d / "replay").string());
   ASSERT_EQ(rp.code, 0) << rp.err;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -195,7 +196,12 @@ TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {
   ASSERT_EQ(rp.code, 0) << rp.err << rp.out;
   auto j = parse(slurp(d / "replay" / "report.json"));
   EXPECT_EQ(j["frames"].get<int>(), frames);
+  EXPECT_EQ(j["frames_replayed"].get<int>(), frames);
+  EXPECT_EQ(j["decode_errors"].get<int>(), 0);
+  EXPECT_EQ(j["recorded"]["device_cycles"], live["recording"]["device_cycles"]);
   EXPECT_EQ(j["reproduction"]["frames_compared"].get<int>(), frames);
+  EXPECT_EQ(j["reproduction"]["hands_compared"].get<int>(), 2 * frames);
+  EXPECT_GT(j["reproduction"]["fingertip_resample_frames"].get<int>(), 0);
   EXPECT_LT(j["reproduction"]["max_param_diff"].get<double>(), 1e-9) << j.dump(2);
   EXPECT_LT(j["reproduction"]["max_cost_diff"].get<double>(), 1e-9) << j.dump(2);
   EXPECT_NEAR(j["registration"]["iou_vs_silhouette_mean"].get<double>(),
@@ -210,12 +216,52 @@ TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {
   auto bad = run("replay " + temp_dir("notrec").string());
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("no session.json"), std::string::npos) << bad.err;
+  // A PNG that does not decode is counted, not fatal; a deleted one is refused naming the row
+  // (frame 1 of the more than 3 frames expected above; a starved machine may record fewer).
+  if (frames > 3) {
+    std::ofstream(d / "frames" / "000001.png") << "not a PNG";
+    auto decode = run("replay " + d.string() + " --no-video --out " + (d / "replay2").string());
+    ASSERT_EQ(decode.code, 0) << decode.err;
+    EXPECT_EQ(parse(slurp(d / "replay2" / "report.json"))["decode_errors"].get<int>(), 1);
+    fs::remove(d / "frames" / "000001.png");
+    auto missing = run("replay " + d.string() + " --no-video --out " + (d / "replay2").string());
+    EXPECT_EQ(missing.code, 2);
+    EXPECT_NE(missing.err.find((d / "frames.csv").string() + ":3:"), std::string::npos) << missing.err;
+    EXPECT_NE(missing.err.find("000001.png is missing"), std::string::npos) << missing.err;
+  }
+  // Without its completion marker (an interrupted recording): incomplete, and how long it is.
+  std::string session_json = slurp(d / "session.json");
+  session_json.replace(session_json.find("\"complete\": true"), 16, "\"complete\": false");
+  std::ofstream(d / "session.json") << session_json;
+  auto incomplete = run("replay " + d.string());
+  EXPECT_EQ(incomplete.code, 2);
+  const auto at = incomplete.err.find("recording incomplete, ");
+  ASSERT_NE(at, std::string::npos) << incomplete.err;
+  // "N.N s": the 2 s run, plus the servo samples before the recorder started, more on a busy machine.
+  const double held_s = std::atof(incomplete.err.c_str() + at + 22);
+  EXPECT_GT(held_s, 0.5) << incomplete.err;
+  EXPECT_LT(held_s, 60.0) << incomplete.err;
   // A damaged recording: a clear error naming the file (and line), never a crash.
   std::ofstream(d / "session.json") << "{\"format\": 3}";
   auto damaged = run("replay " + d.string());
   EXPECT_EQ(damaged.code, 2);
   EXPECT_NE(damaged.err.find("session.json:"), std::string::npos) << damaged.err;
   EXPECT_EQ(damaged.err.find("internal error"), std::string::npos) << damaged.err;
+}
+
+TEST(LiveRecording, AWriteErrorFailsTheRunNamingTheFileAndTheRecordingStaysIncomplete) {
+  // fingertips.csv is a link to /dev/full, where every write fails with ENOSPC (a full disk).
+  const fs::path d = temp_dir("rec_full") / "session";
+  fs::create_directories(d);
+  fs::create_symlink("/dev/full", d / "fingertips.csv");
+  auto r = run("run --config configs/lab-example.yaml --headless --seconds 1 --record " + d.string());
+  EXPECT_EQ(r.code, 2) << r.err << r.out;
+  EXPECT_NE(r.err.find((d / "fingertips.csv").string() + ": write failed: No space left on device"), std::string::npos)
+      << r.err;
+  EXPECT_NE(slurp(d / "session.json").find("\"complete\": false"), std::string::npos);
+  auto rp = run("replay " + d.string());
+  EXPECT_EQ(rp.code, 2);
+  EXPECT_NE(rp.err.find("recording incomplete"), std::string::npos) << rp.err;
 }
 
 TEST(CalibrateStrings, PoleCalibrationOnTheSimulatedDeviceFixesWrongOffsets) {
@@ -244,12 +290,41 @@ TEST(CalibrateStrings, PoleCalibrationOnTheSimulatedDeviceFixesWrongOffsets) {
     EXPECT_LT(f["pole_error_after_mm"].get<double>(), 0.1) << f.dump();  // by construction
   }
   // Written back, previous version kept, and the new file is a valid config.
-  const std::string backup = j["backup"];
+  EXPECT_EQ(j["dry_run"], false);
+  const auto wrote = r.err.find("previous version: ");
+  ASSERT_NE(wrote, std::string::npos) << r.err;
+  const std::string backup = r.err.substr(wrote + 18, r.err.find(')', wrote) - wrote - 18);
   EXPECT_EQ(slurp(backup), text);
   EXPECT_NE(backup.find("dev.yaml.bak-"), std::string::npos);
   auto check = run("check-config " + cfg.string());
   EXPECT_EQ(check.code, 0) << check.err;
   EXPECT_EQ(slurp(cfg).find("[0.44, 0.45, 0.43]"), std::string::npos);
+}
+
+TEST(CalibrateStrings, ASymlinkedConfigIsUpdatedThroughTheLinkAndAFailedWriteKeepsTheResult) {
+  const fs::path d = temp_dir("pole_link");
+  fs::create_directories(d / "real");
+  fs::copy_file("configs/spidar8.yaml", d / "real" / "dev.yaml");
+  fs::create_symlink("real/dev.yaml", d / "dev.yaml");
+  auto r = run("calibrate-strings --backend sim --config " + (d / "dev.yaml").string() + " --fingers right_thumb");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  EXPECT_TRUE(fs::is_symlink(d / "dev.yaml"));
+  EXPECT_NE(slurp(d / "real" / "dev.yaml"), slurp("configs/spidar8.yaml"));  // the target got the result
+  EXPECT_NE(slurp(d / "real" / "dev.yaml").find("pole calibration"), std::string::npos);
+  // A write that fails (a file size limit below the config's 3.6 kB, as a full disk would): the
+  // measurement is on stdout, the exit code is 2, the message names the path, the config is kept.
+  fs::remove(d / "dev.yaml");
+  fs::copy_file("configs/spidar8.yaml", d / "dev2.yaml");
+  const std::string limited = "sh -c 'trap \"\" XFSZ; ulimit -f 6; exec \"$0\" \"$@\"' ";
+  auto full = run("calibrate-strings --backend sim --config " + (d / "dev2.yaml").string() + " --fingers right_thumb",
+                  limited);
+  EXPECT_EQ(full.code, 2) << full.err << full.out;
+  EXPECT_NE(full.err.find((d / "dev2.yaml").string()), std::string::npos) << full.err;
+  EXPECT_NE(full.err.find("the calibration is printed above"), std::string::npos) << full.err;
+  auto j = parse(full.out);
+  ASSERT_EQ(j["fingers"].size(), 1u) << full.out;
+  EXPECT_EQ(j["fingers"][0]["finger"], "right_thumb");
+  EXPECT_EQ(slurp(d / "dev2.yaml"), slurp("configs/spidar8.yaml"));  // unchanged
 }
 
 TEST(CalibrateStrings, MultiPointJigFitsScaleAndOffset) {
@@ -261,7 +336,7 @@ TEST(CalibrateStrings, MultiPointJigFitsScaleAndOffset) {
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   auto j = parse(r.out);
   EXPECT_EQ(j["method"], "multi-point jig");
-  EXPECT_EQ(j["written"], false);
+  EXPECT_EQ(j["dry_run"], true);
   const auto& f = j["fingers"][0];
   for (int i = 0; i < 3; ++i) {
     EXPECT_LT(f["residual_rms_mm"][i].get<double>(), 0.1) << f.dump();

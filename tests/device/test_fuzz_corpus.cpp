@@ -1,36 +1,12 @@
 // The fuzz target's regression corpus as a test: every file of fuzz/corpus/frame_decoder goes
 // through the same entry point libFuzzer calls (fuzz/fuzz_frame_decoder.cpp), which aborts on an
 // invariant violation.
-#include <gtest/gtest.h>
-
-#include <algorithm>
-#include <cstdint>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <vector>
-
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
+#include "fuzz_corpus.hpp"
 
 namespace {
 
 TEST(FuzzCorpus, FrameDecoderCorpusPassesTheFuzzInvariants) {
-  namespace fs = std::filesystem;
-  const fs::path dir = SPIDAR_FUZZ_CORPUS;
-  ASSERT_TRUE(fs::is_directory(dir)) << dir;
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.is_regular_file()) files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
-  EXPECT_GE(files.size(), 24u) << "the seed corpus has a few dozen files";
-  for (const fs::path& f : files) {
-    SCOPED_TRACE(f.filename().string());
-    std::ifstream in(f, std::ios::binary);
-    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                                          std::istreambuf_iterator<char>());
-    EXPECT_EQ(LLVMFuzzerTestOneInput(bytes.data(), bytes.size()), 0);
-  }
+  spidar::test::replay_fuzz_corpus(SPIDAR_FUZZ_CORPUS, 24);  // the seed corpus has a few dozen files
 }
 
 }  // namespace

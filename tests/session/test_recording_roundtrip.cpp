@@ -1,0 +1,207 @@
+// A recording written by RecordingWriter reads back equal, field by field, through
+// read_recording; the writer's failures (a full disk, an existing recording) name the path.
+#include <gtest/gtest.h>
+
+#include "recording_test_support.hpp"
+#include "spidar/session/recording_reader.hpp"
+
+namespace {
+
+using namespace spidar;
+using namespace spidar::session;
+using namespace spidar::session::testing;
+
+void expect_same_sample(const device::FingertipSample& a, const device::FingertipSample& b) {
+  EXPECT_EQ(a.t_ns, b.t_ns);
+  EXPECT_EQ(a.faults, b.faults);
+  EXPECT_EQ(a.consistent, b.consistent);
+  EXPECT_EQ(a.finger_count, b.finger_count);
+  EXPECT_EQ(a.p_W, b.p_W);  // bit for bit: 17 significant digits
+  EXPECT_EQ(a.f_W, b.f_W);
+}
+
+void expect_reads_back(const TestRecording& t, const Recording& r) {
+  EXPECT_EQ(r.meta.width, t.meta.width);
+  EXPECT_EQ(r.meta.height, t.meta.height);
+  EXPECT_EQ(r.meta.fps, t.meta.fps);
+  EXPECT_EQ(r.meta.string_count, t.meta.string_count);
+  EXPECT_EQ(r.meta.finger_count, t.meta.finger_count);
+  EXPECT_EQ(r.meta.device_name, t.meta.device_name);
+  EXPECT_EQ(r.meta.store, t.meta.store);
+  EXPECT_EQ(r.meta.initial_r_W_hand[1], t.meta.initial_r_W_hand[1]);
+  EXPECT_EQ(r.rows.device, t.device.size());
+  EXPECT_EQ(r.rows.fingertips, t.fingertips.size());
+  EXPECT_EQ(r.rows.frames, t.frames.size());
+  EXPECT_EQ(r.rows.scene, 2 * t.frames.size());
+  EXPECT_EQ(r.rows.fits, 2 * t.frames.size());
+  EXPECT_DOUBLE_EQ(r.rows.seconds, 2.375);
+  EXPECT_EQ(r.device_rows, t.device.size());
+  ASSERT_EQ(r.fingertips.size(), t.fingertips.size());
+  for (std::size_t k = 0; k < t.fingertips.size(); ++k) {
+    expect_same_sample(r.fingertips[k], t.fingertips[k]);
+    EXPECT_EQ(r.fingertips[k].cycle, t.fingertips[k].cycle);
+  }
+  ASSERT_EQ(r.frames.size(), t.frames.size());
+  for (std::size_t i = 0; i < t.frames.size(); ++i) {
+    EXPECT_EQ(r.frames[i].index, t.frames[i].index);
+    EXPECT_EQ(r.frames[i].t_exposure_ns, t.frames[i].t_exposure_ns);
+    EXPECT_EQ(r.frames[i].image, t.frames[i].image);
+    expect_same_sample(r.frames[i].measured, t.frames[i].measured);
+    ASSERT_EQ(r.scene[i].size(), t.scene[i].size());
+    for (std::size_t s = 0; s < t.scene[i].size(); ++s) {
+      EXPECT_EQ(r.scene[i][s].p, t.scene[i][s].p);
+      EXPECT_EQ(r.scene[i][s].R.coeffs(), t.scene[i][s].R.coeffs());
+    }
+    for (int h = 0; h < 2; ++h) {
+      const FitRow& a = r.fits[i][static_cast<std::size_t>(h)];
+      const FitRow& b = t.fits[i][static_cast<std::size_t>(h)];
+      EXPECT_EQ(a.frame, b.frame);
+      EXPECT_EQ(a.hand, b.hand);
+      EXPECT_EQ(a.iterations, b.iterations);
+      EXPECT_EQ(a.converged, b.converged);
+      EXPECT_EQ(a.finite, b.finite);
+      if (b.finite) {
+        EXPECT_EQ(a.cost_initial, b.cost_initial);
+        EXPECT_EQ(a.cost_final, b.cost_final);
+        EXPECT_EQ(a.terms, b.terms);
+        EXPECT_EQ(a.q, b.q);
+      } else {
+        EXPECT_TRUE(std::isnan(a.q[0]));  // not a number the replay could compare with
+      }
+    }
+  }
+}
+
+TEST(RecordingRoundTrip, PngRecordingReadsBackEqual) {
+  TempFolder d("roundtrip_png");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, dir);
+  const Recording r = read_recording(dir.string());
+  expect_reads_back(t, r);
+  EXPECT_EQ(r.config_path, (dir / "config.yaml").string());
+  EXPECT_EQ(slurp(dir / "config.yaml"), "device_config: x.yaml\n");
+  // The device rows as the reader parses them.
+  std::ifstream in(dir / "device.csv");
+  std::vector<DeviceCycleRecord> rows;
+  read_device_csv(in, "device.csv", 3, [&](const DeviceCycleRecord& row) { rows.push_back(row); });
+  ASSERT_EQ(rows.size(), t.device.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    EXPECT_EQ(rows[k].seq, t.device[k].seq);
+    EXPECT_EQ(rows[k].reading.host_time_ns, t.device[k].reading.host_time_ns);
+    EXPECT_EQ(rows[k].reading.device_time_us, t.device[k].reading.device_time_us);
+    EXPECT_EQ(rows[k].reading.status_flags, t.device[k].reading.status_flags);
+    EXPECT_EQ(rows[k].reading.repeats, t.device[k].reading.repeats);
+    EXPECT_EQ(rows[k].reading.counts, t.device[k].reading.counts);
+    EXPECT_EQ(rows[k].commands, t.device[k].commands);
+  }
+}
+
+TEST(RecordingRoundTrip, VideoRecordingReadsBackEqualAndNamesItsVideo) {
+  TempFolder d("roundtrip_video");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kMjpg);
+  write_test_recording(t, dir);
+  const Recording r = read_recording(dir.string());
+  expect_reads_back(t, r);
+  EXPECT_EQ(r.meta.frames_file, "camera.avi");
+  EXPECT_EQ(r.meta.frames_codec, "avi/mjpg");
+  EXPECT_EQ(r.video_path, (dir / "camera.avi").string());
+}
+
+TEST(RecordingRoundTrip, CsvColumnsInAnotherOrderAreFoundByName) {
+  TempFolder d("by_name");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, dir);
+  // Swap the first two columns of scene.csv, header and rows alike.
+  auto lines = lines_of(dir / "scene.csv");
+  for (auto& l : lines) {
+    const auto a = l.find(','), b = l.find(',', a + 1);
+    l = l.substr(a + 1, b - a - 1) + "," + l.substr(0, a) + l.substr(b);
+  }
+  write_lines(dir / "scene.csv", lines);
+  expect_reads_back(t, read_recording(dir.string()));
+}
+
+TEST(RecordingRoundTrip, CrlfFilesReadTheSame) {
+  TempFolder d("crlf");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, dir);
+  for (const char* f : {"device.csv", "fingertips.csv", "frames.csv", "scene.csv", "fits.csv", "session.json"}) {
+    std::string text;
+    for (const auto& l : lines_of(dir / f)) text += l + "\r\n";
+    spit(dir / f, text);
+  }
+  expect_reads_back(t, read_recording(dir.string()));
+}
+
+TEST(RecordingWriter, RefusesAFolderHoldingARecording) {
+  TempFolder d("twice");
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, d.path() / "rec");
+  try {
+    RecordingWriter w((d.path() / "rec").string(), t.meta, "");
+    FAIL() << "a second recording into the same folder";
+  } catch (const SpidarError& e) {
+    EXPECT_NE(std::string(e.what()).find("already holds a recording"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RecordingWriter, AFullDiskFailsNamingTheFileAndLeavesNoCompletionMarker) {
+  TempFolder d("full");
+  const fs::path dir = d.path() / "rec";
+  fs::create_directories(dir);
+  fs::create_symlink("/dev/full", dir / "fingertips.csv");  // every write fails with ENOSPC
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  RecordingWriter w(dir.string(), t.meta, "");
+  bool failed_early = false;
+  for (int k = 0; k < 5000 && !failed_early; ++k) failed_early = !w.write_fingertip(t.fingertips[0]);
+  EXPECT_TRUE(failed_early) << "a 64 KiB buffer fills within 5000 rows and its write fails";
+  EXPECT_NE(w.error().find("fingertips.csv: write failed: No space left on device"), std::string::npos) << w.error();
+  try {
+    w.finish();
+    FAIL() << "finish() succeeded on a full disk";
+  } catch (const SpidarError& e) {
+    EXPECT_NE(std::string(e.what()).find((dir / "fingertips.csv").string() + ": write failed"), std::string::npos)
+        << e.what();
+  }
+  const auto s = parse_session_json(slurp(dir / "session.json"), "session.json");
+  EXPECT_FALSE(s.complete);
+  try {
+    (void)read_recording(dir.string());
+    FAIL() << "an incomplete recording was read";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("incomplete"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RecordingWriter, CloseIncompleteKeepsTheRowsWithoutTheMarker) {
+  // A recording that failed elsewhere (a frame image not written): the rows are flushed so that
+  // replay can say how long it is, but it is not complete.
+  TempFolder d("incomplete");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  RecordingWriter w(dir.string(), t.meta, "");
+  for (const auto& s : t.fingertips) ASSERT_TRUE(w.write_fingertip(s));
+  w.close_incomplete();
+  EXPECT_EQ(lines_of(dir / "fingertips.csv").size(), t.fingertips.size() + 1);
+  EXPECT_FALSE(parse_session_json(slurp(dir / "session.json"), "session.json").complete);
+  EXPECT_DOUBLE_EQ(recorded_seconds(dir.string()), 2.375);
+}
+
+TEST(RecordingWriter, AFullDiskAtCloseFailsToo) {
+  // Fewer rows than the buffer holds: nothing is written before finish(), whose flush fails.
+  TempFolder d("full_close");
+  const fs::path dir = d.path() / "rec";
+  fs::create_directories(dir);
+  fs::create_symlink("/dev/full", dir / "fits.csv");
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  RecordingWriter w(dir.string(), t.meta, "");
+  EXPECT_TRUE(w.write_fingertip(t.fingertips[0]));
+  EXPECT_THROW(w.finish(), SpidarError);
+  EXPECT_FALSE(parse_session_json(slurp(dir / "session.json"), "session.json").complete);
+}
+
+}  // namespace
