@@ -15,20 +15,14 @@
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
+#include "spidar/session/cube_monitor.hpp"
 #include "spidar/session/haptic_side.hpp"
 #include "spidar/sim/scripted_grasp.hpp"
 
 namespace spidar::app {
 namespace {
 
-/// What the physics thread reports about the cube (plain data for a Latest<>).
-struct CubeStatus {
-  double t_s = 0;
-  double lift = 0;          ///< core height above its start [m]
-  double u_angle = 0;       ///< top layer angle [rad]
-  double u_misalign = 0;    ///< from the nearest click [rad]
-  int contacts = 0;
-};
+using session::CubeStatus;
 
 }  // namespace
 
@@ -121,10 +115,10 @@ int run_haptic_demo(const DemoOptions& o) {
   double jump_max = 0;
   for (std::size_t k = 0; k < trace.size(); ++k) {
     for (std::size_t f = 0; f < cfg.fingers.size(); ++f) {
-      const Vec3 F(trace[k].f_W[f][0], trace[k].f_W[f][1], trace[k].f_W[f][2]);
+      const Vec3 F = device::fingertip_force(trace[k], f);
       fmax[f] = std::max(fmax[f], F.norm());
       if (k > 0 && trace[k].cycle == trace[k - 1].cycle + 1) {
-        const Vec3 Fp(trace[k - 1].f_W[f][0], trace[k - 1].f_W[f][1], trace[k - 1].f_W[f][2]);
+        const Vec3 Fp = device::fingertip_force(trace[k - 1], f);
         jump_max = std::max(jump_max, (F - Fp).norm());
       }
     }

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cli_support.hpp"
+#include "spidar/core/units.hpp"
 #include "demo.hpp"
 #include "demo_mr_report.hpp"
 #include "progress.hpp"
@@ -162,7 +163,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.has_cube = cube.has_value();
   summary.facelets = cube ? cube->facelets() : "";
   if (cube) {
-    for (char f : std::string("UDFBRL")) summary.face_deg[f] = cube->face_angle(f) * 180 / M_PI;
+    for (char f : std::string("UDFBRL")) summary.face_deg[f] = cube->face_angle(f) * 180 / units::kPi;
   }
   summary.video_path = video ? video->path() : "";
   summary.video_format = video ? render::video_format_name(video->format()) : "";

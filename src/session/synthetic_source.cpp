@@ -21,7 +21,7 @@ class SyntheticSource final : public FrameSource {
       const auto s = device::interpolate_samples({truth_buf_.data(), n}, t_ns);
       if (!s) return false;
       for (std::size_t f = 0; f < out.size() && f < 8; ++f)
-        out[f] = Vec3(s->p_W[f][0], s->p_W[f][1], s->p_W[f][2]);
+        out[f] = device::fingertip_position(*s, static_cast<int>(f));
       return true;
     };
     sim::SyntheticCameraParams cp;

@@ -16,9 +16,10 @@ namespace spidar::session {
 
 /// The cube (or, in another scene, the object the user reaches for) as the physics thread sees it.
 struct CubeStatus {
-  double t_s = 0;
-  double lift = 0;
-  double u_angle = 0, d_angle = 0;
+  double t_s = 0;                  ///< physics time [s]
+  double lift = 0;                 ///< core height above its start [m]
+  double u_angle = 0, d_angle = 0; ///< top and bottom layer angles [rad]
+  double u_misalign = 0;           ///< top layer's angle from its nearest click [rad]
   int turns = 0;
   bool solved = true;
   int contacts = 0;

@@ -1,5 +1,5 @@
 #pragma once
-/// The haptic side of a session (DESIGN.md, "The flow of one session"): the servo loop driving a
+/// The haptic side of a session (docs/architecture.md, "The flow of one session"): the servo loop driving a
 /// device, the physics thread stepping the world, and the bridge between them (fingertip proxies,
 /// coupling, passivity control). The Session and the haptic demo run it the same way.
 #include <cstdint>

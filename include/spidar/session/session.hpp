@@ -1,5 +1,5 @@
 #pragma once
-/// One running system (DESIGN.md, "The flow of one session"): the haptic side — the servo loop
+/// One running system (docs/architecture.md, "The flow of one session"): the haptic side — the servo loop
 /// driving the rig's device, the physics thread and the bridge between them — and the frame side
 /// — camera frames through pipeline::FramePipeline (and optionally a comparison pipeline), with
 /// the warm-up before the clock starts, the servo samples interpolated at each exposure, and one
