@@ -115,10 +115,10 @@ int run_haptic_demo(const DemoOptions& o) {
   double jump_max = 0;
   for (std::size_t k = 0; k < trace.size(); ++k) {
     for (std::size_t f = 0; f < cfg.fingers.size(); ++f) {
-      const Vec3 F = device::fingertip_force(trace[k], f);
+      const Vec3 F = device::fingertip_force(trace[k], static_cast<int>(f));
       fmax[f] = std::max(fmax[f], F.norm());
       if (k > 0 && trace[k].cycle == trace[k - 1].cycle + 1) {
-        const Vec3 Fp = device::fingertip_force(trace[k - 1], f);
+        const Vec3 Fp = device::fingertip_force(trace[k - 1], static_cast<int>(f));
         jump_max = std::max(jump_max, (F - Fp).norm());
       }
     }
