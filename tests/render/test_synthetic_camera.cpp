@@ -97,7 +97,7 @@ TEST(SyntheticCamera, DiffersFromTheModelsCapsules) {
 
 TEST(SyntheticCamera, FilmsAnAnatomicalHandNotTheModelsSkin) {
   SPIDAR_REQUIRE_GL();
-  // DESIGN.md "The simulated world is not the model": the filmed hand is the user's anatomical
+  // The simulated world is not the model (docs/architecture.md, sim): the filmed hand is the user's anatomical
   // hand, not the skin the registration draws. Same pose, same sizes: the hands (no forearm, no
   // bracelet) overlap mostly but clearly differ (the model's skin at the true pose scored 0.993
   // when the camera filmed it).

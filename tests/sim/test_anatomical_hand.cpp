@@ -253,7 +253,7 @@ TEST(AnatomicalHand, PosingIsCheapAndDoesNotAllocate) {
     EXPECT_EQ(alloc::count(), 0);
   }
   EXPECT_EQ(meshes[0].version, alloc::available() ? 2u : 1u);
-  // Timing is reported, not asserted (DESIGN.md: sanitizer builds run slower).
+  // Timing is reported, not asserted (sanitizer builds run slower; timing lives in benchmarks).
   constexpr int kRuns = 200;
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < kRuns; ++i) pose_anatomical_hand(h, q, meshes);
