@@ -14,7 +14,7 @@ namespace {
 using units::deg_to_rad;
 
 TEST(Coupling, PaperQuadraticValues) {
-  // θ2 = 1.1341·θ1² − 0.286·θ1: dips to ≈ −0.018 at θ1 ≈ 0.126 (FACTS.md).
+  // θ2 = 1.1341·θ1² − 0.286·θ1: dips to ≈ −0.018 at θ1 ≈ 0.126 (the paper's coupling).
   const auto dip = couple(Coupling::kPaperQuadratic, 0.126);
   EXPECT_NEAR(dip.penultimate, -0.018, 5e-4);
   EXPECT_NEAR(dip.penultimate, 1.1341 * 0.126 * 0.126 - 0.286 * 0.126, 1e-15);
@@ -91,7 +91,7 @@ TEST(JointLimits, DistalLimitKeepsBothCoupledJointsInRange) {
   // Linear: DIP = ⅔·110° = 73.3°.
   const auto lin = parameter_limits(r, Coupling::kLinear);
   EXPECT_NEAR(lin.upper[kIndexDip], deg_to_rad(110.0) * 2.0 / 3.0, 1e-12);
-  // FACTS.md ranges on the direct parameters; the wrist is free.
+  // The paper's ranges on the direct parameters; the wrist is free.
   EXPECT_NEAR(quad.lower[kIndexMcpFlexion], deg_to_rad(-15.0), 1e-15);
   EXPECT_NEAR(quad.upper[kRingMcpFlexion], deg_to_rad(90.0), 1e-15);
   EXPECT_NEAR(quad.upper[kIndexMcpAbduction], deg_to_rad(20.0), 1e-15);

@@ -10,7 +10,7 @@
 namespace spidar::hand {
 namespace {
 
-constexpr double kUnit = 0.0959;  // FACTS.md: segment unit of a 0.19 m hand
+constexpr double kUnit = 0.0959;  // the paper's segment unit of a 0.19 m hand
 
 TEST(HandShape, DefaultProportionsFromFacts) {
   const HandShape& s = default_hand_shape();
