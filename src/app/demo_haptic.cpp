@@ -10,6 +10,7 @@
 
 #include "cli_support.hpp"
 #include "demo.hpp"
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/core/units.hpp"
 #include "spidar/device/servo_loop.hpp"
@@ -190,7 +191,7 @@ int run_haptic_demo(const DemoOptions& o) {
         {"steps", ps.steps}}},
       {"fingers", fingers}};
   require_finite_json(report, (fs::path(o.out) / "report.json").string());
-  std::ofstream(fs::path(o.out) / "report.json") << report.dump(2) << "\n";
+  core::write_file_atomic((fs::path(o.out) / "report.json").string(), report.dump(2) + "\n");
   std::cout << "wrote " << (fs::path(o.out) / "haptic_trace.csv").string() << " and "
             << (fs::path(o.out) / "report.json").string() << "\n";
   if (ss.faults != 0) {

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cli_support.hpp"
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/core/units.hpp"
 #include "demo.hpp"
 #include "demo_mr_report.hpp"
@@ -181,10 +182,10 @@ int run_mr_demo(const DemoOptions& o) {
   summary.mujoco_warnings = mj.count;
   if (mj.count > 0) {  // MuJoCo's own log, here rather than MUJOCO_LOG.TXT in the working directory
     const fs::path log = fs::path(o.out) / "mujoco_log.txt";
-    std::ofstream f(log);
+    std::ostringstream f;
     f << mj.count << " MuJoCo warning(s) in this run; the last " << mj.messages.size() << ":\n";
     for (const auto& m : mj.messages) f << m << "\n";
-    if (!f) throw SpidarError("cannot write " + log.string());
+    core::write_file_atomic(log.string(), f.str());
     summary.mujoco_log = log.string();
   }
   const int code = write_mr_report(o.out, trace, summary, std::cout);

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <iomanip>
 #include <functional>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/device/device.hpp"
 #include "spidar/render/plot.hpp"
 #include "spidar/render/video_output.hpp"
@@ -60,7 +62,7 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
 
 /// One row per processed frame: what the report's figures are computed from.
 void write_frames_csv(const std::string& path, const MrTrace& t) {
-  std::ofstream f(path);
+  std::ostringstream f;
   f << "t_s,latency_ms,pipeline_ms,registration_ms,truth_ms,output_ms,film_ms,iou,fingertip_mm,"
        "joint_px_left,joint_px_right,occlusion_pct,occlusion_pct_paper,contested_pixels,"
        "contested_error_pct,contested_error_pct_paper,iterations_left,"
@@ -82,6 +84,7 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
     if (m.ceiling_measured) f << m.ceiling_iou;
     f << '\n';
   }
+  core::write_file_atomic(path, f.str());
 }
 
 void save_plot(const std::string& path, const render::PlotSpec& spec,
@@ -314,7 +317,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   }
   report["haptic"]["force_max_n"] = forces;
   require_finite_json(report, (dir / "report.json").string());
-  std::ofstream(dir / "report.json") << report.dump(2) << "\n";
+  // Whole or not at all (a directory or unwritable path there is an error naming it, exit 2).
+  core::write_file_atomic((dir / "report.json").string(), report.dump(2) + "\n");
   write_frames_csv((dir / "frames.csv").string(), t);
   if (frames > 1) write_plots(dir, t);
 

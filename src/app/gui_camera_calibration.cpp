@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "spidar/core/atomic_write.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/core/file_write.hpp"
 #include "spidar/strings/calibration.hpp"
@@ -139,7 +140,7 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
           throw SpidarError(st.error().message);
         const std::string markers = path + ".markers.yaml";
         core::keep_previous_version(markers);
-        std::ofstream(markers) << cal.markers_yaml();
+        core::write_file_atomic(markers, cal.markers_yaml());
         message_ = "wrote " + path + " (previous: " + (backup.empty() ? "none" : backup) + ") and " + markers +
                    "; restart run to use it";
       } catch (const std::exception& ex) {

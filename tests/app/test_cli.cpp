@@ -429,6 +429,19 @@ std::string shifted_config(const std::string& dir) {
   return path;
 }
 
+// Outputs never lie: a report.json that cannot be written (here a directory stands at its
+// path) is an error naming it, exit 2, never "wrote report.json".
+TEST(Cli, DemoWhoseReportCannotBeWrittenFailsNamingIt) {
+  const std::string dir = ::testing::TempDir() + "spidar_demo_unwritable_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/report.json");
+  auto r = run("demo --scenario haptic --seconds 0.5 --out " + dir);
+  EXPECT_EQ(r.code, 2) << r.err << r.out;
+  EXPECT_NE(r.err.find("report.json"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("wrote"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::is_directory(dir + "/report.json"));
+}
+
 TEST(Cli, DemoExitsWithCode1WhenTheServoLatchesAFault) {
   const std::string dir = ::testing::TempDir() + "spidar_demo_fault_" + std::to_string(getpid());
   const std::string cfg = shifted_config(dir);
