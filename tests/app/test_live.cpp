@@ -404,8 +404,10 @@ TEST(LiveGui, KeysTypedIntoTheWindowMoveTheHandsAndSpaceStopsTheDevice) {
   const auto& left = j["hands"][0];
   const auto& right = j["hands"][1];
   // 0.08 m/s for 1.5 s is 0.12 m; the GUI integrates at its frame rate (steps of at most 0.1 s),
-  // so a slow (sanitised) GUI moves less.
-  EXPECT_GT(right["offset_m"][1].get<double>(), 0.03) << r.out;
+  // so a slow GUI (sanitised, or a loaded machine: 0.016 m measured at load 5) moves less. How
+  // far is a matter of speed, not of the keys; what the test asks is that Up moved the right
+  // hand away, and only it.
+  EXPECT_GT(right["offset_m"][1].get<double>(), 0.005) << r.out;
   EXPECT_NEAR(right["offset_m"][0].get<double>(), 0.0, 1e-9) << r.out;
   EXPECT_NEAR(left["offset_m"][1].get<double>(), 0.0, 1e-9) << r.out;  // only the right hand moved
   EXPECT_GT(left["closeness"].get<double>(), 0.3) << r.out;  // 1.5 per second for 1 s
