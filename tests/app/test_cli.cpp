@@ -247,6 +247,8 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_GT(j["seconds"].get<double>(), 0.0);
   EXPECT_LE(j["seconds"].get<double>(), 3.0 + 1e-6);
   EXPECT_EQ(j["cube"]["turns_planned"].get<int>(), 2);  // the script's, whatever 3 s got done
+  EXPECT_GE(j["pipeline"]["dropped_frames"].get<int>(), 0);
+  EXPECT_GE(j["pipeline"]["latency_ms_p95"].get<double>(), j["pipeline"]["latency_ms_median"].get<double>());
   EXPECT_GT(j["haptic"]["rate_hz"].get<double>(), 900.0);
   EXPECT_GT(j["physics"]["step_ms_median"].get<double>(), 0.0);
   const auto& reg = j["registration"];
