@@ -398,8 +398,13 @@ TEST(LiveGui, KeysTypedIntoTheWindowMoveTheHandsAndSpaceStopsTheDevice) {
   auto j = parse(r.out);
   ASSERT_TRUE(j.contains("hands")) << r.err << r.out;
   EXPECT_EQ(j["ended_by"], "seconds") << r.out;
-  // The emergency stop latched (a late cycle on a loaded machine may add a timing fault).
-  EXPECT_EQ(r.code, 1) << r.err << r.out;
+  // The emergency stop latched (a late cycle on a loaded machine may add a timing fault). The
+  // exit status is spidar-mr's as the script reports it: xvfb-run replaces it with 5 when its
+  // own cleanup of a temporary directory fails, which happened once in a full suite run.
+  const std::string said = "spidar-mr exited with ";
+  const std::size_t at = r.err.rfind(said);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  EXPECT_EQ(std::atoi(r.err.c_str() + at + said.size()), 1) << r.err << r.out;
   EXPECT_NE(j["faults"].get<std::string>().find("emergency_stop"), std::string::npos) << r.out;
   const auto& left = j["hands"][0];
   const auto& right = j["hands"][1];

@@ -22,3 +22,8 @@ sleep 1.0
 xdotool keyup z
 xdotool key space
 wait "$pid"
+code=$?
+# xvfb-run's own exit status replaces the command's when its cleanup fails (status 5): the
+# command's is said here for the test to read.
+echo "type_into_window.sh: spidar-mr exited with $code" >&2
+exit $code
