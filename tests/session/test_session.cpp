@@ -77,7 +77,8 @@ TEST(Session, EverySinkSeesEveryProcessedFrameInOrderWithIncreasingTimes) {
   s.session->add_sink(a);
   s.session->add_sink(b);
   const SessionSummary end = s.session->run();
-  ASSERT_GT(end.frames, 5u) << "a 1.5 s run at 30 fps processes frames";
+  // Order and times need two frames; how many a 1.5 s run processes is speed (5 under ASan).
+  ASSERT_GE(end.frames, 2u) << "a 1.5 s run at 30 fps processes frames";
   EXPECT_EQ(end.ended_by, "completed");
   EXPECT_TRUE(end.camera_error.empty()) << end.camera_error;
   EXPECT_GE(end.camera_frames, end.frames);
