@@ -5,6 +5,7 @@
 
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/render_geometry.hpp"
+#include "spidar/registration/residuals.hpp"
 #include "spidar/render/hand_shapes.hpp"
 #include "spidar/vision/silhouette.hpp"
 
@@ -133,7 +134,8 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     for (int h = 0; h < 2; ++h) {
       const Pose X_WH = hand::hand_pose(s.previous[h]);
       const Vec3 p_WB = X_WH * Vec3(0.0, -p.registration.bracelet_offset_m, 0.0);
-      predicted[h] = s.camera.project(p_WB);
+      predicted[h] = s.camera.project(registration::bracelet_visible_point(
+          X_WH, s.models[h].shape.dimensions.width, s.camera.X_WC().p, p.registration));
       prediction.wrist_px[h] = predicted[h];
       // The band's expected length: the forearm's projected diameter there (forearm radius ≈
       // 0.31 × palm breadth, as the skin models it, plus the band's thickness).
@@ -230,6 +232,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     }
     out->hands[h] = q;
     out->fits[h] = report;
+    out->models[h] = s.models[h];
   }
   s.previous = out->hands;
   s.have_previous = true;

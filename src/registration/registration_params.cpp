@@ -23,6 +23,9 @@ constexpr Field kFields[] = {
     {"fingertip_sigma_m", &RegistrationParams::fingertip_sigma_m, nullptr, 0.0, 0.1, true, "m"},
     {"wrist_sigma_px", &RegistrationParams::wrist_sigma_px, nullptr, 0.0, 1000.0, true, "px"},
     {"bracelet_offset_m", &RegistrationParams::bracelet_offset_m, nullptr, -0.05, 0.05, false, "m"},
+    {"bracelet_surface_shift", &RegistrationParams::bracelet_surface_shift, nullptr, 0.0, 1.0, false, ""},
+    {"bracelet_radius_per_width", &RegistrationParams::bracelet_radius_per_width, nullptr, 0.0, 1.0, false, ""},
+    {"bracelet_standoff_m", &RegistrationParams::bracelet_standoff_m, nullptr, 0.0, 0.02, false, "m"},
     {"joint_ball_sigma_px", &RegistrationParams::joint_ball_sigma_px, nullptr, 0.0, 1000.0, true,
      "px"},
     {"joint_ball_alpha", &RegistrationParams::joint_ball_alpha, nullptr, 0.0, 1.0, false, ""},
@@ -79,6 +82,7 @@ Status validate(const RegistrationParams& p) {
 RegistrationParams parse_registration_params(const core::ConfigNode& node) {
   if (!node.is_map()) node.fail("expected a map of registration settings");
   node.expect_keys({"fingertip_sigma_m", "wrist_sigma_px", "bracelet_offset_m",
+                    "bracelet_surface_shift", "bracelet_radius_per_width", "bracelet_standoff_m",
                     "joint_ball_sigma_px", "joint_ball_alpha", "ball_radius_scale",
                     "matte_threshold", "silhouette_term", "silhouette_sigma_px",
                     "silhouette_samples_per_bone", "prior_sigma_wrist_m",

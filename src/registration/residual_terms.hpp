@@ -150,7 +150,7 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
     // The projected wrist from the bracelet.
     if (tg.wrist_active && wrist_observed(obs)) {
       const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / rp.wrist_sigma_px;
-      const Vec3 p = bracelet_point(s, rp, J3p);
+      const Vec3 p = bracelet_point(s, rp, J3p) + tg.bracelet_shift_W;
       add_projected(Term::kWrist, p, Vec2::Zero(), *obs.wrist_px, w);
     }
 

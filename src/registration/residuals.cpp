@@ -76,6 +76,22 @@ struct StackSink {
 
 }  // namespace
 
+Vec3 bracelet_visible_point(const Pose& X_WH, double hand_width_m, const Vec3& p_W_camera,
+                            const RegistrationParams& params, Vec3* shift_W) {
+  const Vec3 centre = X_WH * Vec3(0.0, -params.bracelet_offset_m, 0.0);
+  const Vec3 axis = X_WH.R * Vec3::UnitY();
+  Vec3 toward = p_W_camera - centre;
+  toward -= toward.dot(axis) * axis;
+  Vec3 shift = Vec3::Zero();
+  const double n = toward.norm();
+  if (n > 1e-9) {
+    const double radius = params.bracelet_radius_per_width * hand_width_m + params.bracelet_standoff_m;
+    shift = (params.bracelet_surface_shift * radius / n) * toward;
+  }
+  if (shift_W) *shift_W = shift;
+  return centre + shift;
+}
+
 void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, FrozenTargets* tg) {
   tg->wrist_active = false;
   for (JointBall& b : tg->balls) b = JointBall{};
@@ -85,9 +101,11 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   const vision::Camera& camera = *image->camera;
   detail::PoseState s;
   detail::pose_state(*pr.model, q, false, &s);
+  tg->bracelet_shift_W = Vec3::Zero();
   if (detail::wrist_observed(*pr.observation)) {
-    tg->wrist_active =
-        camera.depth(detail::bracelet_point(s, *pr.params, nullptr)) >= detail::kMinImageDepth;
+    const Vec3 p = bracelet_visible_point(hand::hand_pose(q), pr.model->shape.dimensions.width,
+                                          camera.X_WC().p, *pr.params, &tg->bracelet_shift_W);
+    tg->wrist_active = camera.depth(p) >= detail::kMinImageDepth;
   }
   if (!image->alpha.empty() && image->alpha.type() == CV_32FC1) {
     joint_ball_targets(*pr.model, s.points, camera, image->alpha, *pr.params, &tg->balls);

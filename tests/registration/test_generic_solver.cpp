@@ -55,6 +55,7 @@ TEST(GenericSolver, SameOptimumAsEigenLevenbergMarquardt) {
 
       RegistrationParams params;
       params.bracelet_offset_m = 0.0;
+      params.bracelet_surface_shift = 0.0;  // the wrist pixel above is the wrist joint's
       params.max_iterations = 200;
       params.cost_epsilon = 0.0;
       params.step_epsilon = 1e-12;

@@ -53,6 +53,9 @@ struct FramePipelineParams {
   /// (sim/anatomical_hand.hpp) and also differs in length, width, fingertip caps, joint ranges and
   /// an independent little finger.
   render::HandSkinParams model_skin{0.12, 1.2, 0.10, false};
+  /// Estimate each hand's length and width while the session runs (registration/shape_estimator.hpp)
+  /// and fit with the estimate; off: the models' sizes stay as given.
+  bool personalise_shape = false;
   /// Hand rotations to start from on the first frame (rotation vectors, world) [rad].
   std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};
   /// Device finger index of each hand's thumb, index, middle, ring (the config's order).
@@ -67,6 +70,8 @@ struct FrameTimings {
 
 struct FrameResult {
   std::array<hand::HandParams, 2> hands;                ///< fitted (left, right)
+  /// The hand models the fit used (their sizes change when the shape is personalised).
+  std::array<hand::HandModel, 2> models;
   std::array<registration::FitReport, 2> fits;
   int restarts = 0;  ///< hands whose fit was restarted this frame
   std::array<vision::BraceletObservation, 2> bracelets;

@@ -21,6 +21,17 @@ struct RegistrationParams {
   /// (along −y of the hand frame) [m]; the wrist term compares the projection of that point with
   /// the bracelet's midpoint. 0 = the paper's "the bracelet marks the wrist".
   double bracelet_offset_m = 0.012;
+  /// The camera sees the near half of the band, so the bracelet's detected midpoint is not its
+  /// centre on the forearm's axis but lies toward the camera, on the band's visible surface: the
+  /// wrist term compares it with the band centre shifted by surface_shift × r toward the camera
+  /// (across the forearm), r = radius_per_width × hand width + standoff. 0 = the band centre
+  /// itself (the paper's "the bracelet marks the wrist"). Measured on the simulated rig over the
+  /// demo's script (tests/pipeline/registration_study): the detected midpoint lies 10.5 px from
+  /// the centre's projection, 3.8–3.9 px from the shifted point's at 0.4–0.6 r (2/π ≈ 0.64 would
+  /// be a uniformly seen half ring's centroid; the detector takes the middle of the band's extent).
+  double bracelet_surface_shift = 0.5;
+  double bracelet_radius_per_width = 0.31;  ///< forearm radius at the band / palm width
+  double bracelet_standoff_m = 0.002;        ///< how far the band stands off the skin [m]
   double joint_ball_sigma_px = 4.0;   ///< σ of a joint-ball target [px]
   double joint_ball_alpha = 0.5;      ///< α of eq. 21 (dimensionless, 0..1)
   double ball_radius_scale = 1.0;     ///< ball radius = scale × the bone's projected radius

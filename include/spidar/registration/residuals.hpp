@@ -7,14 +7,16 @@
 /// Residual blocks, each divided by its σ (registration_params.hpp), in this order:
 ///   fingertip  p_W_fingertip(θ) − p̃_W (3 rows per valid, finite fingertip)            [m / m]
 ///   wrist      √conf · (uv(p_W_bracelet(θ)) − wrist_px) / σ_wrist (2 rows)              [px / px]
-///              p_W_bracelet = p_W_wrist + R_WH·(0, −bracelet_offset_m, 0)
+///              p_W_bracelet = p_W_wrist + R_WH·(0, −bracelet_offset_m, 0) + s_W, with s_W the
+///              frozen shift to the band's visible surface (bracelet_visible_point)
 ///   joint-ball (uv(joint j)(θ) − P̃_j) / σ_ball (2 rows per ball with on_count ≥ 1)       [px / px]
 ///   silhouette (uv(axis point)(θ) + offset − nearest) / σ_sil (2 rows per point found outside
 ///              the real silhouette by more than 0.5 px when frozen)                      [px / px]
 ///   prior      (θ_i − θ_prior,i) / σ_group (1 row per parameter with a finite prior)
 /// Frozen with the targets: the joint-ball targets P̃, each silhouette point's nearest silhouette
 /// pixel and its offset from the projected axis point (± the projected radius across the bone),
-/// and whether the wrist term is active (bracelet point in front of the camera).
+/// whether the wrist term is active (bracelet point in front of the camera) and the bracelet's
+/// visible-surface shift.
 #include <array>
 
 #include "spidar/core/types.hpp"
@@ -49,6 +51,9 @@ struct SilhouettePoint {
 /// Everything one linearisation holds fixed. Plain fixed-size storage (about 30 KiB).
 struct FrozenTargets {
   bool wrist_active = false;
+  /// From the band centre to its visible surface's centre, toward the camera (world) [m]
+  /// (bracelet_visible_shift at the linearisation).
+  Vec3 bracelet_shift_W = Vec3::Zero();
   JointBalls balls{};
   std::array<SilhouettePoint, kMaxSilhouettePoints> silhouette{};
   int silhouette_count = 0;  ///< entries of `silhouette` in use
@@ -63,6 +68,13 @@ struct ResidualProblem {
   const hand::HandParams* prior = nullptr;
   const RegistrationParams* params = nullptr;
 };
+
+/// Where the bracelet's detected midpoint should lie for a hand at pose `X_WH` seen from
+/// `p_W_camera` (world, m): the band centre, bracelet_offset_m from the wrist toward the elbow,
+/// shifted toward the camera across the forearm by bracelet_surface_shift × the band's radius
+/// (registration_params.hpp). `shift_W` (optional) receives the shift alone.
+Vec3 bracelet_visible_point(const Pose& X_WH, double hand_width_m, const Vec3& p_W_camera,
+                            const RegistrationParams& params, Vec3* shift_W = nullptr);
 
 /// Recomputes the image targets at pose `q` (joint-balls, silhouette points, wrist activity).
 void freeze_targets(const ResidualProblem& problem, const hand::HandParams& q,

@@ -1,0 +1,228 @@
+// registration-study: the frame pipeline on the simulated user's hands, frame by frame and without
+// a clock (deterministic): the scripted user's caps are exactly the script's goals, the synthetic
+// camera films the user's anatomical hands, and the pipeline fits the model hands. Prints the
+// ground-truth figures over the whole script and over its hard part (frames where the fit is
+// worst: approach and release), so that model and registration changes can be compared on the
+// same frames. Not a test (no assertions); a measuring instrument for issue 14's loss budget.
+//
+//   registration_study [--user PROFILE|--user-file FILE] [--model L,W | --model-user]
+//                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
+//                      [--t0 S] [--t1 S] [--fps F] [--verbose]
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "source_path.hpp"
+#include "spidar/hand/hand_config.hpp"
+#include "spidar/hand/kinematics.hpp"
+#include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/sim/frame_truth.hpp"
+#include "spidar/sim/model_ceiling.hpp"
+#include "spidar/sim/rubiks_task.hpp"
+#include "spidar/sim/synthetic_camera.hpp"
+#include "spidar/sim/user_hands.hpp"
+#include "spidar/vision/vision_config.hpp"
+
+using namespace spidar;
+
+namespace {
+
+struct Args {
+  std::string user_profile = "user";
+  std::string user_file;
+  bool model_user = false;
+  double model_length = 0, model_width = 0;
+  bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
+  double t0 = 0.3, t1 = 18.0, fps = 30.0;
+  bool verbose = false;
+};
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+    if (k == "--user") a.user_profile = next();
+    else if (k == "--user-file") a.user_file = next();
+    else if (k == "--model-user") a.model_user = true;
+    else if (k == "--model") std::sscanf(next().c_str(), "%lf,%lf", &a.model_length, &a.model_width);
+    else if (k == "--silhouette") a.silhouette = true;
+    else if (k == "--no-balls") a.no_balls = true;
+    else if (k == "--no-wrist") a.no_wrist = true;
+    else if (k == "--personalise") a.personalise = true;
+    else if (k == "--t0") a.t0 = std::atof(next().c_str());
+    else if (k == "--t1") a.t1 = std::atof(next().c_str());
+    else if (k == "--fps") a.fps = std::atof(next().c_str());
+    else if (k == "--verbose") a.verbose = true;
+    else {
+      std::fprintf(stderr, "registration_study: unknown argument %s\n", k.c_str());
+      return 2;
+    }
+  }
+  auto ctx = render::Context::create_headless();
+  if (!ctx) {
+    std::fprintf(stderr, "no headless OpenGL: %s\n", ctx.error().message.c_str());
+    return 1;
+  }
+  auto& context = *ctx.value();
+  const auto profiles = hand::load_hand_profiles(
+      a.user_file.empty() ? test::source("configs/hands.yaml") : a.user_file);
+  const auto* user = profiles.find(a.user_profile);
+  if (!user) user = &profiles.profiles.front();
+  const std::array<hand::HandModel, 2> truth_models{user->model(hand::Side::kLeft),
+                                                    user->model(hand::Side::kRight)};
+  std::array<hand::HandModel, 2> models{hand::default_hand_model(hand::Side::kLeft),
+                                        hand::default_hand_model(hand::Side::kRight)};
+  if (a.model_user) models = truth_models;
+  if (a.model_length > 0) {
+    hand::HandDimensions d = models[0].shape.dimensions;
+    d.length = a.model_length;
+    d.width = a.model_width;
+    models = {hand::make_hand_model(hand::Side::kLeft, d).value(),
+              hand::make_hand_model(hand::Side::kRight, d).value()};
+  }
+  const vision::Camera camera = vision::default_rig_camera();
+  auto film = sim::SyntheticCamera::create(context, camera, truth_models).value();
+  auto ceiling = sim::ModelCeiling::create(context, camera, truth_models,
+                                           pipeline::FramePipelineParams{}.model_skin).value();
+
+  const auto vc = vision::load_vision_config(test::source("configs/vision.yaml"));
+  pipeline::FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  p.registration.silhouette_term = a.silhouette;
+  if (a.no_balls) p.registration.joint_ball_sigma_px = 1000;
+  if (a.no_wrist) p.registration.wrist_sigma_px = 1000;
+  p.personalise_shape = a.personalise;
+  sim::RubiksTask task({});
+  task.fit_to_hands(truth_models);
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] =
+        task.nominal(a.t0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  auto pipe = pipeline::FramePipeline::create(context, camera, models, p).value();
+  sim::UserHands hands(truth_models, task);
+
+  SceneSnapshot scene;  // a cube where the user grasps
+  Shape cube;
+  cube.type = Shape::Type::kBox;
+  cube.size = Vec3(0.0285, 0.0285, 0.0285);
+  cube.rgba = {0.9f, 0.9f, 0.9f, 1.f};
+  cube.body = 1;
+  scene.shapes.push_back(cube);
+
+  sim::SyntheticFrame frame;
+  pipeline::FrameResult r;
+  sim::FrameTruthWorkspace ws;
+  std::array<double, 6> brace_k{};
+  int brace_n = 0;
+  std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
+  std::array<Vec3, 8> g;
+  for (double t = a.t0; t < a.t1 && !task.finished(t); t += 1.0 / a.fps) {
+    // The device's caps: at the face, pressed a fifth of the squeeze in (the displayed force
+    // holds the fingers near the touching positions; about what the demo's caps show).
+    std::array<Vec3, 8> touch;
+    task.goals(t, g);
+    task.touch_points(t, touch);
+    for (int f = 0; f < 8; ++f) g[f] = touch[f] + 0.2 * (g[f] - touch[f]);
+    hands.update(t, g);
+    device::FingertipSample s;
+    s.finger_count = 8;
+    for (int f = 0; f < 8; ++f) s.p_W[f] = {g[f].x(), g[f].y(), g[f].z()};
+    const auto& truth = hands.params();
+    if (!film->film({&truth[0], &truth[1]}, &frame).ok()) return 1;
+    if (auto st = pipe->process(frame.bgr, s, scene, &r); !st.ok()) {
+      std::fprintf(stderr, "%s\n", st.error().message.c_str());
+      return 1;
+    }
+    const auto m = sim::measure_frame(frame, r, p.compositor.mode, r.models, truth_models, truth,
+                                      camera, &ws).value();
+    const double c = ceiling->iou(truth, frame.hand_only).value();
+    // Fitted caps to the strings' caps, and the truth's caps to the strings' (the user's IK).
+    double obs_res = 0, cap_res = 0;
+    for (int h = 0; h < 2; ++h) {
+      const auto fit_pts = hand::forward_kinematics(r.models[h], r.hands[h]);
+      const auto true_pts = hand::forward_kinematics(truth_models[h], truth[h]);
+      for (int f = 0; f < 4; ++f) {
+        obs_res += (fit_pts.p_W_fingertip[f] - g[4 * h + f]).norm() / 8;
+        cap_res += (true_pts.p_W_fingertip[f] - g[4 * h + f]).norm() / 8;
+      }
+    }
+    if (a.verbose && cap_res > 0.002) {
+      for (int h = 0; h < 2; ++h) {
+        const auto true_pts = hand::forward_kinematics(truth_models[h], truth[h]);
+        std::printf("  hand %d caps off [mm]:", h);
+        for (int f = 0; f < 4; ++f) std::printf(" %.1f", 1e3 * (true_pts.p_W_fingertip[f] - g[4 * h + f]).norm());
+        std::printf("  at limits:");
+        const auto& lim = truth_models[h].limits;
+        for (int k = 6; k < hand::kParamCount; ++k)
+          if (truth[h][k] <= lim.lower[k] + 1e-6 || truth[h][k] >= lim.upper[k] - 1e-6) std::printf(" %d", k);
+        std::printf("\n");
+      }
+    }
+    // The bracelet's detected midpoint against the projection of the truth's band centre (on the
+    // forearm's axis) and of the band's visible surface centre (toward the camera).
+    for (int h = 0; h < 2; ++h) {
+      if (!r.bracelets[h].found) continue;
+      const Pose X_WH = hand::hand_pose(truth[h]);
+      const Vec3 p_WB = X_WH * Vec3(0.0, -0.012, 0.0);
+      const Vec3 axis = X_WH.R * Vec3::UnitY();
+      Vec3 n = camera.X_WC().p - p_WB;
+      n -= n.dot(axis) * axis;
+      n.normalize();
+      const double radius = 0.31 * truth_models[h].shape.dimensions.width + 0.002;
+      const Vec2 det = r.bracelets[h].wrist_px;
+      brace_axis.push_back((det - camera.project(p_WB)).norm());
+      brace_surf.push_back((det - camera.project(p_WB + (2.0 / 3.14159265) * radius * n)).norm());
+      for (int k = 0; k < 6; ++k)
+        brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
+      ++brace_n;
+    }
+    obs.push_back(1e3 * obs_res);
+    caps.push_back(1e3 * cap_res);
+    iou.push_back(m.iou);
+    tip.push_back(0.5 * (m.fingertip_mm[0] + m.fingertip_mm[1]));
+    joint.push_back(0.5 * (m.joint_px[0] + m.joint_px[1]));
+    ceil_iou.push_back(c);
+    if (m.contested_pixels > 0) {
+      contested.push_back(m.contested_pct());
+      contested_paper.push_back(m.contested_pct_paper());
+    }
+    if (a.verbose)
+      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f mm joints %.1f px  L %.4f/%.4f W %.4f/%.4f\n",
+                  t, m.iou, c, tip.back(), joint.back(), r.models[0].shape.dimensions.length,
+                  r.models[1].shape.dimensions.length, r.models[0].shape.dimensions.width,
+                  r.models[1].shape.dimensions.width);
+  }
+  std::printf(
+      "frames %zu  IoU mean %.3f p5 %.3f  ceiling %.3f (p5 %.3f)  tip %.2f mm (p95 %.2f)  joints "
+      "%.2f px  contested %.2f %% (paper %.2f %%)\n",
+      iou.size(), mean(iou), quantile(iou, 0.05), mean(ceil_iou), quantile(ceil_iou, 0.05),
+      mean(tip), quantile(tip, 0.95), mean(joint), mean(contested), mean(contested_paper));
+  std::printf("fitted caps to the strings %.2f mm (p95 %.2f), truth caps to the strings %.2f mm (max %.2f)\n",
+              mean(obs), quantile(obs, 0.95), mean(caps), quantile(caps, 1.0));
+  std::printf("bracelet midpoint to the band's axis centre %.2f px (p95 %.2f), to its visible surface %.2f px (p95 %.2f)\n",
+              mean(brace_axis), quantile(brace_axis, 0.95), mean(brace_surf), quantile(brace_surf, 0.95));
+  for (int k = 0; k < 6; ++k) std::printf("  shift %.1f r: %.2f px\n", 0.2 * k, brace_k[k] / std::max(brace_n, 1));
+  std::printf("final shape: left L %.4f W %.4f, right L %.4f W %.4f (truth L %.4f W %.4f)\n",
+              r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
+              r.models[1].shape.dimensions.length, r.models[1].shape.dimensions.width,
+              truth_models[0].shape.dimensions.length, truth_models[0].shape.dimensions.width);
+  return 0;
+}
