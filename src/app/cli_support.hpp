@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "spidar/core/result.hpp"
+#include "spidar/session/finite_json.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::app {
@@ -44,10 +45,8 @@ inline constexpr std::uint64_t kMaxSeed = 4294967295u;
 /// "-1" or "1e30" to some other seed (strtoull wraps and saturates) instead of refusing it.
 CLI::Validator seed_check();
 
-/// SpidarError naming the JSON path (e.g. "/haptic/jitter_p99_us") of the first number in `j`
-/// that is NaN or infinite, which nlohmann::json would write as null; `what` names the output
-/// ("report.json"). Call before writing any JSON.
-void require_finite_json(const nlohmann::json& j, std::string_view what);
+/// SpidarError naming the first non-finite number in `j` (session::require_finite_json).
+using session::require_finite_json;
 
 /// `x` if finite, else `fallback` (a statistic of an empty or broken set).
 inline double finite_or(double x, double fallback) { return std::isfinite(x) ? x : fallback; }
