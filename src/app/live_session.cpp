@@ -10,32 +10,6 @@
 
 namespace spidar::app {
 
-/// Every processed frame into the recording (frames.jsonl, the camera images).
-class LiveSession::RecorderSink final : public session::FrameSink {
- public:
-  RecorderSink(SessionRecorder& recorder, const RecordingDevice& device, const device::ServoLoop& loop)
-      : recorder_(recorder), device_(device), loop_(loop) {}
-  void on_start() override { recorder_.start(&device_, &loop_); }
-  void on_frame(const session::FrameEvent& e) override {
-    FrameRecord fr;
-    fr.index = static_cast<std::int64_t>(e.index);
-    fr.t_exposure_ns = e.t_exposure_ns;
-    fr.bgr = e.bgr->clone();  // written by the recorder's thread, after the source reused it
-    fr.measured = *e.measured;
-    fr.scene_poses.reserve(e.scene->shapes.size());
-    for (const Shape& sh : e.scene->shapes) fr.scene_poses.push_back(sh.X_WS);
-    fr.hands = e.result->hands;
-    fr.fits = e.result->fits;
-    recorder_.add_frame(std::move(fr));
-  }
-  void on_end(const session::SessionSummary& /*s*/) override { recorder_.stop(); }
-
- private:
-  SessionRecorder& recorder_;
-  const RecordingDevice& device_;
-  const device::ServoLoop& loop_;
-};
-
 pipeline::FramePipelineParams live_pipeline_params(const LiveConfig& c,
                                                    const std::array<Vec3, 2>& initial_r_W_hand) {
   auto mode = render::parse_composite_mode(c.compositor);
@@ -116,7 +90,7 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   s->session_->add_sink(s->view_);
 
   if (!options.record_dir.empty()) {
-    RecordingMeta meta;
+    session::RecorderSetup meta;
     meta.config_yaml = live_config_yaml(c);
     meta.width = c.width;
     meta.height = c.height;
@@ -125,10 +99,9 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
     meta.finger_count = static_cast<int>(device_config.fingers.size());
     meta.initial_r_W_hand = r0;
     meta.device_name = c.backend == "sim" ? "simulated " + device_config.name : "serial " + c.port;
-    s->recorder_ = std::make_unique<SessionRecorder>(options.record_dir, options.record_frames, meta);
-    s->recorder_sink_ = std::make_unique<RecorderSink>(*s->recorder_, *s->recording_device_,
-                                                       s->session_->servo());
-    s->session_->add_sink(*s->recorder_sink_);
+    s->recorder_ = std::make_unique<SessionRecorder>(options.record_dir, options.record_frames, meta,
+                                                     *s->recording_device_, s->session_->servo());
+    s->session_->add_sink(*s->recorder_);
   }
   return s;
 }

@@ -11,7 +11,6 @@
 #include <string>
 
 #include "live_config.hpp"
-#include "session_recorder.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/render/context.hpp"
@@ -20,11 +19,16 @@
 #include "spidar/session/rig.hpp"
 #include "spidar/session/scene.hpp"
 #include "spidar/session/session.hpp"
+#include "spidar/session/session_recorder.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::app {
 
 using LiveFrameStats = session::FrameStats;
+using session::DeviceCycleRecord;
+using session::FrameStore;
+using session::RecordingDevice;
+using session::SessionRecorder;
 using session::silhouette_iou;
 
 /// The pipeline parameters a live config asks for (shared by run and replay, so both fit alike).
@@ -92,7 +96,6 @@ class LiveSession {
   double seconds() const { return session_->seconds(); }
 
  private:
-  class RecorderSink;
   LiveSession() = default;
   LiveConfig config_;
   vision::Camera camera_;
@@ -101,7 +104,6 @@ class LiveSession {
   std::unique_ptr<session::Rig> rig_;
   std::unique_ptr<RecordingDevice> recording_device_;
   std::unique_ptr<SessionRecorder> recorder_;
-  std::unique_ptr<RecorderSink> recorder_sink_;
   session::FrameStatsSink view_;
   std::unique_ptr<session::Session> session_;
   pipeline::FrameResult no_result_;
