@@ -7,16 +7,6 @@
 
 namespace spidar::app {
 
-std::string resolve_data_path(const std::string& path) {
-  namespace fs = std::filesystem;
-  if (fs::exists(path)) return path;
-#ifdef SPIDAR_DATA_DIR
-  const fs::path installed = fs::path(SPIDAR_DATA_DIR) / path;
-  if (fs::exists(installed)) return installed.string();
-#endif
-  return path;  // the loader reports it missing
-}
-
 int find_finger(const strings::DeviceConfig& cfg, const std::string& finger) {
   const int n = static_cast<int>(cfg.fingers.size());
   int index = -1;

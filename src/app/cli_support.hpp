@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "spidar/core/result.hpp"
+#include "spidar/session/data_path.hpp"
 #include "spidar/session/finite_json.hpp"
 #include "spidar/strings/device_config.hpp"
 
@@ -27,9 +28,8 @@ class UsageError : public SpidarError {
   using SpidarError::SpidarError;
 };
 
-/// Resolves a data file given relative to the project (e.g. "configs/spidar8.yaml"): as given if
-/// it exists, else under the installed data directory.
-std::string resolve_data_path(const std::string& path);
+/// Resolves a data file given relative to the project (session::resolve_data_path).
+using session::resolve_data_path;
 
 /// Finger by index ("3") or by name ("left_ring"); UsageError listing the valid ones otherwise.
 int find_finger(const strings::DeviceConfig& cfg, const std::string& finger);

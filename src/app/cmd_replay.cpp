@@ -11,8 +11,8 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
-#include "live_config.hpp"
-#include "live_session.hpp"
+#include "spidar/session/live_config.hpp"
+#include "spidar/session/live_session.hpp"
 #include "spidar/render/video_output.hpp"
 #include "spidar/session/output_sinks.hpp"
 #include "spidar/session/recording_rig.hpp"
@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 nlohmann::json replay_recording(const std::string& dir, const std::string& out, bool video_out) {
   const fs::path d(dir);
   session::Recording rec = session::read_recording(dir);
-  const LiveConfig cfg = load_live_config(rec.config_path, false);
+  const session::LiveConfig cfg = session::load_live_config(rec.config_path, false);
   if (rec.meta.width != cfg.width || rec.meta.height != cfg.height)
     throw UsageError((d / "session.json").string() + ": size " + std::to_string(rec.meta.width) + "x" +
                      std::to_string(rec.meta.height) + " differs from config.yaml's " +
@@ -59,7 +59,7 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
 
   session::SessionParams sp;
   sp.warm_up = false;  // the recorded fits started cold from the recording's start rotations
-  sp.pipeline = live_pipeline_params(cfg, r0);
+  sp.pipeline = session::live_pipeline_params(cfg, r0);
   auto session = session::Session::create(rig, **scene_r, *context, camera, models, sp);
   session::ReplayScorer scorer(rig);
   session->add_sink(scorer);
