@@ -26,7 +26,6 @@ int find_finger(const strings::DeviceConfig& cfg, const std::string& finger) {
                    "; expected one of " + names);
 }
 
-nlohmann::json to_json(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 
 void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit) {
   if (x >= lo && x <= hi) return;

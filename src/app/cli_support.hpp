@@ -34,7 +34,7 @@ using session::resolve_data_path;
 /// Finger by index ("3") or by name ("left_ring"); UsageError listing the valid ones otherwise.
 int find_finger(const strings::DeviceConfig& cfg, const std::string& finger);
 
-nlohmann::json to_json(const Vec3& v);
+using session::to_json;
 
 /// UsageError unless lo <= x <= hi (NaN is refused too): "--seconds: expected 0 to 600 s, got nan".
 void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit = "");
