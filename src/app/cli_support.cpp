@@ -7,16 +7,6 @@
 
 namespace spidar::app {
 
-std::string resolve_data_path(const std::string& path) {
-  namespace fs = std::filesystem;
-  if (fs::exists(path)) return path;
-#ifdef SPIDAR_DATA_DIR
-  const fs::path installed = fs::path(SPIDAR_DATA_DIR) / path;
-  if (fs::exists(installed)) return installed.string();
-#endif
-  return path;  // the loader reports it missing
-}
-
 int find_finger(const strings::DeviceConfig& cfg, const std::string& finger) {
   const int n = static_cast<int>(cfg.fingers.size());
   int index = -1;
@@ -36,7 +26,6 @@ int find_finger(const strings::DeviceConfig& cfg, const std::string& finger) {
                    "; expected one of " + names);
 }
 
-nlohmann::json to_json(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 
 void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit) {
   if (x >= lo && x <= hi) return;
@@ -57,41 +46,6 @@ CLI::Validator seed_check() {
         return {};
       },
       "SEED 0.." + std::to_string(kMaxSeed));
-}
-
-namespace {
-
-/// The first non-finite number under `j`, as a JSON pointer ("" if none).
-bool find_non_finite(const nlohmann::json& j, const std::string& path, std::string* where, double* value) {
-  if (j.is_number_float()) {
-    const double v = j.get<double>();
-    if (std::isfinite(v)) return false;
-    *where = path.empty() ? "/" : path;
-    *value = v;
-    return true;
-  }
-  if (j.is_object()) {
-    for (auto it = j.begin(); it != j.end(); ++it) {
-      if (find_non_finite(*it, path + "/" + it.key(), where, value)) return true;
-    }
-  } else if (j.is_array()) {
-    for (std::size_t i = 0; i < j.size(); ++i) {
-      if (find_non_finite(j[i], path + "/" + std::to_string(i), where, value)) return true;
-    }
-  }
-  return false;
-}
-
-}  // namespace
-
-void require_finite_json(const nlohmann::json& j, std::string_view what) {
-  std::string where;
-  double v = 0;
-  if (!find_non_finite(j, "", &where, &v)) return;
-  std::ostringstream os;
-  os << std::string(what) << ": " << where << " is " << v
-     << " (a bug: every number written must be finite; JSON would show it as null)";
-  throw SpidarError(os.str());
 }
 
 }  // namespace spidar::app

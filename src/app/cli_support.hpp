@@ -8,6 +8,8 @@
 #include <string_view>
 
 #include "spidar/core/result.hpp"
+#include "spidar/session/data_path.hpp"
+#include "spidar/session/finite_json.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::app {
@@ -26,14 +28,13 @@ class UsageError : public SpidarError {
   using SpidarError::SpidarError;
 };
 
-/// Resolves a data file given relative to the project (e.g. "configs/spidar8.yaml"): as given if
-/// it exists, else under the installed data directory.
-std::string resolve_data_path(const std::string& path);
+/// Resolves a data file given relative to the project (session::resolve_data_path).
+using session::resolve_data_path;
 
 /// Finger by index ("3") or by name ("left_ring"); UsageError listing the valid ones otherwise.
 int find_finger(const strings::DeviceConfig& cfg, const std::string& finger);
 
-nlohmann::json to_json(const Vec3& v);
+using session::to_json;
 
 /// UsageError unless lo <= x <= hi (NaN is refused too): "--seconds: expected 0 to 600 s, got nan".
 void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit = "");
@@ -44,10 +45,8 @@ inline constexpr std::uint64_t kMaxSeed = 4294967295u;
 /// "-1" or "1e30" to some other seed (strtoull wraps and saturates) instead of refusing it.
 CLI::Validator seed_check();
 
-/// SpidarError naming the JSON path (e.g. "/haptic/jitter_p99_us") of the first number in `j`
-/// that is NaN or infinite, which nlohmann::json would write as null; `what` names the output
-/// ("report.json"). Call before writing any JSON.
-void require_finite_json(const nlohmann::json& j, std::string_view what);
+/// SpidarError naming the first non-finite number in `j` (session::require_finite_json).
+using session::require_finite_json;
 
 /// `x` if finite, else `fallback` (a statistic of an empty or broken set).
 inline double finite_or(double x, double fallback) { return std::isfinite(x) ? x : fallback; }

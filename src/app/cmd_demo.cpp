@@ -1,11 +1,34 @@
 // spidar-mr demo: the best demonstration available (see demo.hpp for the scenarios).
+#include <iostream>
 #include <memory>
 
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "demo.hpp"
+#include "spidar/session/scenarios.hpp"
 
 namespace spidar::app {
+
+namespace {
+
+session::ScenarioOptions scenario_options(const DemoOptions& o) {
+  return {o.config, o.scene, o.out, o.seconds, o.rate_hz, o.seed};
+}
+
+}  // namespace
+
+int run_haptic_demo(const DemoOptions& o) {
+  const device::ServoStats ss = session::run_haptic_scenario(scenario_options(o), std::cout);
+  if (ss.faults == 0) return 0;
+  std::cerr << "spidar-mr demo: the servo loop latched " << device::fault_names(ss.faults) << ": "
+            << ss.fault_message << " (the report is written; exit code " << kExitFault << ")\n";
+  return kExitFault;
+}
+
+int run_strings_demo(const DemoOptions& o) {
+  session::run_strings_walkthrough(scenario_options(o), std::cout);
+  return 0;
+}
 
 Action add_demo(CLI::App& app) {
   auto* cmd = app.add_subcommand("demo", "Run a demonstration on the simulated SPIDAR-8");

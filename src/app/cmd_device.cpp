@@ -1,6 +1,5 @@
 // spidar-mr device-test: run the servo loop on a device with zero desired force and report
 // loop statistics as JSON.
-#include <csignal>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -8,17 +7,11 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "device_backends.hpp"
+#include "signal_scope.hpp"
 #include "spidar/device/serial_device.hpp"
 #include "spidar/device/servo_loop.hpp"
 
 namespace spidar::app {
-namespace {
-
-std::atomic<bool> g_interrupted{false};
-void on_signal(int) { g_interrupted.store(true); }
-
-}  // namespace
-
 Action add_device_test(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "device-test", "Run the servo loop with zero force and print loop statistics (JSON)");
@@ -43,10 +36,9 @@ Action add_device_test(CLI::App& app) {
     servo.rate_hz = *rate;
     servo.max_seconds = *seconds;
     device::ServoLoop loop(*dev, cfg, servo, std::make_shared<device::ZeroForce>());
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
+    SignalScope signals;  // SIGINT / SIGTERM end the run early, with its statistics printed
     if (auto st = loop.start(); !st.ok()) throw UsageError(st.error().message);
-    while (loop.running() && !g_interrupted.load()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    while (loop.running() && SignalScope::received() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     loop.stop();
     dev->close();
 

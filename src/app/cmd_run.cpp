@@ -12,14 +12,14 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "live_gui.hpp"
-#include "live_session.hpp"
+#include "spidar/session/live_session.hpp"
 #include "signal_scope.hpp"
 #include "spidar/core/config.hpp"
 
 namespace spidar::app {
 namespace {
 
-nlohmann::json summary_json(const LiveSession& s, const std::string& ended_by, double wall_s) {
+nlohmann::json summary_json(const session::LiveSession& s, const std::string& ended_by, double wall_s) {
   nlohmann::json j;
   j["ended_by"] = ended_by;
   j["seconds"] = wall_s;
@@ -34,7 +34,7 @@ nlohmann::json summary_json(const LiveSession& s, const std::string& ended_by, d
                        {"ms_mean", s.view().registration_ms_mean()}};
   if (auto c = s.cube_status())
     j["cube"] = {{"turns", c->turns}, {"solved", c->solved}, {"lift_mm", c->lift * 1e3}};
-  if (const SessionRecorder* r = s.recorder()) {
+  if (const session::SessionRecorder* r = s.recorder()) {
     j["recording"] = {{"dir", r->dir()},
                       {"device_cycles", r->device_records()},
                       {"fingertip_samples", r->fingertip_records()},
@@ -75,19 +75,19 @@ Action add_run(CLI::App& app) {
   return [a] {
     require_range(a->seconds, 0, 86400, "--seconds", "s");
     SignalScope signals;  // from the start: a signal during start-up ends the session once it runs
-    const LiveConfig cfg = load_live_config(a->config);
-    LiveSessionOptions opt;
+    const session::LiveConfig cfg = session::load_live_config(a->config);
+    session::LiveSessionOptions opt;
     opt.record_dir = a->record;
-    opt.record_frames = a->record_frames == "png"    ? FrameStore::kPng
-                        : a->record_frames == "mjpg" ? FrameStore::kMjpg
-                                                     : FrameStore::kVideo;
+    opt.record_frames = a->record_frames == "png"    ? session::FrameStore::kPng
+                        : a->record_frames == "mjpg" ? session::FrameStore::kMjpg
+                                                     : session::FrameStore::kVideo;
 
     if (!a->headless) return run_gui(cfg, opt, a->seconds, a->screenshot, g_signal);
 
     auto ctx_r = render::Context::create_headless();
     if (!ctx_r) throw SpidarError("OpenGL: " + ctx_r.error().message);
     auto context = std::move(ctx_r).value();
-    auto session = LiveSession::create(cfg, *context, opt);
+    auto session = session::LiveSession::create(cfg, *context, opt);
     std::cerr << "spidar-mr run: " << cfg.source << ": device " << cfg.backend << ", camera "
               << cfg.camera_source << " " << cfg.width << "x" << cfg.height << ", compositor "
               << cfg.compositor << (a->record.empty() ? "" : ", recording to " + a->record)
@@ -119,7 +119,7 @@ Action add_run(CLI::App& app) {
     require_finite_json(j, "run's summary");
     std::cout << j.dump(2) << "\n";
     // A recording that could not be written whole (a full disk, an I/O error): exit 2 naming the file.
-    if (const SessionRecorder* r = session->recorder(); r != nullptr && !r->error().empty()) {
+    if (const session::SessionRecorder* r = session->recorder(); r != nullptr && !r->error().empty()) {
       std::cerr << "spidar-mr: error: --record: " << r->error() << " (the recording is incomplete)\n";
       return kExitBadInput;
     }

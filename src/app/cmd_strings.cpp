@@ -55,6 +55,17 @@ void require_in_workspace(const strings::DeviceConfig& cfg, const Vec3& p_W, con
                    " m of the box of " + cfg.source + "'s fulcrums");
 }
 
+/// What position and tension take first: the device config and a finger.
+struct FingerArgs {
+  std::string config = "configs/spidar8.yaml";
+  std::string finger;
+};
+
+void add_finger_options(CLI::App& cmd, FingerArgs& a) {
+  cmd.add_option("--config", a.config, "device config (YAML)")->capture_default_str();
+  cmd.add_option("--finger", a.finger, "finger index or name")->required();
+}
+
 }  // namespace
 
 Action add_check_config(CLI::App& app) {
@@ -75,14 +86,11 @@ Action add_check_config(CLI::App& app) {
 
 Action add_position(CLI::App& app) {
   auto* cmd = app.add_subcommand("position", "Fingertip position from string lengths (JSON)");
-  struct Args {
-    std::string config = "configs/spidar8.yaml";
-    std::string finger;
+  struct Args : FingerArgs {
     std::vector<double> lengths;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("--config", a->config, "device config (YAML)")->capture_default_str();
-  cmd->add_option("--finger", a->finger, "finger index or name")->required();
+  add_finger_options(*cmd, *a);
   cmd->add_option("--lengths", a->lengths, "string lengths [m], one per string")
       ->required()
       ->expected(1, -1);
@@ -125,14 +133,11 @@ Action add_position(CLI::App& app) {
 
 Action add_tension(CLI::App& app) {
   auto* cmd = app.add_subcommand("tension", "String tensions displaying a force (JSON)");
-  struct Args {
-    std::string config = "configs/spidar8.yaml";
-    std::string finger;
+  struct Args : FingerArgs {
     std::vector<double> position, force;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("--config", a->config, "device config (YAML)")->capture_default_str();
-  cmd->add_option("--finger", a->finger, "finger index or name")->required();
+  add_finger_options(*cmd, *a);
   cmd->add_option("--position", a->position, "fingertip position X Y Z [m]")
       ->required()
       ->expected(3);

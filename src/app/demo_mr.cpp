@@ -15,7 +15,7 @@
 #include "spidar/core/atomic_write.hpp"
 #include "spidar/core/units.hpp"
 #include "demo.hpp"
-#include "demo_mr_report.hpp"
+#include "spidar/session/run_report.hpp"
 #include "progress.hpp"
 #include "signal_scope.hpp"
 #include "spidar/physics/mujoco_log.hpp"
@@ -30,6 +30,10 @@
 namespace spidar::app {
 
 namespace fs = std::filesystem;
+using session::MrFrame;
+using session::MrSummary;
+using session::MrTrace;
+using session::write_mr_report;
 
 namespace {
 

@@ -12,7 +12,7 @@
 
 namespace spidar::app {
 
-void CameraCalibrationPanel::draw(LiveSession& s) {
+void CameraCalibrationPanel::draw(session::LiveSession& s) {
   const strings::DeviceConfig& cfg = s.device_config();
   if (finger_ < 0) {  // the right index finger by default: the one a person points with
     finger_ = 0;
@@ -151,7 +151,7 @@ void CameraCalibrationPanel::draw(LiveSession& s) {
   if (!message_.empty()) ImGui::TextWrapped("%s", message_.c_str());
 }
 
-void CameraCalibrationPanel::on_view(const LiveSession& s, const ImVec2& image_min, float scale) {
+void CameraCalibrationPanel::on_view(const session::LiveSession& s, const ImVec2& image_min, float scale) {
   if (!cal_ || scale <= 0) return;
   ImDrawList* dl = ImGui::GetWindowDrawList();
   auto screen = [&](const Vec2& uv) {

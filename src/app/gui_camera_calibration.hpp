@@ -10,7 +10,7 @@
 #include <optional>
 #include <string>
 
-#include "live_session.hpp"
+#include "spidar/session/live_session.hpp"
 #include "spidar/device/unwrapped_counts.hpp"
 #include "spidar/strings/stability_check.hpp"
 #include "spidar/vision/marker_calibration.hpp"
@@ -20,12 +20,12 @@ namespace spidar::app {
 class CameraCalibrationPanel {
  public:
   /// The panel's own window contents.
-  void draw(LiveSession& s);
+  void draw(session::LiveSession& s);
   /// Called right after the view's image was drawn: `image_min` is its top-left corner on the
   /// screen and `scale` screen pixels per camera pixel. Takes a click on the image as the pending
   /// marker's pixel and draws the markers (green: done, yellow: where the present calibration
   /// expects the pending one).
-  void on_view(const LiveSession& s, const ImVec2& image_min, float scale);
+  void on_view(const session::LiveSession& s, const ImVec2& image_min, float scale);
   /// True while the panel waits for a click in the view.
   bool wants_click() const { return cal_ && cal_->pending(); }
 

@@ -107,7 +107,7 @@ class Texture {
 };
 
 /// The image a view shows, from the last processed frame.
-cv::Mat view_image(View view, const LiveSession& s) {
+cv::Mat view_image(View view, const session::LiveSession& s) {
   const pipeline::FrameResult& r = s.result();
   switch (view) {
     case View::kComposite:
@@ -143,7 +143,7 @@ cv::Mat view_image(View view, const LiveSession& s) {
 
 /// The last `n` values of a history field, as floats for ImGui's plots.
 template <typename F>
-std::vector<float> series(const session::HistoryRing<LiveFrameStats>& h, std::size_t n, F field) {
+std::vector<float> series(const session::HistoryRing<session::LiveFrameStats>& h, std::size_t n, F field) {
   std::vector<float> v;
   const std::size_t start = h.size() > n ? h.size() - n : 0;
   v.reserve(h.size() - start);
@@ -157,7 +157,7 @@ void plot(const char* label, const std::vector<float>& v, const char* fmt, float
   ImGui::PlotLines(label, v.data(), static_cast<int>(v.size()), 0, overlay, lo, hi, ImVec2(0, 60));
 }
 
-void device_panel(LiveSession& s) {
+void device_panel(session::LiveSession& s) {
   const strings::DeviceConfig& cfg = s.device_config();
   const device::FingertipSample& m = s.measured();
   const auto limits = cfg.effective_limits();
@@ -174,9 +174,9 @@ void device_panel(LiveSession& s) {
   ImGui::PopStyleColor();
 
   const auto& h = s.history();
-  plot("loop rate [Hz]", series(h, 300, [](const LiveFrameStats& x) { return x.servo_rate_hz; }), "%.0f Hz",
+  plot("loop rate [Hz]", series(h, 300, [](const session::LiveFrameStats& x) { return x.servo_rate_hz; }), "%.0f Hz",
        0.0f, static_cast<float>(s.config().rate_hz * 1.2));
-  plot("jitter max [us]", series(h, 300, [](const LiveFrameStats& x) { return x.servo_jitter_max_us; }),
+  plot("jitter max [us]", series(h, 300, [](const session::LiveFrameStats& x) { return x.servo_jitter_max_us; }),
        "%.0f us", 0.0f, FLT_MAX);
 
   if (ImGui::BeginTable("strings", 4, ImGuiTableFlags_SizingStretchProp)) {
@@ -228,21 +228,21 @@ void device_panel(LiveSession& s) {
   }
 }
 
-void registration_panel(const LiveSession& s) {
+void registration_panel(const session::LiveSession& s) {
   const auto& h = s.history();
   if (h.empty()) {
     ImGui::TextUnformatted("waiting for the first frame");
     return;
   }
-  const LiveFrameStats& last = h.back();
+  const session::LiveFrameStats& last = h.back();
   ImGui::Text("frames %llu of %llu filmed   latency %.0f ms   pipeline %.0f ms",
               static_cast<unsigned long long>(s.frames()), static_cast<unsigned long long>(s.camera_frames()),
               last.latency_ms, last.pipeline_ms);
   ImGui::Text("iterations: left %d, right %d", last.iterations[0], last.iterations[1]);
-  plot("IoU vs matte", series(h, 300, [](const LiveFrameStats& x) { return x.iou; }), "%.3f", 0.0f, 1.0f);
+  plot("IoU vs matte", series(h, 300, [](const session::LiveFrameStats& x) { return x.iou; }), "%.3f", 0.0f, 1.0f);
   static const char* kTerms[] = {"fingertip", "wrist", "joint-ball", "silhouette", "prior"};
   for (int t = 0; t < 5; ++t) {
-    auto v = series(h, 300, [t](const LiveFrameStats& x) {
+    auto v = series(h, 300, [t](const session::LiveFrameStats& x) {
       double sum = 0;
       for (const auto& term : x.terms) {
         const double a[5] = {term.fingertip, term.wrist, term.joint_ball, term.silhouette, term.prior};
@@ -252,11 +252,11 @@ void registration_panel(const LiveSession& s) {
     });
     plot(kTerms[t], v, "%.3g", 0.0f, FLT_MAX);
   }
-  plot("iterations", series(h, 300, [](const LiveFrameStats& x) { return x.iterations[0] + x.iterations[1]; }),
+  plot("iterations", series(h, 300, [](const session::LiveFrameStats& x) { return x.iterations[0] + x.iterations[1]; }),
        "%.0f", 0.0f, FLT_MAX);
 }
 
-void scene_panel(LiveSession& s) {
+void scene_panel(session::LiveSession& s) {
   const auto st = s.cube_status();
   if (!s.cube().has_cube()) ImGui::TextUnformatted("no Rubik's cube in this scene");
   if (st) {
@@ -317,7 +317,7 @@ void hands_panel(session::InteractiveHands& ih, GLFWwindow* window, double dt) {
 /// session keeps its calibration until restarted.
 class CalibrationPanel {
  public:
-  void draw(LiveSession& s) {
+  void draw(session::LiveSession& s) {
     const strings::DeviceConfig& cfg = s.device_config();
     std::vector<const char*> names;
     for (const auto& f : cfg.fingers) names.push_back(f.name.c_str());
@@ -397,7 +397,7 @@ cv::Mat read_default_framebuffer(const Gl& gl, int w, int h) {
 
 }  // namespace
 
-int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double seconds,
+int run_gui(const session::LiveConfig& cfg, const session::LiveSessionOptions& options, double seconds,
             const std::string& screenshot, std::atomic<int>& signal) {
   render::WindowParams wp;
   wp.width = cfg.window_width;
@@ -412,9 +412,9 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   Gl gl;
   if (!gl.load()) throw SpidarError("window: GL entry points missing (glfwGetProcAddress)");
 
-  LiveSessionOptions no_warm_up = options;  // the window is up: show frames at once
+  session::LiveSessionOptions no_warm_up = options;  // the window is up: show frames at once
   no_warm_up.warm_up = false;
-  auto session = LiveSession::create(cfg, *context, no_warm_up);
+  auto session = session::LiveSession::create(cfg, *context, no_warm_up);
   // Sticky keys: a tap shorter than one GUI frame (the space bar's emergency stop above all) is
   // still seen by the next glfwGetKey.
   glfwSetInputMode(window, GLFW_STICKY_KEYS, GLFW_TRUE);
@@ -567,7 +567,7 @@ int run_gui(const LiveConfig& cfg, const LiveSessionOptions& options, double sec
   }
   std::cout << summary.dump() << "\n";
   if (!session->error().empty()) std::cerr << "spidar-mr run: " << session->error() << "\n";
-  if (const SessionRecorder* r = session->recorder(); r != nullptr && !r->error().empty()) {
+  if (const session::SessionRecorder* r = session->recorder(); r != nullptr && !r->error().empty()) {
     std::cerr << "spidar-mr: error: --record: " << r->error() << " (the recording is incomplete)\n";
     return kExitBadInput;
   }

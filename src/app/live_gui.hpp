@@ -8,15 +8,15 @@
 #include <atomic>
 #include <string>
 
-#include "live_config.hpp"
-#include "live_session.hpp"
+#include "spidar/session/live_config.hpp"
+#include "spidar/session/live_session.hpp"
 
 namespace spidar::app {
 
 /// Runs the session in a window until it is closed, `seconds` pass (0: no limit), `signal`
 /// becomes non-zero (SIGINT/SIGTERM) or the session ends. With `screenshot`, the window's last
 /// frame (default framebuffer, glReadPixels) is written there as PNG. Returns the exit code.
-int run_gui(const LiveConfig& config, const LiveSessionOptions& options, double seconds,
+int run_gui(const session::LiveConfig& config, const session::LiveSessionOptions& options, double seconds,
             const std::string& screenshot, std::atomic<int>& signal);
 
 }  // namespace spidar::app

@@ -8,8 +8,11 @@
 
 namespace spidar::session {
 
-CsvCursor::CsvCursor(std::istream& in, std::string name, std::vector<std::string> columns)
+CsvCursor::CsvCursor(std::istream& in, std::string name, std::vector<std::string> columns,
+                     const std::vector<std::string>& optional)
     : in_(in), name_(std::move(name)), columns_(std::move(columns)) {
+  const std::size_t required = columns_.size();
+  columns_.insert(columns_.end(), optional.begin(), optional.end());
   const std::string expected = "expected the header row of a version-" + std::to_string(kRecordingVersion) +
                                " recording: " + quote(header_row(columns_));
   if (!read_line()) fail_line("empty file; " + expected, 1);
@@ -26,6 +29,13 @@ CsvCursor::CsvCursor(std::istream& in, std::string name, std::vector<std::string
       throw RecordingError(name_, line_, static_cast<int>(starts_[i] + 1),
                            "column " + quote(fields_[i]) + " appears twice; " + expected);
     position_[k] = i;
+  }
+  // The optional group: all of its columns or none (then they are not expected in the rows).
+  has_optional_ = false;
+  for (std::size_t k = required; k < columns_.size(); ++k) has_optional_ = has_optional_ || position_[k] != SIZE_MAX;
+  if (!has_optional_) {
+    columns_.resize(required);
+    position_.resize(required);
   }
   for (std::size_t k = 0; k < columns_.size(); ++k)
     if (position_[k] == SIZE_MAX) fail_line("no column " + quote(columns_[k]) + "; " + expected);

@@ -16,8 +16,10 @@ class CsvCursor {
   /// Longest line accepted [bytes]: our widest row is about 1.3 kB.
   static constexpr std::size_t kMaxLineBytes = 64 * 1024;
 
-  /// Reads and checks the header row against `columns`. Throws RecordingError.
-  CsvCursor(std::istream& in, std::string name, std::vector<std::string> columns);
+  /// Reads and checks the header row against `columns` and the `optional` group of columns
+  /// (a newer addition: the header has all of them or none). Throws RecordingError.
+  CsvCursor(std::istream& in, std::string name, std::vector<std::string> columns,
+            const std::vector<std::string>& optional = {});
 
   /// Reads the next row; false at the end of the file. Throws RecordingError for an empty line, a
   /// row with too few or too many fields, or a last row cut off (no line end).
@@ -25,6 +27,8 @@ class CsvCursor {
 
   /// Index of column `name` in the expected columns (for the accessors below).
   std::size_t col(std::string_view name) const;
+  /// True if the file has the optional columns.
+  bool has_optional() const { return has_optional_; }
 
   std::string_view text(std::size_t c) const;
   bool empty(std::size_t c) const { return text(c).empty(); }
@@ -57,6 +61,7 @@ class CsvCursor {
   std::vector<std::string_view> fields_;
   std::vector<std::size_t> starts_;  ///< 0-based byte column of each field
   int line_ = 0;
+  bool has_optional_ = false;
 };
 
 }  // namespace spidar::session

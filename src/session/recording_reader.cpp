@@ -238,12 +238,23 @@ std::uint64_t read_device_csv(std::istream& in, const std::string& name, int str
   return rows;
 }
 
-std::vector<device::FingertipSample> read_fingertips_csv(std::istream& in, const std::string& name, int finger_count) {
-  CsvCursor c(in, name, fingertip_columns());
+std::vector<device::FingertipSample> read_fingertips_csv(std::istream& in, const std::string& name, int finger_count,
+                                                         int string_count) {
+  CsvCursor c(in, name, fingertip_columns(), servo_output_columns(std::clamp(string_count, 0, device::kMaxDeviceStrings)));
   const std::size_t t = c.col("t_ns"), cycle = c.col("cycle");
+  const bool outputs = c.has_optional() && string_count > 0;
+  const std::size_t tension0 = outputs ? c.col("tension0") : 0, motor0 = outputs ? c.col("motor0") : 0;
   std::vector<device::FingertipSample> out;
   while (c.next()) {
     device::FingertipSample s = read_sample(c, finger_count);
+    if (outputs) {
+      s.string_count = string_count;
+      for (int i = 0; i < string_count; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        s.tension[k] = c.number(tension0 + k);
+        s.command[k] = static_cast<std::int32_t>(c.integer(motor0 + k, INT32_MIN, INT32_MAX));
+      }
+    }
     s.t_ns = c.integer(t, 0);
     s.cycle = c.unsigned_integer(cycle);
     if (!out.empty() && s.cycle <= out.back().cycle)
@@ -433,7 +444,7 @@ Recording read_recording(const std::string& dir) {
   const std::string fingertips_path = (d / files::kFingertips).string();
   {
     std::ifstream in = open_csv(fingertips_path);
-    r.fingertips = read_fingertips_csv(in, fingertips_path, r.meta.finger_count);
+    r.fingertips = read_fingertips_csv(in, fingertips_path, r.meta.finger_count, r.meta.string_count);
     require_rows(fingertips_path, static_cast<int>(r.fingertips.size() + 2), r.fingertips.size(), r.rows.fingertips,
                  "fingertips");
   }

@@ -23,6 +23,13 @@ std::vector<std::string> fingertip_columns() {
   return c;
 }
 
+std::vector<std::string> servo_output_columns(int string_count) {
+  std::vector<std::string> c;
+  for (int i = 0; i < string_count; ++i) c.push_back("tension" + std::to_string(i));
+  for (int i = 0; i < string_count; ++i) c.push_back("motor" + std::to_string(i));
+  return c;
+}
+
 std::vector<std::string> frame_columns() {
   std::vector<std::string> c = {"frame", "t_exposure_ns", "image"};
   for (auto& s : sample_columns()) c.push_back(std::move(s));

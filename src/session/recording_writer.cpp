@@ -46,9 +46,11 @@ std::string device_row_text(const DeviceCycleRecord& r, int string_count) {
   return row + '\n';
 }
 
-std::string fingertip_row_text(const device::FingertipSample& s) {
+std::string fingertip_row_text(const device::FingertipSample& s, int string_count) {
   std::string row = std::to_string(s.t_ns) + ',' + std::to_string(s.cycle) + ',';
   append_sample(row, s);
+  for (int i = 0; i < string_count; ++i) row += ',' + number_text(i < s.string_count ? s.tension[i] : 0.0);
+  for (int i = 0; i < string_count; ++i) row += ',' + std::to_string(i < s.string_count ? s.command[i] : 0);
   return row + '\n';
 }
 
@@ -99,7 +101,9 @@ RecordingWriter::RecordingWriter(std::string dir, const RecordingMeta& meta, std
   core::write_file_atomic((d / files::kConfig).string(), config_yaml);
   write_session_json(false);
   device_ = open_csv(d, files::kDevice, device_columns(meta_.string_count));
-  fingertips_ = open_csv(d, files::kFingertips, fingertip_columns());
+  std::vector<std::string> fingertip_header = fingertip_columns();
+  for (auto& c : servo_output_columns(meta_.string_count)) fingertip_header.push_back(std::move(c));
+  fingertips_ = open_csv(d, files::kFingertips, fingertip_header);
   frames_ = open_csv(d, files::kFrames, frame_columns());
   scene_ = open_csv(d, files::kScene, scene_columns());
   fits_ = open_csv(d, files::kFits, fit_columns());
@@ -146,7 +150,7 @@ bool RecordingWriter::write_device(const DeviceCycleRecord& r) {
 }
 
 bool RecordingWriter::write_fingertip(const device::FingertipSample& s) {
-  if (!fingertips_->write(fingertip_row_text(s))) return false;
+  if (!fingertips_->write(fingertip_row_text(s, meta_.string_count))) return false;
   if (counts_.fingertips == 0) t_first_ns_ = s.t_ns;
   t_last_ns_ = s.t_ns;
   ++counts_.fingertips;

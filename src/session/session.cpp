@@ -19,16 +19,18 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
                                          const SessionParams& params, device::Device* drive) {
   std::unique_ptr<Session> s(new Session(rig, scene, context, params));
   s->camera_ = camera;
-  // --- the haptic side: servo loop ↔ bridge ↔ physics thread ---
-  HapticSideParams hp;
-  hp.servo = params.servo;
-  hp.physics_priority = params.physics_priority;
-  hp.snapshot_proxies = false;  // the fitted hands are drawn instead
-  s->haptic_ = std::make_unique<HapticSide>(drive != nullptr ? *drive : rig.device(),
-                                            rig.device_config(), *scene.world,
-                                            scene.params.coupling, hp);
-  CubeMonitor* monitor = scene.monitor.get();
-  s->haptic_->set_before_step([monitor](physics::World& w) { monitor->before_step(w); });
+  // --- the haptic side: servo loop ↔ bridge ↔ physics thread (none when playing back) ---
+  if (!rig.plays_back()) {
+    HapticSideParams hp;
+    hp.servo = params.servo;
+    hp.physics_priority = params.physics_priority;
+    hp.snapshot_proxies = false;  // the fitted hands are drawn instead
+    s->haptic_ = std::make_unique<HapticSide>(drive != nullptr ? *drive : rig.device(),
+                                              rig.device_config(), *scene.world,
+                                              scene.params.coupling, hp);
+    CubeMonitor* monitor = scene.monitor.get();
+    s->haptic_->set_before_step([monitor](physics::World& w) { monitor->before_step(w); });
+  }
   // --- the frame side ---
   auto pipe_r = pipeline::FramePipeline::create(context, camera, models, params.pipeline);
   if (!pipe_r) throw SpidarError(pipe_r.error().message);
@@ -71,7 +73,13 @@ void Session::warm_up() {
 void Session::start() {
   if (started_) return;
   if (params_.warm_up) warm_up();
-  haptic_->start();  // throws with the haptic side stopped again
+  if (haptic_) {
+    haptic_->start();  // throws with the haptic side stopped again
+    t_start_ns_ = haptic_->t_open_ns();
+  } else {
+    t_start_ns_ = core::monotonic_ns();
+    scene_.world->snapshot(snapshot_, false);  // the shapes the recorded poses apply to
+  }
   started_ = true;
   try {
     for (FrameSink* k : sinks_) k->on_start();
@@ -79,18 +87,56 @@ void Session::start() {
     stop_threads();
     throw;
   }
-  if (auto st = rig_.camera().start(haptic_->t_open_ns()); !st) {
+  if (auto st = rig_.camera().start(t_start_ns_); !st) {
     stop_threads();
     throw SpidarError("camera: " + st.error().message);
   }
 }
 
+bool Session::servo_running() const { return !haptic_ || haptic_->loop().running(); }
+
 bool Session::running() const {
-  return started_ && !threads_stopped_ && haptic_->loop().running() && !rig_.camera().ended();
+  return started_ && !threads_stopped_ && servo_running() && !rig_.camera().ended();
 }
 
 double Session::seconds() const {
-  return started_ ? core::ns_to_s(core::monotonic_ns() - haptic_->t_open_ns()) : 0.0;
+  return started_ ? core::ns_to_s(core::monotonic_ns() - t_start_ns_) : 0.0;
+}
+
+device::ServoLoop& Session::servo() {
+  if (!haptic_) throw SpidarError(rig_.name() + ": a recording played back has no servo loop");
+  return haptic_->loop();
+}
+
+const device::ServoLoop& Session::servo() const {
+  if (!haptic_) throw SpidarError(rig_.name() + ": a recording played back has no servo loop");
+  return haptic_->loop();
+}
+
+sim::PhysicsThreadStats Session::physics_stats() const {
+  return haptic_ ? haptic_->physics().stats() : sim::PhysicsThreadStats{};
+}
+
+bool Session::take_inputs(std::int64_t t_exposure_ns, ServoTiming* servo) {
+  if (!haptic_) {
+    if (frame_.measured == nullptr) throw SpidarError(rig_.name() + ": a frame without its recorded fingertips");
+    measured_ = *frame_.measured;
+    if (frame_.scene_poses != nullptr && !frame_.scene_poses->empty()) {
+      if (frame_.scene_poses->size() != snapshot_.shapes.size())
+        throw SpidarError(rig_.name() + ": " + std::to_string(frame_.scene_poses->size()) +
+                          " scene poses for a scene of " + std::to_string(snapshot_.shapes.size()) + " shapes");
+      for (std::size_t k = 0; k < snapshot_.shapes.size(); ++k) snapshot_.shapes[k].X_WS = (*frame_.scene_poses)[k];
+    }
+    return true;
+  }
+  const std::size_t ns = haptic_->loop().newest_samples(servo_buf_.data(), servo_buf_.size());
+  const auto measured = device::interpolate_samples({servo_buf_.data(), ns}, t_exposure_ns);
+  if (!measured) return false;
+  measured_ = *measured;
+  haptic_->physics().snapshots().update();
+  snapshot_ = haptic_->physics().snapshots().front();
+  *servo = servo_timing_since({servo_buf_.data(), ns}, params_.servo.rate_hz, &last_servo_t_);
+  return true;
 }
 
 std::uint64_t Session::camera_frames() const { return rig_.camera().delivered(); }
@@ -105,20 +151,16 @@ Session::Step Session::step() {
                         std::to_string(frame_.bgr.rows) + " px, expected " + std::to_string(k.width) +
                         "x" + std::to_string(k.height));
     const std::int64_t t_exp = frame_.t_exposure_ns;
-    const double t_s = frame_.filmed != nullptr ? frame_.filmed->t_script_s
-                                                : core::ns_to_s(t_exp - haptic_->t_open_ns());
+    const double t_s = frame_.filmed != nullptr  ? frame_.filmed->t_script_s
+                       : frame_.measured != nullptr ? frame_.t_recorded_s
+                                                    : core::ns_to_s(t_exp - t_start_ns_);
     if ((params_.seconds > 0 && t_s > params_.seconds) ||
         (params_.end_with_script && scene_.task->finished(t_s)))
       return Step::kPastEnd;
     t_last_s_ = t_s;
-    const std::size_t ns = haptic_->loop().newest_samples(servo_buf_.data(), servo_buf_.size());
-    const auto measured = device::interpolate_samples({servo_buf_.data(), ns}, t_exp);
-    if (!measured) return Step::kSkipped;  // no servo samples around the exposure (a stall)
-    measured_ = *measured;
-    haptic_->physics().snapshots().update();
-    snapshot_ = haptic_->physics().snapshots().front();
-
     FrameEvent e;
+    if (!take_inputs(t_exp, &e.servo)) return Step::kSkipped;  // a stall: no servo samples around it
+
     e.cold_start = !pipe_->has_previous();
     if (auto st = pipe_->process(frame_.bgr, measured_, snapshot_, &result_); !st)
       throw SpidarError(st.error().message);
@@ -139,7 +181,6 @@ Session::Step Session::step() {
     e.scene = &snapshot_;
     e.result = &result_;
     e.filmed = frame_.filmed;
-    e.servo = servo_timing_since({servo_buf_.data(), ns}, params_.servo.rate_hz, &last_servo_t_);
     for (FrameSink* sink : sinks_) sink->on_frame(e);
     ++frames_;
     return Step::kFrame;
@@ -152,7 +193,7 @@ Session::Step Session::step() {
 SessionSummary Session::run(const std::function<std::optional<std::string>()>& interrupted) {
   start();
   std::string ended_by = "completed";
-  while (haptic_->loop().running()) {
+  while (servo_running()) {
     if (interrupted) {
       if (auto why = interrupted()) {
         ended_by = *why;
@@ -190,8 +231,10 @@ SessionSummary Session::stop(const std::string& ended_by) {
   s.t_last_s = t_last_s_;
   s.frames = frames_;
   s.camera_frames = rig_.camera().delivered();
-  s.servo = haptic_->loop().stats();
-  s.physics = haptic_->physics().stats();
+  if (haptic_) {
+    s.servo = haptic_->loop().stats();
+    s.physics = haptic_->physics().stats();
+  }
   s.camera_error = rig_.camera().error();
   summary_ = s;
   for (FrameSink* k : sinks_) k->on_end(s);

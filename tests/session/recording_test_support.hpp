@@ -118,6 +118,11 @@ inline TestRecording make_test_recording(FrameStore store) {
         s.p_W[f][a] = 0.1 * f - 0.01 * a + 1e-3 * k + 1.0 / 7.0;
         s.f_W[f][a] = a == 2 ? -0.5 * k : 1e-17 * f;
       }
+    s.string_count = 3;  // the servo's outputs: tensions [N] and motor commands [DAC counts]
+    for (int i = 0; i < 3; ++i) {
+      s.tension[static_cast<std::size_t>(i)] = 1.0 / 3.0 + k + 0.1 * i;
+      s.command[static_cast<std::size_t>(i)] = 200 * i - k;
+    }
     t.fingertips.push_back(s);
   }
   for (int i = 0; i < 5; ++i) {

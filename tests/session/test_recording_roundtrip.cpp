@@ -40,6 +40,9 @@ void expect_reads_back(const TestRecording& t, const Recording& r) {
   for (std::size_t k = 0; k < t.fingertips.size(); ++k) {
     expect_same_sample(r.fingertips[k], t.fingertips[k]);
     EXPECT_EQ(r.fingertips[k].cycle, t.fingertips[k].cycle);
+    EXPECT_EQ(r.fingertips[k].string_count, t.meta.string_count);
+    EXPECT_EQ(r.fingertips[k].tension, t.fingertips[k].tension);  // bit for bit
+    EXPECT_EQ(r.fingertips[k].command, t.fingertips[k].command);
   }
   ASSERT_EQ(r.frames.size(), t.frames.size());
   for (std::size_t i = 0; i < t.frames.size(); ++i) {
@@ -135,6 +138,42 @@ TEST(RecordingRoundTrip, CrlfFilesReadTheSame) {
     spit(dir / f, text);
   }
   expect_reads_back(t, read_recording(dir.string()));
+}
+
+/// fingertips.csv without its last `drop` columns (header and rows).
+void drop_last_fingertip_columns(const fs::path& dir, int drop) {
+  auto lines = lines_of(dir / "fingertips.csv");
+  for (auto& l : lines)
+    for (int k = 0; k < drop; ++k) l.erase(l.rfind(','));
+  write_lines(dir / "fingertips.csv", lines);
+}
+
+// A version-2 recording made before fingertips.csv had the servo's outputs still reads: its
+// samples have no strings; one with only some of those columns is refused naming the missing one.
+TEST(RecordingRoundTrip, ServoOutputColumnsAreOptionalButAllOrNone) {
+  TempFolder d("servo_outputs");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, dir);
+  EXPECT_NE(lines_of(dir / "fingertips.csv").front().find(",tension0,tension1,tension2,motor0,motor1,motor2"),
+            std::string::npos);
+  drop_last_fingertip_columns(dir, 1);  // motor2
+  try {
+    read_recording(dir.string());
+    ADD_FAILURE() << "a fingertips.csv without motor2 was read";
+  } catch (const RecordingError& e) {
+    EXPECT_EQ(e.file(), (dir / "fingertips.csv").string());
+    EXPECT_EQ(e.line(), 1);
+    EXPECT_NE(std::string(e.what()).find("no column 'motor2'"), std::string::npos) << e.what();
+  }
+  drop_last_fingertip_columns(dir, 5);  // the rest: as written before the columns existed
+  const Recording r = read_recording(dir.string());
+  ASSERT_EQ(r.fingertips.size(), t.fingertips.size());
+  for (std::size_t k = 0; k < t.fingertips.size(); ++k) {
+    expect_same_sample(r.fingertips[k], t.fingertips[k]);
+    EXPECT_EQ(r.fingertips[k].string_count, 0);
+    EXPECT_EQ(r.fingertips[k].tension[0], 0.0);
+  }
 }
 
 TEST(RecordingWriter, RefusesAFolderHoldingARecording) {

@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "spidar/core/pose.hpp"
 #include "spidar/core/result.hpp"
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/hand/hand_model.hpp"
@@ -27,6 +29,12 @@ struct CameraFrame {
   std::int64_t t_exposure_ns = 0;  ///< host monotonic time of the exposure [ns]
   /// What the synthetic camera filmed (true hand poses, script time, ...); null for real cameras.
   const sim::FilmedFrame* filmed = nullptr;
+  /// A recording's frame (Rig::plays_back): the fingertip sample its registration used, the scene
+  /// poses it was rendered with (empty: the scene has no shapes) and its time since the
+  /// recording's first frame [s]; null for live cameras.
+  const device::FingertipSample* measured = nullptr;
+  const std::vector<Pose>* scene_poses = nullptr;
+  double t_recorded_s = 0;
 };
 
 class FrameSource {

@@ -62,8 +62,10 @@ SessionJson parse_session_json(std::string_view text, const std::string& name);
 /// finger_count from 0 to 8 in samples. Throw RecordingError.
 std::uint64_t read_device_csv(std::istream& in, const std::string& name, int string_count,
                               const std::function<void(const DeviceCycleRecord&)>& on_row = {});
+/// fingertips.csv: with `string_count` > 0 its servo output columns (tensions, motor commands)
+/// are read if the file has them (samples then have that string_count), else left 0.
 std::vector<device::FingertipSample> read_fingertips_csv(std::istream& in, const std::string& name,
-                                                         int finger_count);
+                                                         int finger_count, int string_count = 0);
 /// `check_image(row, image)` (row 0, 1, ...) returns what is wrong with a frame's image field, or
 /// "" if nothing (read_recording checks PNG paths and video frame numbers with it).
 std::vector<FrameRow> read_frames_csv(

@@ -11,7 +11,8 @@
 ///                    completion marker: a recording without it was interrupted);
 ///   config.yaml      the live config as used;
 ///   device.csv       one row per servo cycle at the device boundary (DeviceCycleRecord);
-///   fingertips.csv   one row per servo cycle as the loop published it (FingertipSample);
+///   fingertips.csv   one row per servo cycle as the loop published it (FingertipSample, with the
+///                    strings' tensions and motor commands: servo_output_columns);
 ///   frames.csv       one row per processed camera frame (FrameRow);
 ///   scene.csv        the scene's shape poses per frame (one row per frame and shape);
 ///   fits.csv         the live registration's fit per frame and hand (FitRow);
@@ -112,6 +113,12 @@ struct FitRow {
 /// these names and requires exactly this set.
 std::vector<std::string> device_columns(int string_count);
 std::vector<std::string> fingertip_columns();  ///< t_ns, cycle, then sample_columns()
+/// fingertips.csv's servo output columns after fingertip_columns(): tension0..tensionN-1 (the
+/// tension the cycle solved per string [N]) and motor0..motorN-1 (the motor command sent [DAC
+/// counts]) for the N = session.json string_count strings. Optional on reading: a version-2
+/// recording made before they were written has none of them (its samples read with
+/// string_count 0); one that has any must have all.
+std::vector<std::string> servo_output_columns(int string_count);
 std::vector<std::string> frame_columns();      ///< frame, t_exposure_ns, image, then sample_columns()
 std::vector<std::string> scene_columns();      ///< frame, shape, px..pz [m], qw..qz (unit), world
 std::vector<std::string> fit_columns();

@@ -70,7 +70,9 @@ class RecordingWriter {
 /// One CSV row (with its '\n') exactly as the writer writes it. Also used by the fuzz target to
 /// check that what the reader accepts writes back to rows that read the same.
 std::string device_row_text(const DeviceCycleRecord& r, int string_count);
-std::string fingertip_row_text(const device::FingertipSample& s);
+/// fingertips.csv: with the servo output columns of `string_count` strings (0: none; strings past
+/// the sample's string_count are written 0).
+std::string fingertip_row_text(const device::FingertipSample& s, int string_count = 0);
 std::string frame_row_text(const FrameRow& f);
 std::string scene_row_text(std::int64_t frame, std::size_t shape, const Pose& X_WS);
 std::string fit_row_text(const FitRow& r);

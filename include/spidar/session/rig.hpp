@@ -1,7 +1,7 @@
 #pragma once
 /// A rig gives a session its device and its camera, and on the simulated rig the ground truth
-/// (the user's true hands) and the user (scripted or interactive). New rigs (a recording played
-/// back, another lab's device) implement this interface.
+/// (the user's true hands) and the user (scripted or interactive). New rigs (another lab's
+/// device) implement this interface; a recording played back is one too (recording_rig.hpp).
 #include <array>
 #include <memory>
 #include <string>
@@ -20,7 +20,11 @@ namespace spidar::session {
 class Rig {
  public:
   virtual ~Rig() = default;
-  /// The device the servo loop drives, and its string layout.
+  /// True for a rig that plays a recording back: its frames carry the fingertip sample and the
+  /// scene poses they were processed with live (CameraFrame::measured, scene_poses), so the
+  /// session drives no device and runs no physics, and takes every frame in turn.
+  virtual bool plays_back() const { return false; }
+  /// The device the servo loop drives, and its string layout (not asked of a rig that plays back).
   virtual device::Device& device() = 0;
   virtual const strings::DeviceConfig& device_config() const = 0;
   /// The camera the frame thread takes frames from.

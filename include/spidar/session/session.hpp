@@ -45,7 +45,8 @@ struct SessionParams {
 
 class Session {
  public:
-  /// Builds the servo loop, the physics thread and the pipelines (nothing started). `context`
+  /// Builds the servo loop, the physics thread and the pipelines (nothing started; a rig that
+  /// plays back gets the pipelines only, `scene` gives the shapes its poses apply to). `context`
   /// must be current on the calling thread (the frame thread) and outlive the session, as must
   /// the rig and the scene. `drive`: the device the servo loop drives if not the rig's own (a
   /// wrapper around it, e.g. one that records every cycle). Throws SpidarError saying what failed.
@@ -89,7 +90,7 @@ class Session {
   bool started() const { return started_; }
   /// Seconds since start().
   double seconds() const;
-  std::int64_t t_start_ns() const { return haptic_->t_open_ns(); }
+  std::int64_t t_start_ns() const { return t_start_ns_; }
   std::uint64_t frames() const { return frames_; }
   /// Warm-ups done: 1 after start() with SessionParams::warm_up, else 0.
   int warm_ups() const { return warm_ups_; }
@@ -97,9 +98,10 @@ class Session {
 
   Rig& rig() { return rig_; }
   Scene& scene() { return scene_; }
-  device::ServoLoop& servo() { return haptic_->loop(); }
-  const device::ServoLoop& servo() const { return haptic_->loop(); }
-  sim::PhysicsThreadStats physics_stats() const { return haptic_->physics().stats(); }
+  /// The servo loop; SpidarError for a rig that plays back (it has none).
+  device::ServoLoop& servo();
+  const device::ServoLoop& servo() const;
+  sim::PhysicsThreadStats physics_stats() const;
   pipeline::FramePipeline& pipeline() { return *pipe_; }
   const SessionParams& params() const { return params_; }
 
@@ -107,6 +109,10 @@ class Session {
   Session(Rig& rig, Scene& scene, render::Context& context, const SessionParams& params);
   void warm_up();
   void stop_threads();
+  bool servo_running() const;
+  /// Where the frame's measurement and scene come from: the servo loop and physics, or the
+  /// recording the frame came from. False: no servo samples around the exposure (a stall).
+  bool take_inputs(std::int64_t t_exposure_ns, ServoTiming* servo);
 
   Rig& rig_;
   Scene& scene_;
@@ -123,6 +129,7 @@ class Session {
   int warm_ups_ = 0;
   double t_last_s_ = 0;
   std::int64_t last_servo_t_ = 0;
+  std::int64_t t_start_ns_ = 0;
   std::vector<device::FingertipSample> servo_buf_;
   CameraFrame frame_;
   SceneSnapshot snapshot_;

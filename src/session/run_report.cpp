@@ -1,4 +1,4 @@
-#include "demo_mr_report.hpp"
+#include "spidar/session/run_report.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -8,13 +8,13 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
-#include "cli_support.hpp"
 #include "spidar/core/atomic_write.hpp"
 #include "spidar/device/device.hpp"
 #include "spidar/render/plot.hpp"
 #include "spidar/render/video_output.hpp"
+#include "spidar/session/finite_json.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 namespace {
 
 namespace fs = std::filesystem;
@@ -363,4 +363,4 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   return 0;
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::session

@@ -6,10 +6,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
-#include <iostream>
+#include <nlohmann/json.hpp>
+#include <thread>
 
-#include "cli_support.hpp"
-#include "demo.hpp"
+#include "spidar/session/data_path.hpp"
+#include "spidar/session/finite_json.hpp"
+#include "spidar/session/scenarios.hpp"
 #include "spidar/core/atomic_write.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/core/units.hpp"
@@ -20,23 +22,18 @@
 #include "spidar/session/haptic_side.hpp"
 #include "spidar/sim/scripted_grasp.hpp"
 
-namespace spidar::app {
-namespace {
+namespace spidar::session {
 
-using session::CubeStatus;
-
-}  // namespace
-
-int run_haptic_demo(const DemoOptions& o) {
+device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& out) {
   namespace fs = std::filesystem;
   const auto cfg = strings::load_device_config(resolve_data_path(o.config));
   const std::string scene = resolve_data_path(o.scene);
   physics::WorldParams wp;
   auto world_r = physics::World::Load(scene, wp);
-  if (!world_r) throw UsageError("--scene: " + world_r.error().message);
+  if (!world_r) throw SpidarError("--scene: " + world_r.error().message);
   auto world = std::move(world_r).value();
   auto cube_r = physics::RubiksCube::Attach(*world);
-  if (!cube_r) throw UsageError("--scene: the haptic demo needs a Rubik's cube scene: " + cube_r.error().message);
+  if (!cube_r) throw SpidarError("--scene: the haptic demo needs a Rubik's cube scene: " + cube_r.error().message);
   auto cube = std::move(cube_r).value();
   fs::create_directories(o.out);
 
@@ -51,11 +48,11 @@ int run_haptic_demo(const DemoOptions& o) {
   dp.seed = o.seed;
   device::SimulatedSpidar dev(cfg, dp, script);
 
-  session::HapticSideParams hp;
+  HapticSideParams hp;
   hp.servo.rate_hz = o.rate_hz;
   hp.servo.force_timeout_s = 0.05;
   const device::ServoConfig& servo = hp.servo;
-  session::HapticSide haptic(dev, cfg, *world, wp.coupling, hp);
+  HapticSide haptic(dev, cfg, *world, wp.coupling, hp);
   core::Latest<CubeStatus> cube_status;
   haptic.set_before_step([&](physics::World& w) {
     CubeStatus s;
@@ -68,7 +65,7 @@ int run_haptic_demo(const DemoOptions& o) {
   });
   device::ServoLoop& loop = haptic.loop();
 
-  std::cout << "spidar-mr demo: haptic Rubik's cube on a simulated " << cfg.name << "\n  scene "
+  out << "spidar-mr demo: haptic Rubik's cube on a simulated " << cfg.name << "\n  scene "
             << scene << ", servo " << servo.rate_hz << " Hz, physics in its own thread at "
             << 1.0 / world->timestep() << " Hz, coupling " << wp.coupling.stiffness << " N/m\n\n";
   haptic.start();
@@ -95,7 +92,7 @@ int run_haptic_demo(const DemoOptions& o) {
       lift_max = std::max(lift_max, s->lift);
       angle_max = std::max(angle_max, s->u_angle);
       if (t >= next_print) {
-        std::cout << std::fixed << std::setprecision(1) << "  t=" << std::setw(4) << t << " s  "
+        out << std::fixed << std::setprecision(1) << "  t=" << std::setw(4) << t << " s  "
                   << std::left << std::setw(19) << sim::RubiksScript::phase(t) << std::right
                   << " lift " << std::setw(5) << s->lift * 1e3 << " mm   top layer "
                   << std::setw(6) << units::rad_to_deg(s->u_angle) << " deg   contacts "
@@ -124,7 +121,7 @@ int run_haptic_demo(const DemoOptions& o) {
       }
     }
   }
-  std::cout << "\nresult:\n" << std::fixed << std::setprecision(2)
+  out << "\nresult:\n" << std::fixed << std::setprecision(2)
             << "  cube lifted           " << lift_max * 1e3 << " mm (max)\n"
             << "  top layer turned      " << units::rad_to_deg(angle_max) << " deg (max), final "
             << units::rad_to_deg(final_status.u_angle) << " deg, "
@@ -140,7 +137,7 @@ int run_haptic_demo(const DemoOptions& o) {
   nlohmann::json fingers = nlohmann::json::array();
   for (std::size_t f = 0; f < cfg.fingers.size(); ++f) {
     const auto& port = hs.ports[f];
-    std::cout << "    " << std::left << std::setw(14) << cfg.fingers[f].name << std::right
+    out << "    " << std::left << std::setw(14) << cfg.fingers[f].name << std::right
               << std::setw(12) << fmax[f] << std::setw(16) << port.min_energy * 1e3 << std::setw(12)
               << port.dissipated * 1e3 << std::setw(12) << port.active_steps << "\n";
     fingers.push_back({{"name", cfg.fingers[f].name},
@@ -192,14 +189,9 @@ int run_haptic_demo(const DemoOptions& o) {
       {"fingers", fingers}};
   require_finite_json(report, (fs::path(o.out) / "report.json").string());
   core::write_file_atomic((fs::path(o.out) / "report.json").string(), report.dump(2) + "\n");
-  std::cout << "wrote " << (fs::path(o.out) / "haptic_trace.csv").string() << " and "
+  out << "wrote " << (fs::path(o.out) / "haptic_trace.csv").string() << " and "
             << (fs::path(o.out) / "report.json").string() << "\n";
-  if (ss.faults != 0) {
-    std::cerr << "spidar-mr demo: the servo loop latched " << device::fault_names(ss.faults) << ": "
-              << ss.fault_message << " (the report is written; exit code " << kExitFault << ")\n";
-    return kExitFault;
-  }
-  return 0;
+  return ss;
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::session

@@ -1,7 +1,7 @@
 #pragma once
 /// The live mixed-reality session (`spidar-mr run`): a LiveConfig wired into a rig (the simulated
 /// SPIDAR-8 or a serial device; the synthetic camera, a V4L2 device or a video file), a
-/// session::Session and its sinks — the GUI's view model (session::FrameStatsSink) and, when
+/// Session and its sinks — the GUI's view model (FrameStatsSink) and, when
 /// asked for, the recorder. The caller steps it on its thread (GL context current) and shows the
 /// results (window, GUI) or not (headless).
 #include <array>
@@ -10,22 +10,21 @@
 #include <optional>
 #include <string>
 
-#include "live_config.hpp"
-#include "session_recorder.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/session/frame_stats.hpp"
 #include "spidar/session/interactive_hands.hpp"
+#include "spidar/session/live_config.hpp"
 #include "spidar/session/rig.hpp"
 #include "spidar/session/scene.hpp"
 #include "spidar/session/session.hpp"
+#include "spidar/session/session_recorder.hpp"
 #include "spidar/strings/device_config.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 
-using LiveFrameStats = session::FrameStats;
-using session::silhouette_iou;
+using LiveFrameStats = FrameStats;
 
 /// The pipeline parameters a live config asks for (shared by run and replay, so both fit alike).
 pipeline::FramePipelineParams live_pipeline_params(const LiveConfig& c,
@@ -34,7 +33,7 @@ pipeline::FramePipelineParams live_pipeline_params(const LiveConfig& c,
 struct LiveSessionOptions {
   std::string record_dir;             ///< empty: no recording
   FrameStore record_frames = FrameStore::kVideo;
-  /// The pipeline's warm-up before the clock starts (session::SessionParams::warm_up). The GUI
+  /// The pipeline's warm-up before the clock starts (SessionParams::warm_up). The GUI
   /// skips it: its window is up already, and the warm-up (~0.3 s, seconds on a loaded machine)
   /// would only delay the first frame the user sees.
   bool warm_up = true;
@@ -70,41 +69,39 @@ class LiveSession {
   const vision::Camera& camera() const { return camera_; }
   const std::array<hand::HandModel, 2>& models() const { return models_; }
   /// The GUI's view model: the last processed frame, the bounded history, the run's means.
-  const session::FrameStatsSink& view() const { return view_; }
+  const FrameStatsSink& view() const { return view_; }
   /// The last processed frame: camera image and pipeline result (empty before the first).
   const cv::Mat& camera_image() const { return view_.camera_image(); }
   const pipeline::FrameResult& result() const { return view_.result() ? *view_.result() : no_result_; }
   const device::FingertipSample& measured() const { return view_.measured(); }
-  const session::HistoryRing<LiveFrameStats>& history() const { return view_.history(); }
+  const HistoryRing<LiveFrameStats>& history() const { return view_.history(); }
   std::uint64_t frames() const { return session_->frames(); }
   std::uint64_t camera_frames() const { return session_->camera_frames(); }
   device::ServoLoop& servo() { return session_->servo(); }
   const device::ServoLoop& servo() const { return session_->servo(); }
-  std::optional<session::CubeStatus> cube_status() const { return scene_->monitor->status().read(); }
-  session::CubeMonitor& cube() { return *scene_->monitor; }
+  std::optional<CubeStatus> cube_status() const { return scene_->monitor->status().read(); }
+  CubeMonitor& cube() { return *scene_->monitor; }
   sim::PhysicsThreadStats physics_stats() const { return session_->physics_stats(); }
   const SessionRecorder* recorder() const { return recorder_.get(); }
   /// The newest servo cycle at the device boundary (raw counts, commands); any thread.
   std::optional<DeviceCycleRecord> newest_device_cycle() const;
   /// The simulated user's hands under interactive control; null unless hands.control is
   /// interactive.
-  session::InteractiveHands* interactive() { return rig_->interactive(); }
+  InteractiveHands* interactive() { return rig_->interactive(); }
   double seconds() const { return session_->seconds(); }
 
  private:
-  class RecorderSink;
   LiveSession() = default;
   LiveConfig config_;
   vision::Camera camera_;
   std::array<hand::HandModel, 2> models_, user_models_;
-  std::unique_ptr<session::Scene> scene_;
-  std::unique_ptr<session::Rig> rig_;
+  std::unique_ptr<Scene> scene_;
+  std::unique_ptr<Rig> rig_;
   std::unique_ptr<RecordingDevice> recording_device_;
   std::unique_ptr<SessionRecorder> recorder_;
-  std::unique_ptr<RecorderSink> recorder_sink_;
-  session::FrameStatsSink view_;
-  std::unique_ptr<session::Session> session_;
+  FrameStatsSink view_;
+  std::unique_ptr<Session> session_;
   pipeline::FrameResult no_result_;
 };
 
-}  // namespace spidar::app
+}  // namespace spidar::session

@@ -4,12 +4,13 @@
 ///   RecordingDevice  wraps the device: every servo cycle's encoder reading and the motor commands
 ///                    written after it go into a lock-free ring (no allocation, no lock in the
 ///                    servo thread);
-///   SessionRecorder  a writer thread drains that ring and the servo loop's fingertip samples into
-///                    the recording's CSVs, and writes each processed camera frame (video or PNG),
-///                    the scene poses, the fingertip sample the frame was registered with and the
-///                    fit. The files and their columns are session::RecordingWriter's
-///                    (include/spidar/session/recording_schema.hpp); this is the threads and the
-///                    frame images around it.
+///   SessionRecorder  a FrameSink: a writer thread drains that ring and the servo loop's
+///                    fingertip samples (positions, forces, the strings' tensions and motor
+///                    commands) into the recording's CSVs, and writes each processed camera frame
+///                    (video or PNG), the scene poses, the fingertip sample the frame was
+///                    registered with and the fit. The files and their columns are
+///                    RecordingWriter's (recording_schema.hpp); this is the threads and the frame
+///                    images around it.
 #include <array>
 #include <atomic>
 #include <condition_variable>
@@ -29,12 +30,10 @@
 #include "spidar/hand/parameters.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/render/video_output.hpp"
+#include "spidar/session/frame_sink.hpp"
 #include "spidar/session/recording_writer.hpp"
 
-namespace spidar::app {
-
-/// One servo cycle at the device boundary (a device.csv row).
-using DeviceCycleRecord = session::DeviceCycleRecord;
+namespace spidar::session {
 
 /// A Device that forwards everything to another and records reads and writes.
 class RecordingDevice final : public device::Device {
@@ -61,8 +60,8 @@ class RecordingDevice final : public device::Device {
   std::uint64_t seq_ = 0;
 };
 
-/// What a recording needs to know once, at the start (session.json).
-struct RecordingMeta {
+/// What a recording needs to know once, at the start (session.json, config.yaml).
+struct RecorderSetup {
   std::string config_yaml;           ///< the resolved live config (config.yaml)
   int width = 0, height = 0;
   double fps = 30;
@@ -83,17 +82,21 @@ struct FrameRecord {
   std::array<registration::FitReport, 2> fits;
 };
 
-/// How camera frames are stored (session/recording_schema.hpp).
-using FrameStore = session::FrameStore;
-
-class SessionRecorder {
+class SessionRecorder final : public FrameSink {
  public:
   /// Creates DIR (it must not hold a recording already) and writes config.yaml and session.json
-  /// (without its completion marker). Throws SpidarError naming the path on failure.
-  SessionRecorder(const std::string& dir, FrameStore store, const RecordingMeta& meta);
-  ~SessionRecorder();
-  /// Starts the writer thread polling `device` and `servo` (both must outlive stop()).
-  void start(const RecordingDevice* device, const device::ServoLoop* servo);
+  /// (without its completion marker). The writer thread, started by on_start, polls `device`
+  /// and `servo` (both must outlive stop()). Throws SpidarError naming the path on failure.
+  SessionRecorder(const std::string& dir, FrameStore store, const RecorderSetup& setup,
+                  const RecordingDevice& device, const device::ServoLoop& servo);
+  ~SessionRecorder() override;
+  /// Starts the writer thread.
+  void on_start() override;
+  /// Queues the frame (a copy of its image, its sample, scene poses and fits) for writing;
+  /// blocks while 16 frames wait.
+  void on_frame(const FrameEvent& e) override;
+  /// stop().
+  void on_end(const SessionSummary& s) override;
   /// Frame thread: queues a frame for writing (blocks while 16 frames wait).
   void add_frame(FrameRecord frame);
   /// Drains everything, closes the files and, if every write succeeded, writes the completion
@@ -118,10 +121,10 @@ class SessionRecorder {
 
   std::string dir_;
   FrameStore store_;
-  RecordingMeta meta_;
+  RecorderSetup meta_;
   const RecordingDevice* device_ = nullptr;
   const device::ServoLoop* servo_ = nullptr;
-  std::unique_ptr<session::RecordingWriter> writer_;
+  std::unique_ptr<RecordingWriter> writer_;
   std::unique_ptr<render::VideoOutput> video_;
   std::vector<DeviceCycleRecord> dev_buf_;
   std::vector<device::FingertipSample> sample_buf_;
@@ -138,4 +141,4 @@ class SessionRecorder {
   std::thread thread_;
 };
 
-}  // namespace spidar::app
+}  // namespace spidar::session

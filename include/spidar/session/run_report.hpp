@@ -1,6 +1,6 @@
 #pragma once
-/// What the mixed-reality demo records per frame, and its report: report.json, plot PNGs and the
-/// printed summary.
+/// The run report of a scored session (the mixed-reality demo): what it records per frame, and
+/// report.json, frames.csv, the plot PNGs and the printed summary built from it.
 #include <array>
 #include <map>
 #include <ostream>
@@ -14,11 +14,11 @@
 #include "spidar/sim/haptic_bridge.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 
 /// Per frame and per run: the ground-truth scorer's trace (session::TruthScorer).
-using MrFrame = session::TruthFrame;
-using MrTrace = session::TruthTrace;
+using MrFrame = TruthFrame;
+using MrTrace = TruthTrace;
 
 struct MrSummary {
   double seconds = 0, wall_s = 0;
@@ -43,4 +43,4 @@ struct MrSummary {
 int write_mr_report(const std::string& out, const MrTrace& trace, const MrSummary& summary,
                     std::ostream& os);
 
-}  // namespace spidar::app
+}  // namespace spidar::session

@@ -7,19 +7,20 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
-#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <random>
 
-#include "cli_support.hpp"
-#include "commands.hpp"
-#include "demo.hpp"
+#include "spidar/session/data_path.hpp"
+#include "spidar/session/finite_json.hpp"
+#include "spidar/session/scenarios.hpp"
 #include "spidar/core/atomic_write.hpp"
 #include "spidar/core/units.hpp"
 #include "spidar/strings/calibration.hpp"
 #include "spidar/strings/position.hpp"
 #include "spidar/strings/tension.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 namespace {
 
 using namespace spidar::strings;
@@ -119,19 +120,19 @@ double workspace_error_rms(const DeviceConfig& cfg, const SimulatedStrings& dev,
 
 }  // namespace
 
-int run_strings_demo(const DemoOptions& a) {
+void run_strings_walkthrough(const ScenarioOptions& a, std::ostream& out) {
   using namespace spidar::strings;
   const double seconds = a.seconds > 0 ? a.seconds : 3.0;
   namespace fs = std::filesystem;
   const auto cfg = load_device_config(resolve_data_path(a.config));
-  if (!(seconds > 0 && seconds <= 600)) throw UsageError("--seconds: expected (0, 600]");
-  if (!(a.rate_hz >= 10 && a.rate_hz <= 20000)) throw UsageError("--rate: expected 10..20000 Hz");
+  if (!(seconds > 0 && seconds <= 600)) throw SpidarError("--seconds: expected (0, 600]");
+  if (!(a.rate_hz >= 10 && a.rate_hz <= 20000)) throw SpidarError("--rate: expected 10..20000 Hz");
   fs::create_directories(a.out);
   std::mt19937_64 rng(a.seed);
   const auto limits = cfg.effective_limits();
   const int nf = static_cast<int>(cfg.fingers.size());
 
-  std::cout << "spidar-mr demo: device maths walkthrough on " << cfg.name << " (" << cfg.source
+  out << "spidar-mr demo: device maths walkthrough on " << cfg.name << " (" << cfg.source
             << ")\n  " << nf << " fingers, " << cfg.string_count() << " strings; tension "
             << limits.t_min << "-" << limits.t_max << " N (drive: "
             << std::setprecision(4) << volts_per_newton(cfg.motor) << " V/N, saturates at "
@@ -191,7 +192,7 @@ int run_strings_demo(const DemoOptions& a) {
     }
   }
   const double jig_err = workspace_error_rms(cfg, dev, jig_cal, rng);
-  std::cout << std::fixed << std::setprecision(2)
+  out << std::fixed << std::setprecision(2)
             << "calibration (position error RMS over random points within 8 cm of the centre):\n"
             << "  pole, manual placement sigma 3 mm   " << units::m_to_mm(pole_err) << " mm\n"
             << "  3x3x3 jig, placement sigma 0.5 mm  " << units::m_to_mm(jig_err)
@@ -200,7 +201,7 @@ int run_strings_demo(const DemoOptions& a) {
   // 4. Force cones at the grasp: a 3-string unit only pulls toward its own corner, and t_min on
   // every string adds a baseline force. Share of directions displayable at 2 N, the baseline,
   // and whether the contact push the grasp needs is displayable.
-  std::cout << "force cones at the grasp point (share of directions displayable at 2 N; baseline "
+  out << "force cones at the grasp point (share of directions displayable at 2 N; baseline "
                "force of t_min on all strings; the contact push of the grasp):\n";
   const VirtualBox box;
   nlohmann::json cones = nlohmann::json::array();
@@ -220,7 +221,7 @@ int run_strings_demo(const DemoOptions& a) {
     const Vec3 push = box.force(p);
     const auto sol = solve_tensions(U, push, limits).value();
     const double along = push.norm() > 0 ? sol.f_displayed.dot(push.normalized()) / push.norm() : 0;
-    std::cout << "  " << std::left << std::setw(13) << cfg.fingers[f].name << std::right
+    out << "  " << std::left << std::setw(13) << cfg.fingers[f].name << std::right
               << std::setprecision(1) << std::setw(5) << 100.0 * ok / m << " %   baseline "
               << fmt_vec(baseline, 2) << "   push " << fmt_vec(push, 2) << " -> "
               << fmt_vec(sol.f_displayed, 2) << (sol.reachable ? "" : " (projected)") << "\n";
@@ -243,7 +244,7 @@ int run_strings_demo(const DemoOptions& a) {
   std::vector<int> contact(nf, 0);
   std::vector<double> fidelity_sum(nf, 0.0);
   double pos_ns = 0, ten_ns = 0;
-  std::cout << "\nscripted grasp, " << seconds << " s at " << a.rate_hz
+  out << "\nscripted grasp, " << seconds << " s at " << a.rate_hz
             << " Hz (left index and right thumb shown; all fingers in walkthrough.csv):\n"
             << "     t  finger        position est [m]          err[mm]  desired F [N]"
                "            displayed F [N]          tensions [N]\n";
@@ -293,7 +294,7 @@ int run_strings_demo(const DemoOptions& a) {
         std::ostringstream ts;
         ts << std::fixed << std::setprecision(2);
         for (int i = 0; i < sol.t.size(); ++i) ts << (i ? " " : "") << std::setw(5) << sol.t[i];
-        std::cout << std::fixed << std::setprecision(2) << std::setw(6) << t << "  "
+        out << std::fixed << std::setprecision(2) << std::setw(6) << t << "  "
                   << std::left << std::setw(12) << fc.name << std::right << fmt_vec(est.p_WF)
                   << std::setw(7) << std::setprecision(2) << err * 1e3 << "  "
                   << fmt_vec(f_des, 2) << "  " << fmt_vec(f_out, 2) << "  " << ts.str()
@@ -302,13 +303,13 @@ int run_strings_demo(const DemoOptions& a) {
     }
   }
   const int samples = (steps + 1);
-  std::cout << "\nper finger over the run (fidelity: displayed force along the desired push / "
+  out << "\nper finger over the run (fidelity: displayed force along the desired push / "
                "desired, in contact):\n  finger        err RMS [mm]  err max [mm]  max |F| [N]"
                "  contact [ms]  fidelity  largest gap [N]\n";
   nlohmann::json fingers = nlohmann::json::array();
   for (int f = 0; f < nf; ++f) {
     const double rms = std::sqrt(err_sum2[f] / samples);
-    std::cout << "  " << std::left << std::setw(13) << cfg.fingers[f].name << std::right
+    out << "  " << std::left << std::setw(13) << cfg.fingers[f].name << std::right
               << std::setprecision(3) << std::setw(12) << rms * 1e3 << std::setw(14)
               << err_max[f] * 1e3 << std::setw(13) << force_max[f] << std::setw(14)
               << std::setprecision(0) << contact[f] * dt * 1e3 << std::setprecision(2)
@@ -323,7 +324,7 @@ int run_strings_demo(const DemoOptions& a) {
                        {"force_gap_max_n", force_gap_max[f]}});
   }
   const double per = 1.0 / (static_cast<double>(samples) * nf);
-  std::cout << std::setprecision(0) << "\nsolver time per fingertip (wall clock, this run): position "
+  out << std::setprecision(0) << "\nsolver time per fingertip (wall clock, this run): position "
             << pos_ns * per << " ns, tensions " << ten_ns * per
             << " ns (make bench gives the careful figures)\n";
   nlohmann::json report = {
@@ -340,9 +341,8 @@ int run_strings_demo(const DemoOptions& a) {
       {"solver_ns_per_fingertip", {{"position", pos_ns * per}, {"tension", ten_ns * per}}}};
   require_finite_json(report, (fs::path(a.out) / "report.json").string());
   core::write_file_atomic((fs::path(a.out) / "report.json").string(), report.dump(2) + "\n");
-  std::cout << "wrote " << (fs::path(a.out) / "walkthrough.csv").string() << " and "
+  out << "wrote " << (fs::path(a.out) / "walkthrough.csv").string() << " and "
             << (fs::path(a.out) / "report.json").string() << "\n";
-  return 0;
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::session

@@ -1,65 +1,38 @@
-#include "live_session.hpp"
+#include "spidar/session/live_session.hpp"
 
 #include <filesystem>
 
-#include "cli_support.hpp"
-#include "device_backends.hpp"
+#include "spidar/session/device_backends.hpp"
 #include "spidar/session/rig_inputs.hpp"
 #include "spidar/vision/camera_config.hpp"
 #include "spidar/vision/capture.hpp"
 
-namespace spidar::app {
-
-/// Every processed frame into the recording (frames.jsonl, the camera images).
-class LiveSession::RecorderSink final : public session::FrameSink {
- public:
-  RecorderSink(SessionRecorder& recorder, const RecordingDevice& device, const device::ServoLoop& loop)
-      : recorder_(recorder), device_(device), loop_(loop) {}
-  void on_start() override { recorder_.start(&device_, &loop_); }
-  void on_frame(const session::FrameEvent& e) override {
-    FrameRecord fr;
-    fr.index = static_cast<std::int64_t>(e.index);
-    fr.t_exposure_ns = e.t_exposure_ns;
-    fr.bgr = e.bgr->clone();  // written by the recorder's thread, after the source reused it
-    fr.measured = *e.measured;
-    fr.scene_poses.reserve(e.scene->shapes.size());
-    for (const Shape& sh : e.scene->shapes) fr.scene_poses.push_back(sh.X_WS);
-    fr.hands = e.result->hands;
-    fr.fits = e.result->fits;
-    recorder_.add_frame(std::move(fr));
-  }
-  void on_end(const session::SessionSummary& /*s*/) override { recorder_.stop(); }
-
- private:
-  SessionRecorder& recorder_;
-  const RecordingDevice& device_;
-  const device::ServoLoop& loop_;
-};
+namespace spidar::session {
 
 pipeline::FramePipelineParams live_pipeline_params(const LiveConfig& c,
                                                    const std::array<Vec3, 2>& initial_r_W_hand) {
   auto mode = render::parse_composite_mode(c.compositor);
-  if (!mode) throw UsageError("compositor.mode: " + mode.error().message);
-  return session::pipeline_params(c.vision_config, c.registration_config, c.silhouette, *mode,
+  if (!mode) throw SpidarError("compositor.mode: " + mode.error().message);
+  return pipeline_params(c.vision_config, c.registration_config, c.silhouette, *mode,
                                   initial_r_W_hand);
 }
 
 namespace {
 
 /// The configured real camera (V4L2 device or video file), checked against the config's size.
-std::unique_ptr<session::FrameSource> capture_source(const LiveConfig& c) {
+std::unique_ptr<FrameSource> capture_source(const LiveConfig& c) {
   vision::CaptureOptions co;
   co.fallback_fps = c.fps;
   co.width = c.width;
   co.height = c.height;
   const std::string name = c.camera_source == "device" ? c.camera_device : c.camera_file;
   auto cap = vision::Capture::open(name, co);
-  if (!cap) throw UsageError(c.source + ": camera: " + cap.error().message);
+  if (!cap) throw SpidarError(c.source + ": camera: " + cap.error().message);
   if (cap->width() > 0 && (cap->width() != c.width || cap->height() != c.height))
-    throw UsageError(c.source + ": camera: '" + name + "' gives " + std::to_string(cap->width()) + "x" +
+    throw SpidarError(c.source + ": camera: '" + name + "' gives " + std::to_string(cap->width()) + "x" +
                      std::to_string(cap->height()) + " px, the config says " + std::to_string(c.width) +
                      "x" + std::to_string(c.height) + " (set camera.width and camera.height to match)");
-  return session::make_capture_source(std::move(cap).value());
+  return make_capture_source(std::move(cap).value());
 }
 
 }  // namespace
@@ -67,37 +40,37 @@ std::unique_ptr<session::FrameSource> capture_source(const LiveConfig& c) {
 std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Context& context,
                                                  const LiveSessionOptions& options) {
   if (!options.record_dir.empty() && std::filesystem::exists(std::filesystem::path(options.record_dir) / "session.json"))
-    throw UsageError("--record " + options.record_dir + ": already holds a recording (session.json); choose a new folder");
+    throw SpidarError("--record " + options.record_dir + ": already holds a recording (session.json); choose a new folder");
   std::unique_ptr<LiveSession> s(new LiveSession());
   s->config_ = c;
   const strings::DeviceConfig device_config = strings::load_device_config(c.device_config);
   if (device_config.fingers.size() != 8)
-    throw UsageError(c.device_config + ": the live session needs 8 fingers (thumb, index, middle, "
+    throw SpidarError(c.device_config + ": the live session needs 8 fingers (thumb, index, middle, "
                      "ring of both hands), got " + std::to_string(device_config.fingers.size()));
-  s->camera_ = session::scaled_camera(vision::load_camera_file(c.camera_calibration).camera, c.width, c.height);
-  s->models_ = session::hand_models(c.hands_file, c.model_profile, false);
-  s->user_models_ = session::hand_models(c.hands_file, c.user_profile, true);
-  auto scene_r = session::Scene::load(c.scene, s->user_models_);
-  if (!scene_r) throw UsageError(c.source + ": scene: " + scene_r.error().message);
+  s->camera_ = scaled_camera(vision::load_camera_file(c.camera_calibration).camera, c.width, c.height);
+  s->models_ = hand_models(c.hands_file, c.model_profile, false);
+  s->user_models_ = hand_models(c.hands_file, c.user_profile, true);
+  auto scene_r = Scene::load(c.scene, s->user_models_);
+  if (!scene_r) throw SpidarError(c.source + ": scene: " + scene_r.error().message);
   s->scene_ = std::move(scene_r).value();
 
   // --- the rig: simulated or serial device; synthetic, V4L2 or file camera ---
-  std::unique_ptr<session::FrameSource> camera;
+  std::unique_ptr<FrameSource> camera;
   if (c.camera_source != "synthetic") camera = capture_source(c);
   if (c.backend == "sim") {
-    session::SimulatedRigParams rp;
+    SimulatedRigParams rp;
     rp.seed = c.seed;
     rp.fps = c.fps;
     rp.interactive = c.user_mode == "interactive";
-    s->rig_ = std::make_unique<session::SimulatedRig>(device_config, *s->scene_, s->camera_,
+    s->rig_ = std::make_unique<SimulatedRig>(device_config, *s->scene_, s->camera_,
                                                       s->user_models_, rp, std::move(camera));
   } else {
-    if (!camera) throw UsageError(c.source + ": the synthetic camera needs device.backend: sim");
+    if (!camera) throw SpidarError(c.source + ": the synthetic camera needs device.backend: sim");
     BackendArgs a;
     a.backend = "serial";
     a.port = c.port;
     a.baud = c.baud;
-    s->rig_ = std::make_unique<session::HardwareRig>(device_config, make_backend(a, device_config),
+    s->rig_ = std::make_unique<HardwareRig>(device_config, make_backend(a, device_config),
                                                      std::move(camera), "serial " + c.port);
   }
   // Every cycle's counts and commands pass through a lock-free ring: the recorder drains it, the
@@ -105,18 +78,18 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
   s->recording_device_ = std::make_unique<RecordingDevice>(s->rig_->device());
 
   // --- the session: servo loop, physics, frame pipeline (warmed up before the clock starts) ---
-  session::SessionParams sp;
+  SessionParams sp;
   sp.servo.rate_hz = c.rate_hz;
   sp.servo.force_timeout_s = 0.05;
   sp.warm_up = options.warm_up;
   const std::array<Vec3, 2> r0 = s->scene_->initial_r_W_hand();
   sp.pipeline = live_pipeline_params(c, r0);
-  s->session_ = session::Session::create(*s->rig_, *s->scene_, context, s->camera_, s->models_, sp,
+  s->session_ = Session::create(*s->rig_, *s->scene_, context, s->camera_, s->models_, sp,
                                          s->recording_device_.get());
   s->session_->add_sink(s->view_);
 
   if (!options.record_dir.empty()) {
-    RecordingMeta meta;
+    RecorderSetup meta;
     meta.config_yaml = live_config_yaml(c);
     meta.width = c.width;
     meta.height = c.height;
@@ -125,10 +98,9 @@ std::unique_ptr<LiveSession> LiveSession::create(const LiveConfig& c, render::Co
     meta.finger_count = static_cast<int>(device_config.fingers.size());
     meta.initial_r_W_hand = r0;
     meta.device_name = c.backend == "sim" ? "simulated " + device_config.name : "serial " + c.port;
-    s->recorder_ = std::make_unique<SessionRecorder>(options.record_dir, options.record_frames, meta);
-    s->recorder_sink_ = std::make_unique<RecorderSink>(*s->recorder_, *s->recording_device_,
-                                                       s->session_->servo());
-    s->session_->add_sink(*s->recorder_sink_);
+    s->recorder_ = std::make_unique<SessionRecorder>(options.record_dir, options.record_frames, meta,
+                                                     *s->recording_device_, s->session_->servo());
+    s->session_->add_sink(*s->recorder_);
   }
   return s;
 }
@@ -151,7 +123,7 @@ std::optional<DeviceCycleRecord> LiveSession::newest_device_cycle() const {
   return std::nullopt;
 }
 
-bool LiveSession::step() { return session_->step() == session::Session::Step::kFrame; }
+bool LiveSession::step() { return session_->step() == Session::Step::kFrame; }
 
 void LiveSession::stop() {
   if (!session_) return;
@@ -159,4 +131,4 @@ void LiveSession::stop() {
   if (recorder_) recorder_->stop();
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::session

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-namespace spidar::app {
+namespace spidar::session {
 
 struct LiveConfig {
   std::string source;  ///< the YAML file it came from
@@ -53,4 +53,4 @@ LiveConfig load_live_config(const std::string& path, bool check_hardware = true)
 /// The config as YAML text with every path resolved (absolute), as a recording stores it.
 std::string live_config_yaml(const LiveConfig& c);
 
-}  // namespace spidar::app
+}  // namespace spidar::session

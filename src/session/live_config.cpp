@@ -1,12 +1,12 @@
-#include "live_config.hpp"
+#include "spidar/session/live_config.hpp"
 
 #include <filesystem>
 #include <sstream>
 
-#include "cli_support.hpp"
+#include "spidar/session/data_path.hpp"
 #include "spidar/core/config.hpp"
 
-namespace spidar::app {
+namespace spidar::session {
 namespace {
 
 namespace fs = std::filesystem;
@@ -154,4 +154,4 @@ std::string live_config_yaml(const LiveConfig& c) {
   return os.str();
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::session

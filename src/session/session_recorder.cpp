@@ -1,16 +1,16 @@
-#include "session_recorder.hpp"
+#include "spidar/session/session_recorder.hpp"
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 
-namespace spidar::app {
+namespace spidar::session {
 namespace {
 
 namespace fs = std::filesystem;
 
-session::RecordingMeta schema_meta(const RecordingMeta& m, FrameStore store) {
-  session::RecordingMeta s;
+RecordingMeta schema_meta(const RecorderSetup& m, FrameStore store) {
+  RecordingMeta s;
   s.width = m.width;
   s.height = m.height;
   s.fps = m.fps;
@@ -23,8 +23,8 @@ session::RecordingMeta schema_meta(const RecordingMeta& m, FrameStore store) {
   return s;
 }
 
-session::FitRow fit_row(std::int64_t frame, int hand, const registration::FitReport& r, const hand::HandParams& p) {
-  session::FitRow row;
+FitRow fit_row(std::int64_t frame, int hand, const registration::FitReport& r, const hand::HandParams& p) {
+  FitRow row;
   row.frame = frame;
   row.hand = hand;
   row.iterations = r.iterations;
@@ -53,9 +53,10 @@ Status RecordingDevice::write(std::span<const std::int32_t> commands) {
   return st;
 }
 
-SessionRecorder::SessionRecorder(const std::string& dir, FrameStore store, const RecordingMeta& meta)
-    : dir_(dir), store_(store), meta_(meta) {
-  writer_ = std::make_unique<session::RecordingWriter>(dir, schema_meta(meta, store), meta.config_yaml);
+SessionRecorder::SessionRecorder(const std::string& dir, FrameStore store, const RecorderSetup& meta,
+                                 const RecordingDevice& device, const device::ServoLoop& servo)
+    : dir_(dir), store_(store), meta_(meta), device_(&device), servo_(&servo) {
+  writer_ = std::make_unique<RecordingWriter>(dir, schema_meta(meta, store), meta.config_yaml);
   if (store_ != FrameStore::kPng) {
     const render::VideoFormat mjpg = render::VideoFormat::kAviMjpg;
     auto v = render::VideoOutput::open((fs::path(dir) / "camera.mp4").string(), meta.width, meta.height, meta.fps,
@@ -72,11 +73,22 @@ SessionRecorder::SessionRecorder(const std::string& dir, FrameStore store, const
 
 SessionRecorder::~SessionRecorder() { stop(); }
 
-void SessionRecorder::start(const RecordingDevice* device, const device::ServoLoop* servo) {
-  device_ = device;
-  servo_ = servo;
-  thread_ = std::thread([this] { run(); });
+void SessionRecorder::on_start() { thread_ = std::thread([this] { run(); }); }
+
+void SessionRecorder::on_frame(const FrameEvent& e) {
+  FrameRecord fr;
+  fr.index = static_cast<std::int64_t>(e.index);
+  fr.t_exposure_ns = e.t_exposure_ns;
+  fr.bgr = e.bgr->clone();  // written by the writer thread, after the source reused it
+  fr.measured = *e.measured;
+  fr.scene_poses.reserve(e.scene->shapes.size());
+  for (const Shape& sh : e.scene->shapes) fr.scene_poses.push_back(sh.X_WS);
+  fr.hands = e.result->hands;
+  fr.fits = e.result->fits;
+  add_frame(std::move(fr));
 }
+
+void SessionRecorder::on_end(const SessionSummary& /*s*/) { stop(); }
 
 void SessionRecorder::add_frame(FrameRecord frame) {
   std::unique_lock lock(mutex_);
@@ -139,7 +151,7 @@ void SessionRecorder::drain() {
 }
 
 void SessionRecorder::write_frame(FrameRecord& f) {
-  session::FrameRow row;
+  FrameRow row;
   row.index = f.index;
   row.t_exposure_ns = f.t_exposure_ns;
   row.measured = f.measured;
@@ -152,7 +164,7 @@ void SessionRecorder::write_frame(FrameRecord& f) {
     row.image = std::to_string(video_->frames());  // frame number in the video
     if (auto st = video_->write(f.bgr); !st) note_error(st.error().message);
   }
-  const std::array<session::FitRow, 2> fits = {fit_row(f.index, 0, f.fits[0], f.hands[0]),
+  const std::array<FitRow, 2> fits = {fit_row(f.index, 0, f.fits[0], f.hands[0]),
                                                fit_row(f.index, 1, f.fits[1], f.hands[1])};
   if (writer_->write_frame(row, f.scene_poses, fits)) ++frames_written_;
 }
@@ -180,4 +192,4 @@ void SessionRecorder::stop() {
   }
 }
 
-}  // namespace spidar::app
+}  // namespace spidar::session
