@@ -1,6 +1,7 @@
 #include "spidar/pipeline/frame_pipeline.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <opencv2/core.hpp>
 
 #include "spidar/hand/kinematics.hpp"
@@ -58,9 +59,19 @@ struct FramePipeline::Impl {
   std::array<render::HandSkin, 2> skins;
   std::array<hand::HandParams, 2> previous;
   bool have_previous = false;
+  /// Online size estimates (personalise_shape), and the sizes the skins were last built with.
+  std::array<registration::ShapeEstimator, 2> shape;
+  std::array<hand::HandDimensions, 2> skin_dims;
 
-  Impl(const FramePipelineParams& p, vision::ChromaKeyer k)
-      : params(p), keyer(std::move(k)), solver(p.registration), main(p.compositor) {
+  Impl(const FramePipelineParams& p, vision::ChromaKeyer k,
+       const std::array<hand::HandModel, 2>& start)
+      : params(p),
+        models(start),
+        keyer(std::move(k)),
+        solver(p.registration),
+        main(p.compositor),
+        shape{registration::ShapeEstimator(start[0], p.shape_estimator),
+              registration::ShapeEstimator(start[1], p.shape_estimator)} {
     render::CompositorParams o = p.compositor;
     o.mode = p.compositor.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper
                                                                 : render::CompositeMode::kDepth;
@@ -85,9 +96,8 @@ Result<std::unique_ptr<FramePipeline>> FramePipeline::create(
   }
   auto keyer = vision::ChromaKeyer::create(params.chroma_key);
   if (!keyer) return keyer.error();
-  auto impl = std::make_unique<Impl>(params, std::move(keyer).value());
+  auto impl = std::make_unique<Impl>(params, std::move(keyer).value(), models);
   impl->camera = camera;
-  impl->models = models;
   auto renderer = render::Renderer::create(context, camera.width(), camera.height());
   if (!renderer) return renderer.error();
   impl->renderer = std::move(renderer).value();
@@ -233,6 +243,12 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     out->hands[h] = q;
     out->fits[h] = report;
     out->models[h] = s.models[h];
+    // Personalisation: this frame's evidence on the hand's sizes; the next fit uses the estimate.
+    if (p.personalise_shape) {
+      const hand::HandParams* prior = cold ? nullptr : &s.previous[h];
+      if (s.shape[h].add_frame(q, obs, image, prior, p.registration)) s.models[h] = s.shape[h].model();
+    }
+    out->shapes[h] = s.shape[h].estimate();
   }
   s.previous = out->hands;
   s.have_previous = true;
@@ -248,7 +264,16 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   s.scene.t_s = world.t_s;
   s.scene.shapes = world.shapes;
   if (p.skinned_hands) {
-    if (!s.meshes || s.world_meshes != world.meshes.get()) {
+    // Rebuild the skins when the world's meshes change or a hand's estimated size moved by more
+    // than half a millimetre since they were built.
+    bool resized = false;
+    for (int h = 0; h < 2; ++h) {
+      const auto& d = s.models[h].shape.dimensions;
+      resized = resized || std::abs(d.length - s.skin_dims[h].length) > 5e-4 ||
+                std::abs(d.width - s.skin_dims[h].width) > 5e-4;
+    }
+    if (!s.meshes || s.world_meshes != world.meshes.get() || resized) {
+      for (int h = 0; h < 2; ++h) s.skin_dims[h] = s.models[h].shape.dimensions;
       auto meshes = std::make_shared<std::vector<MeshData>>();
       if (world.meshes) *meshes = *world.meshes;
       for (int h = 0; h < 2; ++h) s.skins[h] = render::build_hand_skin(s.models[h], p.model_skin, meshes.get());

@@ -18,7 +18,7 @@ void KeyframeSink::on_frame(const FrameEvent& e) {
   char name[64];
   std::snprintf(name, sizeof name, "keyframe_%d_t%04.1fs.png", static_cast<int>(next_) + 1, e.t_s);
   keyframes_.emplace_back((std::filesystem::path(dir_) / name).string(),
-                          sim::keyframe_montage(*e.bgr, *e.result, mode_, models_, camera_, caption_(e)));
+                          sim::keyframe_montage(*e.bgr, *e.result, mode_, e.result->models, camera_, caption_(e)));
   ++next_;
 }
 

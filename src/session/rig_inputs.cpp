@@ -43,6 +43,8 @@ pipeline::FramePipelineParams pipeline_params(const std::string& vision_yaml,
   pp.bracelet = vision_cfg.bracelet;
   pp.registration = registration::parse_registration_params(reg_root["registration"]);
   pp.registration.silhouette_term = silhouette;
+  if (auto node = reg_root.find("personalisation"))
+    pp.shape_estimator = registration::parse_shape_estimator_params(*node, &pp.personalise_shape);
   pp.compositor.mode = mode;
   pp.initial_r_W_hand = initial_r_W_hand;
   return pp;

@@ -67,7 +67,8 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
        "joint_px_left,joint_px_right,occlusion_pct,occlusion_pct_paper,contested_pixels,"
        "contested_error_pct,contested_error_pct_paper,iterations_left,"
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
-       "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou\n";
+       "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou,"
+       "length_mm_left,width_mm_left,length_mm_right,width_mm_right\n";
   f << std::setprecision(6);
   for (const MrFrame& m : t.frames) {
     const auto& a = m.truth[0];
@@ -82,6 +83,7 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
       << m.servo_jitter_max_us << ',' << m.truth_cap_residual_mm[0] << ','
       << m.truth_cap_residual_mm[1] << ',';
     if (m.ceiling_measured) f << m.ceiling_iou;
+    for (int h = 0; h < 2; ++h) f << ',' << 1e3 * m.shape[h].length_m << ',' << 1e3 * m.shape[h].width_m;
     f << '\n';
   }
   core::write_file_atomic(path, f.str());
@@ -104,7 +106,7 @@ render::PlotSeries series(const MrTrace& t, const std::string& label, int colour
   return s;
 }
 
-void write_plots(const fs::path& dir, const MrTrace& t) {
+void write_plots(const fs::path& dir, const MrTrace& t, const MrSummary& summary) {
   using S = std::vector<render::PlotSeries>;
   {
     render::PlotSpec spec;
@@ -117,6 +119,20 @@ void write_plots(const fs::path& dir, const MrTrace& t) {
                 series(t, "right fingertip [mm]", 1, [](const MrFrame& m) { return m.truth[0].fingertip_mm[1]; }),
                 series(t, "left joints [px]", 2, [](const MrFrame& m) { return m.truth[0].joint_px[0]; }),
                 series(t, "right joints [px]", 3, [](const MrFrame& m) { return m.truth[0].joint_px[1]; })});
+  }
+  if (!t.frames.empty() && summary.user_length_m > 0) {
+    // The registration's size estimates converging (personalisation) against the user's sizes.
+    render::PlotSpec spec;
+    spec.title = "Hand size: the registration's estimate and the user's true size";
+    spec.x_label = "time [s]";
+    spec.y_label = "mm";
+    spec.references = {{"true length", 1e3 * summary.user_length_m, render::plot_colour(7)},
+                       {"true width", 1e3 * summary.user_width_m, render::plot_colour(6)}};
+    save_plot((dir / "hand_shape.png").string(), spec,
+              S{series(t, "left length", 0, [](const MrFrame& m) { return 1e3 * m.shape[0].length_m; }),
+                series(t, "right length", 1, [](const MrFrame& m) { return 1e3 * m.shape[1].length_m; }),
+                series(t, "left width", 2, [](const MrFrame& m) { return 1e3 * m.shape[0].width_m; }),
+                series(t, "right width", 3, [](const MrFrame& m) { return 1e3 * m.shape[1].width_m; })});
   }
   {
     render::PlotSpec spec;
@@ -226,6 +242,23 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   nlohmann::json other = registration_json(t, 1);
   other["method"] = s.main_silhouette ? "joint-balls (paper)" : "joint-balls + silhouette";
   reg["comparison"] = other;
+  // The hands' sizes as the registration estimated them (its starting profile when not
+  // personalised), beside ground_truth.hand_shape.
+  if (!t.frames.empty()) {
+    nlohmann::json shape;
+    for (int h = 0; h < 2; ++h) {
+      const registration::ShapeEstimate& e = t.frames.back().shape[h];
+      shape[h == 0 ? "left" : "right"] = {{"length_m", e.length_m},
+                                          {"width_m", e.width_m},
+                                          {"sigma_length_m", e.sigma_length_m},
+                                          {"sigma_width_m", e.sigma_width_m},
+                                          {"length_frozen", e.length_frozen},
+                                          {"width_frozen", e.width_frozen},
+                                          {"frames_used", e.frames_used}};
+    }
+    shape["personalised"] = s.personalised;
+    reg["hand_shape"] = shape;
+  }
 
   nlohmann::json report = {
       {"ended_by", s.ended_by},
@@ -322,7 +355,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   // Whole or not at all (a directory or unwritable path there is an error naming it, exit 2).
   core::write_file_atomic((dir / "report.json").string(), report.dump(2) + "\n");
   write_frames_csv((dir / "frames.csv").string(), t);
-  if (frames > 1) write_plots(dir, t);
+  if (frames > 1) write_plots(dir, t, s);
 
   os << "\nresult (" << frames << " frames in " << std::fixed << std::setprecision(1) << s.wall_s
      << " s, " << s.dropped << " dropped):\n"

@@ -31,12 +31,12 @@ void TruthScorer::on_frame(const FrameEvent& e) {
   m.preprocess_ms = result.timings.key_ms + result.timings.bracelet_ms + result.timings.distance_ms;
   m.stages = result.timings;
   m.film_ms = filmed.film_ms;
-  auto main_m = sim::measure_frame(filmed.frame, result, mode_, models_, truth_models_, filmed.truth,
+  auto main_m = sim::measure_frame(filmed.frame, result, mode_, result.models, truth_models_, filmed.truth,
                                    camera_, &ws_);
   if (!main_m) throw SpidarError(main_m.error().message);
   m.truth[0] = *main_m;
   if (e.compared != nullptr) {
-    auto alt_m = sim::measure_frame(filmed.frame, *e.compared, mode_, models_, truth_models_,
+    auto alt_m = sim::measure_frame(filmed.frame, *e.compared, mode_, e.compared->models, truth_models_,
                                     filmed.truth, camera_, &ws_);
     if (!alt_m) throw SpidarError(alt_m.error().message);
     m.truth[1] = *alt_m;
@@ -48,6 +48,7 @@ void TruthScorer::on_frame(const FrameEvent& e) {
   }
   for (int h = 0; h < 2; ++h) {
     m.iterations[h] = result.fits[h].iterations;
+    m.shape[h] = result.shapes[h];
     m.truth_cap_residual_mm[h] = filmed.cap_residual_m[h] * 1e3;
   }
   if (auto s = monitor_.status().read()) {

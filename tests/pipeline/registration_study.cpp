@@ -38,6 +38,7 @@ struct Args {
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
+  double shape_w = 0, shape_dq = 0;
 };
 
 double mean(const std::vector<double>& v) {
@@ -67,6 +68,8 @@ int main(int argc, char** argv) {
     else if (k == "--no-balls") a.no_balls = true;
     else if (k == "--no-wrist") a.no_wrist = true;
     else if (k == "--personalise") a.personalise = true;
+    else if (k == "--shape-w") a.shape_w = std::atof(next().c_str());
+    else if (k == "--shape-dq") a.shape_dq = std::atof(next().c_str());
     else if (k == "--t0") a.t0 = std::atof(next().c_str());
     else if (k == "--t1") a.t1 = std::atof(next().c_str());
     else if (k == "--fps") a.fps = std::atof(next().c_str());
@@ -111,6 +114,8 @@ int main(int argc, char** argv) {
   if (a.no_balls) p.registration.joint_ball_sigma_px = 1000;
   if (a.no_wrist) p.registration.wrist_sigma_px = 1000;
   p.personalise_shape = a.personalise;
+  if (a.shape_w > 0) p.shape_estimator.frame_weight = a.shape_w;
+  if (a.shape_dq > 0) p.shape_estimator.min_pose_change = a.shape_dq;
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models);
   for (int h = 0; h < 2; ++h)

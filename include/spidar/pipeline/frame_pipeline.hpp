@@ -18,6 +18,7 @@
 #include "spidar/core/scene_snapshot.hpp"
 #include "spidar/device/servo_types.hpp"
 #include "spidar/hand/hand_model.hpp"
+#include "spidar/registration/shape_estimator.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/render/compositor.hpp"
 #include "spidar/render/context.hpp"
@@ -54,8 +55,9 @@ struct FramePipelineParams {
   /// an independent little finger.
   render::HandSkinParams model_skin{0.12, 1.2, 0.10, false};
   /// Estimate each hand's length and width while the session runs (registration/shape_estimator.hpp)
-  /// and fit with the estimate; off: the models' sizes stay as given.
+  /// and fit with the estimate, starting from the given models; off: their sizes stay as given.
   bool personalise_shape = false;
+  registration::ShapeEstimatorParams shape_estimator;
   /// Hand rotations to start from on the first frame (rotation vectors, world) [rad].
   std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};
   /// Device finger index of each hand's thumb, index, middle, ring (the config's order).
@@ -72,6 +74,8 @@ struct FrameResult {
   std::array<hand::HandParams, 2> hands;                ///< fitted (left, right)
   /// The hand models the fit used (their sizes change when the shape is personalised).
   std::array<hand::HandModel, 2> models;
+  /// The hands' size estimates after this frame (the given sizes when not personalised).
+  std::array<registration::ShapeEstimate, 2> shapes;
   std::array<registration::FitReport, 2> fits;
   int restarts = 0;  ///< hands whose fit was restarted this frame
   std::array<vision::BraceletObservation, 2> bracelets;

@@ -32,6 +32,7 @@ struct MrSummary {
   std::string facelets, video_path, video_format, compositor, scene, user_hand;
   double user_length_m = 0, user_width_m = 0;  ///< the simulated user's true hand sizes
   bool main_silhouette = false;
+  bool personalised = false;  ///< the registration estimated the hands' sizes online
   int width = 0, height = 0;
   std::string ended_by = "completed";  ///< completed | SIGINT | SIGTERM
   std::uint64_t mujoco_warnings = 0;   ///< MuJoCo warnings in the process (physics::mujoco_warnings)

@@ -36,6 +36,8 @@ struct TruthFrame {
   double ceiling_iou = 0;
   bool ceiling_measured = false;
   std::array<int, 2> iterations{};
+  /// The registration's size estimates after this frame (left, right).
+  std::array<registration::ShapeEstimate, 2> shape{};
   std::array<double, 2> truth_cap_residual_mm{};
   double lift_mm = 0, u_angle_deg = 0, d_angle_deg = 0;
   int turns = 0;
