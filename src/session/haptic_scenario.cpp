@@ -4,9 +4,9 @@
 // own thread (proxies, coupling, contacts) with passivity control per finger.
 #include <algorithm>
 #include <filesystem>
-#include <sstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "spidar/session/data_path.hpp"

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <sstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
