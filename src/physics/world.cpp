@@ -12,6 +12,8 @@
 #include "spidar/core/file_read.hpp"
 #include "spidar/physics/mujoco_log.hpp"
 
+#include "model_numbers.hpp"
+
 namespace spidar::physics {
 namespace {
 
@@ -71,6 +73,11 @@ Result<std::unique_ptr<World>> World::Load(const std::string& scene_path, const 
                                 "(a name clash with proxy_N?): " + err};
     }
     return Error{scene_path + ": MuJoCo could not load the scene: " + err_original};
+  }
+  if (const std::string bad = first_non_finite_number(m); !bad.empty()) {
+    mj_deleteModel(m);
+    return Error{scene_path + ": the compiled scene has a non-finite number in " + bad +
+                 " (a nan or inf in the MJCF?); expected finite numbers"};
   }
   const double dt = m->opt.timestep;
   if (!(dt >= kMinTimestep && dt <= kMaxTimestep)) {

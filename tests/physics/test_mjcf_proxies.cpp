@@ -161,5 +161,20 @@ TEST(MjcfProxies, SceneFileMustBeASmallRegularFileWithASaneTimestep) {
   }
 }
 
+// MuJoCo 2.2.2 compiles "nan" in an attribute silently: the loaded world would step NaN.
+TEST(MjcfProxies, NonFiniteNumbersInTheSceneAreRefused) {
+  const auto dir = spidar::test::temp_dir("mjcf_nan");
+  const auto nan_size = write(dir, "nan_size.xml",
+                              "<mujoco><worldbody><geom type=\"sphere\" size=\"0.1\"/>\n"
+                              "<geom type=\"sphere\" size=\"nan\" pos=\"0 0 1\"/></worldbody></mujoco>");
+  EXPECT_NE(load_error(nan_size).find(nan_size + ": the compiled scene has a non-finite number in geom_size[3]"),
+            std::string::npos)
+      << load_error(nan_size);
+  const auto inf_gravity = write(dir, "inf_gravity.xml",
+                                 "<mujoco><option gravity=\"0 0 -inf\"/><worldbody/></mujoco>");
+  EXPECT_NE(load_error(inf_gravity).find("non-finite number in option gravity[2]"), std::string::npos)
+      << load_error(inf_gravity);
+}
+
 }  // namespace
 }  // namespace spidar::physics
