@@ -50,6 +50,25 @@ TEST(Outputs, ADemoCsvThatCannotBeWrittenFailsTheDemoNamingIt) {
   EXPECT_EQ(csv.back(), '\n') << "cut mid-row";
 }
 
+// An output folder that is a file, or under one, was "internal error: filesystem error" with
+// exit 1 (the servo-fault code): now exit 2 naming the path, for every command that writes one.
+TEST(Outputs, AnOutputFolderThatIsAFileIsNamedWithExit2) {
+  const fs::path dir = temp_dir("robust_out_is_file");
+  const std::string file = (dir / "a_file").string();
+  std::ofstream(file) << "not a folder\n";
+  for (const std::string& cmd :
+       {"demo --scenario strings --seconds 0.2 --out " + file, "demo --scenario haptic --seconds 0.2 --out " + file,
+        "render-test --frames 0 --out " + file,
+        "run --config configs/lab-example.yaml --headless --seconds 0.2 --record " + file + "/rec"}) {
+    SCOPED_TRACE(cmd);
+    const spidar::test::Run r = run_cli(cmd, "timeout 120 ");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(slurp(file), "not a folder\n");
+}
+
 // A recording whose fingertip log is empty (and session.json agrees) replays, but the comparison
 // it could not make is named, not written as null nor as a perfect 0.
 TEST(Outputs, ReplayOfARecordingWithNoFingertipSamplesWritesNoNull) {
