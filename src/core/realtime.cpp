@@ -4,6 +4,7 @@
 #include <sched.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstring>
 #include <string>
 
@@ -31,6 +32,24 @@ Status pin_to_cpu(int cpu) {
   CPU_SET(c, &set);
   if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set); rc != 0)
     return Error{"could not pin to CPU " + std::to_string(c) + " (" + std::strerror(rc) + ")"};
+  return Ok{};
+}
+
+Status release_starved_thread(pthread_t thread) {
+  std::string error;
+  sched_param sp{};
+  sp.sched_priority = 0;
+  if (const int rc = pthread_setschedparam(thread, SCHED_OTHER, &sp); rc != 0)
+    error = std::string("could not set SCHED_OTHER (") + std::strerror(rc) + ")";
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0) {
+    if (const int rc = pthread_setaffinity_np(thread, sizeof(set), &set); rc != 0 && error.empty())
+      error = std::string("could not widen its CPU affinity (") + std::strerror(rc) + ")";
+  } else if (error.empty()) {
+    error = std::string("could not read the CPU affinity (") + std::strerror(errno) + ")";
+  }
+  if (!error.empty()) return Error{error};
   return Ok{};
 }
 

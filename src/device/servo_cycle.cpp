@@ -4,11 +4,16 @@
 #include <cmath>
 #include <limits>
 
+#include "spidar/strings/device_config.hpp"
 #include "spidar/strings/motor.hpp"
 #include "spidar/strings/position.hpp"
 #include "spidar/strings/tension.hpp"
 
 namespace spidar::device {
+
+// A device config that loads (strings::parse_device_config) fits the samples and the protocol.
+static_assert(strings::kMaxConfigFingers == kMaxFingers);
+static_assert(strings::kMaxConfigStrings == kMaxDeviceStrings);
 
 ServoCycle::ServoCycle(const strings::DeviceConfig& config, const DeviceInfo& device)
     : config_(config),

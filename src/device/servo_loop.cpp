@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstring>
+#include <limits>
 
 #include "spidar/core/clock.hpp"
 
@@ -116,9 +117,11 @@ Status ServoLoop::start() {
     return Error{"servo loop: " + budget.error().message};
   }
   stop_.store(false);
+  released_at_end_.store(false);
+  start_ns_ = core::monotonic_ns();
   running_.store(true, std::memory_order_release);
   thread_ = std::thread([this] { run(); });
-  monitor_thread_ = std::thread([this] { monitor(); });
+  monitor_thread_ = std::thread([this, h = thread_.native_handle()] { monitor(h); });
   return Ok{};
 }
 
@@ -168,14 +171,23 @@ void ServoLoop::reset_faults() {
   device_.clear_safe_state();
 }
 
-void ServoLoop::monitor() {
+void ServoLoop::monitor(pthread_t servo_thread) {
   // Detects a servo thread that stopped cycling (stuck in a read, starved): safe state at once.
   const auto window_ns = std::max<std::int64_t>(core::s_to_ns(servo_.stall_limit_s), 1'000'000);
+  // The end by the wall clock, whether the servo thread runs or not.
+  const std::int64_t end_ns =
+      servo_.max_seconds > 0
+          ? start_ns_ + core::s_to_ns(servo_.max_seconds + kMaxSecondsGrace_s)
+          : std::numeric_limits<std::int64_t>::max();
   std::uint64_t last = cycle_.load(std::memory_order_acquire);
   std::int64_t last_progress_ns = core::monotonic_ns();  // when `last` was first seen
   std::int64_t next = last_progress_ns + 4 * window_ns;  // grace for start-up
   while (running_.load(std::memory_order_acquire) && !stop_.load(std::memory_order_acquire)) {
-    core::sleep_until_ns(std::min(next, core::monotonic_ns() + 1'000'000));
+    core::sleep_until_ns(std::min({next, end_ns, core::monotonic_ns() + 1'000'000}));
+    if (core::monotonic_ns() >= end_ns) {
+      stop_.store(true, std::memory_order_release);
+      break;
+    }
     if (core::monotonic_ns() < next) continue;
     const std::uint64_t now_cycles = cycle_.load(std::memory_order_acquire);
     if (now_cycles == last && running_.load(std::memory_order_acquire)) {
@@ -190,6 +202,26 @@ void ServoLoop::monitor() {
     if (now_cycles != last) last_progress_ns = core::monotonic_ns();
     last = now_cycles;
     next = core::monotonic_ns() + window_ns;
+  }
+  if (stop_.load(std::memory_order_acquire)) end_servo_thread(servo_thread, window_ns);
+}
+
+void ServoLoop::end_servo_thread(pthread_t servo_thread, std::int64_t window_ns) {
+  const std::int64_t requested = core::monotonic_ns();
+  while (running_.load(std::memory_order_acquire)) {
+    if (core::monotonic_ns() - requested >= window_ns) {
+      // Starved (or stuck in a read): let it run anywhere at normal priority. Harmless to a
+      // thread that is merely slow, since it is ending anyway.
+      released_at_end_.store(true, std::memory_order_release);
+      device_.request_safe_state();
+      const Status st = core::release_starved_thread(servo_thread);
+      spdlog::warn("servo loop: the servo thread had not ended {:.0f} ms after the stop request "
+                   "(starved by the scheduler?); moved it to normal scheduling on every CPU{}{}",
+                   static_cast<double>(core::monotonic_ns() - requested) * 1e-6,
+                   st.ok() ? "" : ": ", st.ok() ? "" : st.error().message);
+      return;
+    }
+    core::sleep_until_ns(core::monotonic_ns() + 1'000'000);
   }
 }
 
@@ -358,6 +390,7 @@ ServoStats ServoLoop::stats() const {
   s.longest_repeat = longest_repeat_;
   s.inconsistent = cycle_maths_.inconsistent();
   s.realtime_scheduling = realtime_granted_;
+  s.released_at_end = released_at_end_.load(std::memory_order_acquire);
   return s;
 }
 

@@ -4,131 +4,90 @@
 
 #include <mujoco/mujoco.h>
 
-#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
-#include <string_view>
 
+#include "spidar/core/file_read.hpp"
 #include "spidar/physics/mujoco_log.hpp"
+
+#include "model_numbers.hpp"
 
 namespace spidar::physics {
 namespace {
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+/// MuJoCo's model compiled from MJCF `text` staged in a virtual file system under the scene's own
+/// file name, so relative assets and includes still resolve against the scene's directory. Null
+/// with MuJoCo's message in `err` on failure.
+mjModel* load_from_memory(const std::string& scene_path, const std::string& text,
+                          std::string& err) {
+  namespace fs = std::filesystem;
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  const std::string name = fs::path(scene_path).filename().string();
+  if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(text.size())) != 0) {
+    err = "could not stage the scene in MuJoCo's virtual file system";
+    return nullptr;
+  }
+  const int idx = mj_findFileVFS(vfs.get(), name.c_str());
+  std::memcpy(vfs->filedata[idx], text.data(), text.size());
+  char buf[1024] = "";
+  mjModel* m = mj_loadXML(scene_path.c_str(), vfs.get(), buf, sizeof(buf));
+  mj_deleteVFS(vfs.get());
+  err = buf;
+  return m;
 }
+
+/// Physics steps in real time beside the servo loop: a step longer than this makes the coupling
+/// a spring sampled too slowly to be stable, one shorter cannot be computed in real time.
+constexpr double kMinTimestep = 1e-5;  // [s]
+constexpr double kMaxTimestep = 0.01;  // [s]
 
 }  // namespace
-
-namespace {
-
-int line_at(const std::string& text, std::size_t pos) {
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
-}
-
-/// Where the last real closing worldbody tag starts in an MJCF text: a tiny XML scanner that
-/// skips comments, CDATA sections, processing instructions and declarations, so a
-/// "</worldbody>" inside any of them is not taken for the tag.
-Result<std::size_t> find_worldbody_end(const std::string& xml) {
-  static constexpr std::string_view kTag = "</worldbody";
-  std::size_t found = std::string::npos;
-  std::size_t i = 0;
-  const auto skip_to = [&](std::size_t from, std::string_view close, const char* what) -> Result<std::size_t> {
-    const std::size_t e = xml.find(close, from);
-    if (e == std::string::npos) {
-      return Error{std::string("unterminated ") + what + " starting at line " + std::to_string(line_at(xml, i)) +
-                   " (expected '" + std::string(close) + "')"};
-    }
-    return e + close.size();
-  };
-  while ((i = xml.find('<', i)) != std::string::npos) {
-    const std::string_view rest = std::string_view(xml).substr(i);
-    Result<std::size_t> next = i + 1;
-    if (rest.starts_with("<!--")) {
-      next = skip_to(i + 4, "-->", "comment");
-    } else if (rest.starts_with("<![CDATA[")) {
-      next = skip_to(i + 9, "]]>", "CDATA section");
-    } else if (rest.starts_with("<?")) {
-      next = skip_to(i + 2, "?>", "processing instruction");
-    } else if (rest.starts_with("<!")) {
-      next = skip_to(i + 2, ">", "declaration");
-    } else if (rest.starts_with(kTag)) {
-      std::size_t k = i + kTag.size();
-      while (k < xml.size() && std::isspace(static_cast<unsigned char>(xml[k]))) ++k;
-      if (k < xml.size() && xml[k] == '>') found = i;
-      next = i + kTag.size();
-    }
-    if (!next) return next.error();
-    i = *next;
-  }
-  if (found == std::string::npos) {
-    return Error{"no </worldbody> (outside comments) to add the fingertip proxies to; expected an "
-                 "MJCF scene with a <worldbody>...</worldbody> element"};
-  }
-  return found;
-}
-
-}  // namespace
-
-Result<std::string> inject_proxies(const std::string& mjcf, const ProxyParams& p) {
-  const auto found = find_worldbody_end(mjcf);
-  if (!found) return found.error();
-  const std::size_t pos = *found;
-  std::ostringstream os;
-  os.precision(9);
-  os << "\n    <!-- spidar-mr fingertip proxies -->\n";
-  for (int i = 0; i < p.count; ++i) {
-    // Parked below the scene until placed; contype 2 / conaffinity 1: they touch the scene
-    // (default contype 1) but not each other.
-    // Three slide joints: a fingertip proxy translates but does not roll (a rolling sphere would
-    // climb a grasped object instead of lifting it).
-    os << "    <body name=\"proxy_" << i << "\" pos=\"" << 0.05 * i << " 0 -5\">\n"
-       << "      <joint name=\"proxy_" << i << "_x\" type=\"slide\" axis=\"1 0 0\"/>\n"
-       << "      <joint name=\"proxy_" << i << "_y\" type=\"slide\" axis=\"0 1 0\"/>\n"
-       << "      <joint name=\"proxy_" << i << "_z\" type=\"slide\" axis=\"0 0 1\"/>\n"
-       << "      <geom name=\"proxy_" << i << "_geom\" type=\"sphere\" size=\"" << p.radius
-       << "\" mass=\"" << p.mass << "\" contype=\"2\" conaffinity=\"1\" condim=\"4\" friction=\""
-       << p.friction << " " << p.torsional_friction << " 0.0001\" rgba=\"0.9 0.3 0.3 0.6\"/>\n"
-       << "    </body>\n";
-  }
-  std::string out = mjcf;
-  out.insert(pos, os.str());
-  return out;
-}
 
 Result<std::unique_ptr<World>> World::Load(const std::string& scene_path, const WorldParams& params) {
-  namespace fs = std::filesystem;
   install_mujoco_warning_handler();  // before MuJoCo's compiler can warn
-  if (!fs::exists(scene_path)) {
-    return Error{scene_path + ": scene file not found (expected an MJCF .xml file)"};
-  }
   if (params.proxy.count < 0 || params.proxy.count > 16 || !(params.proxy.radius > 0) ||
       !(params.proxy.mass > 0)) {
     return Error{scene_path + ": bad proxy parameters (count 0..16, radius > 0, mass > 0)"};
   }
-  auto text = inject_proxies(read_text(scene_path), params.proxy);
-  if (!text) return Error{scene_path + ": " + text.error().message};
-
-  // Load from memory under the scene's own file name, so relative assets still resolve against
-  // the scene's directory.
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  const std::string name = fs::path(scene_path).filename().string();
-  if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(text->size())) != 0) {
-    return Error{scene_path + ": could not stage the scene in MuJoCo's virtual file system"};
+  std::string original;
+  try {
+    original = core::read_file_bounded(scene_path, kMaxSceneFileBytes, "a scene file");
+  } catch (const core::FileError& e) {
+    return Error{std::string(e.what()) + " (expected an MJCF .xml scene file)"};
   }
-  const int idx = mj_findFileVFS(vfs.get(), name.c_str());
-  std::memcpy(vfs->filedata[idx], text->data(), text->size());
-  char err[1024] = "";
-  mjModel* m = mj_loadXML(scene_path.c_str(), vfs.get(), err, sizeof(err));
-  mj_deleteVFS(vfs.get());
-  if (!m) return Error{scene_path + ": MuJoCo could not load the scene: " + std::string(err)};
+  auto text = inject_proxies(original, params.proxy, scene_path);
+  if (!text) return text.error();
+
+  std::string err;
+  mjModel* m = load_from_memory(scene_path, *text, err);
+  if (!m) {
+    // MuJoCo's line numbers are of the re-printed text: quote its words about the user's own file
+    // when that fails alone, and say so when only the proxies made it fail (a name clash).
+    std::string err_original;
+    if (mjModel* alone = load_from_memory(scene_path, original, err_original)) {
+      mj_deleteModel(alone);
+      return Error{scene_path + ": MuJoCo could not load the scene with the fingertip proxies added "
+                                "(a name clash with proxy_N?): " + err};
+    }
+    return Error{scene_path + ": MuJoCo could not load the scene: " + err_original};
+  }
+  if (const std::string bad = first_non_finite_number(m); !bad.empty()) {
+    mj_deleteModel(m);
+    return Error{scene_path + ": the compiled scene has a non-finite number in " + bad +
+                 " (a nan or inf in the MJCF?); expected finite numbers"};
+  }
+  const double dt = m->opt.timestep;
+  if (!(dt >= kMinTimestep && dt <= kMaxTimestep)) {
+    mj_deleteModel(m);
+    std::ostringstream os;
+    os << scene_path << ": <option timestep=\"" << dt << "\"> is out of range; expected "
+       << kMinTimestep << " s <= timestep <= " << kMaxTimestep
+       << " s (the physics steps in real time beside the servo loop)";
+    return Error{os.str()};
+  }
 
   std::unique_ptr<World> w(new World());
   w->params_ = params;

@@ -1,8 +1,12 @@
 #include "spidar/render/video_output.hpp"
 
 #include <filesystem>
+#include <string_view>
+#include <vector>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+
+#include "spidar/core/atomic_write.hpp"
 
 namespace spidar::render {
 
@@ -12,10 +16,19 @@ Status write_png(const std::string& path, const cv::Mat& image) {
   const auto parent = std::filesystem::path(path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   if (ec) return Error{"write_png: cannot create folder " + parent.string() + ": " + ec.message()};
+  std::vector<unsigned char> png;
   try {
-    if (!cv::imwrite(path, image)) return Error{"write_png: cannot write " + path};
+    if (!cv::imencode(".png", image, png)) return Error{"write_png: cannot encode " + path};
   } catch (const cv::Exception& e) {
     return Error{"write_png: " + path + ": " + e.what()};
+  }
+  // Whole or not at all (temporary file + rename, through symlinks); no fsync: a recording writes
+  // one per frame, and the rename alone keeps a killed run from leaving half an image.
+  try {
+    core::write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()),
+                            core::AtomicWriteOptions{.sync = false});
+  } catch (const core::FileError& e) {
+    return Error{std::string("write_png: ") + e.what()};
   }
   return Ok{};
 }

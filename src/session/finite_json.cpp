@@ -1,6 +1,7 @@
 #include "spidar/session/finite_json.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -10,8 +11,14 @@ namespace spidar::session {
 
 namespace {
 
-/// The first non-finite number under `j`, as a JSON pointer ("" if none).
+/// The first non-finite number or null under `j`, as a JSON pointer ("" if none); a null reads
+/// as NaN in `value`.
 bool find_non_finite(const nlohmann::json& j, const std::string& path, std::string* where, double* value) {
+  if (j.is_null()) {
+    *where = path.empty() ? "/" : path;
+    *value = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
   if (j.is_number_float()) {
     const double v = j.get<double>();
     if (std::isfinite(v)) return false;
@@ -39,7 +46,8 @@ void require_finite_json(const nlohmann::json& j, std::string_view what) {
   if (!find_non_finite(j, "", &where, &v)) return;
   std::ostringstream os;
   os << std::string(what) << ": " << where << " is " << v
-     << " (a bug: every number written must be finite; JSON would show it as null)";
+     << " (a bug: every number written must be finite and every value present; JSON would show "
+        "it as null)";
   throw SpidarError(os.str());
 }
 

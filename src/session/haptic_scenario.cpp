@@ -4,9 +4,9 @@
 // own thread (proxies, coupling, contacts) with passivity control per finger.
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "spidar/session/data_path.hpp"
@@ -146,7 +146,7 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
                        {"energy_dissipated_mj", port.dissipated * 1e3},
                        {"passivity_active_cycles", port.active_steps}});
   }
-  std::ofstream csv(fs::path(o.out) / "haptic_trace.csv");
+  std::ostringstream csv;  // written whole (write_file_atomic) below, never cut mid-row
   csv << "t";
   for (const auto& f : cfg.fingers) {
     for (const char* q : {"x", "y", "z", "fx", "fy", "fz"}) csv << ',' << f.name << '_' << q;
@@ -160,6 +160,7 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
     }
     csv << '\n';
   }
+  core::write_file_atomic((fs::path(o.out) / "haptic_trace.csv").string(), csv.str());
   nlohmann::json report = {
       {"scenario", "haptic"},
       {"scene", scene},

@@ -5,6 +5,7 @@
 
 #include "spidar/session/data_path.hpp"
 #include "spidar/core/config.hpp"
+#include "spidar/hand/hand_config.hpp"
 
 namespace spidar::session {
 namespace {
@@ -111,8 +112,19 @@ LiveConfig load_live_config(const std::string& path, bool check_hardware) {
   const ConfigNode hands = root["hands"];
   hands.expect_keys({"file", "model", "user", "control"});
   c.hands_file = existing_file(hands["file"], base);
-  if (auto n = hands.find("model")) c.model_profile = n->as_string();
-  if (auto n = hands.find("user")) c.user_profile = n->as_string();
+  // A profile named here must exist (only an absent `user` falls back to the file's first).
+  const hand::HandProfiles profiles = hand::load_hand_profiles(c.hands_file);
+  auto profile = [&](const ConfigNode& n) {
+    std::string name = n.as_string();
+    if (profiles.find(name) == nullptr) {
+      std::string known;
+      for (const auto& p : profiles.profiles) known += (known.empty() ? "" : ", ") + p.name;
+      n.fail("no hand profile '" + name + "' in " + c.hands_file + "; expected one of: " + known);
+    }
+    return name;
+  };
+  if (auto n = hands.find("model")) c.model_profile = profile(*n);
+  if (auto n = hands.find("user")) c.user_profile = profile(*n);
   if (auto n = hands.find("control")) c.user_mode = one_of(*n, {"scripted", "interactive"});
   if (c.camera_source == "synthetic" && c.backend != "sim")
     root["camera"]["source"].fail(

@@ -98,7 +98,7 @@ nlohmann::json write_replay_report(const std::string& out, const RecordingRig& r
                        {"residual_mean", {{"fingertip", mean(f.terms[0])}, {"wrist", mean(f.terms[1])},
                                           {"joint_ball", mean(f.terms[2])}, {"silhouette", mean(f.terms[3])},
                                           {"prior", mean(f.terms[4])}}}};
-  // Comparisons with no data are null, not a perfect 0.
+  // Comparisons with no data are null here, not a perfect 0 ...
   const int hands = f.compared_hands;
   j["reproduction"] = {{"frames_compared", f.compared},
                        {"hands_compared", hands},
@@ -110,6 +110,13 @@ nlohmann::json write_replay_report(const std::string& out, const RecordingRig& r
                        {"fingertip_resample_max_mm", measured_or_null(f.max_resample_mm, f.resampled)},
                        {"frames_store", png ? "png (lossless)"
                                         : rec.meta.frames_codec + " (lossy: the fits differ from the live ones)"}};
+  // ... and then not written at all: JSON we write holds no null (issue 17). Their names are listed
+  // in reproduction.not_measured instead.
+  nlohmann::json not_measured = nlohmann::json::array();
+  for (const auto& [key, value] : j["reproduction"].items())
+    if (value.is_null()) not_measured.push_back(key);
+  for (const auto& key : not_measured) j["reproduction"].erase(key.get<std::string>());
+  j["reproduction"]["not_measured"] = not_measured;
   j["outputs"] = {{"video", video}};
 
   auto write_plot = [&](const std::string& name, render::PlotSpec spec, std::vector<render::PlotSeries> s) {

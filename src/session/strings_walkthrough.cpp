@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -237,7 +236,7 @@ void run_strings_walkthrough(const ScenarioOptions& a, std::ostream& out) {
   const double dt = 1.0 / a.rate_hz;
   const int steps = static_cast<int>(std::lround(seconds * a.rate_hz));
   const int print_every = std::max(1, steps / 12);
-  std::ofstream csv(fs::path(a.out) / "walkthrough.csv");
+  std::ostringstream csv;  // written whole (write_file_atomic) after the grasp, never cut mid-row
   csv << "t,finger,x_true,y_true,z_true,x_est,y_est,z_est,err_mm,fx_des,fy_des,fz_des,"
          "fx_disp,fy_disp,fz_disp,reachable,t0,t1,t2,dac0,dac1,dac2\n";
   std::vector<double> err_max(nf, 0), err_sum2(nf, 0), force_max(nf, 0), force_gap_max(nf, 0);
@@ -302,6 +301,7 @@ void run_strings_walkthrough(const ScenarioOptions& a, std::ostream& out) {
       }
     }
   }
+  core::write_file_atomic((fs::path(a.out) / "walkthrough.csv").string(), csv.str());
   const int samples = (steps + 1);
   out << "\nper finger over the run (fidelity: displayed force along the desired push / "
                "desired, in contact):\n  finger        err RMS [mm]  err max [mm]  max |F| [N]"

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <sstream>
 
+#include "spidar/strings/convex_hull.hpp"
+
 namespace spidar::strings {
 namespace {
 
@@ -24,11 +26,21 @@ FingerConfig parse_finger(const core::ConfigNode& node, const DeviceConfig& dev,
                     "length_at_zero"});
   FingerConfig f;
   f.name = node["name"].as_string();
+  if (f.name.find_first_not_of(" \t") == std::string::npos) {
+    node["name"].fail("expected a non-empty finger name");
+  }
   if (auto hand = node.find("hand")) {
     f.hand = hand->as_string();
     if (f.hand != "left" && f.hand != "right") hand->fail("expected 'left' or 'right'");
   }
-  f.unit = static_cast<int>(node.get_int("unit", -1));
+  if (node.has("unit")) {
+    const std::int64_t unit = node["unit"].as_int();
+    if (unit < 0 || unit >= kMaxConfigFingers) {
+      node["unit"].fail("expected a unit number 0.." + std::to_string(kMaxConfigFingers - 1) +
+                        " (one per fingertip), got " + std::to_string(unit));
+    }
+    f.unit = static_cast<int>(unit);
+  }
   const auto fulcrums = node["fulcrums"];
   std::vector<Vec3> p_WA;
   for (std::size_t i = 0; i < fulcrums.size(); ++i) p_WA.push_back(fulcrums.at(i).as_vec3());
@@ -124,13 +136,41 @@ DeviceConfig parse_device_config(const core::ConfigNode& root) {
 
   const auto fingers = root["fingers"];
   if (fingers.size() == 0) fingers.fail("expected at least one finger");
+  if (fingers.size() > static_cast<std::size_t>(kMaxConfigFingers)) {
+    fingers.fail("expected at most " + std::to_string(kMaxConfigFingers) + " fingers, got " +
+                 std::to_string(fingers.size()));
+  }
+  std::vector<Vec3> p_WA_all;
   for (std::size_t i = 0; i < fingers.size(); ++i) {
     dev.fingers.push_back(parse_finger(fingers.at(i), dev, mpc));
+    const FingerConfig& f = dev.fingers.back();
     for (std::size_t j = 0; j < i; ++j) {
-      if (dev.fingers[j].name == dev.fingers[i].name) {
-        fingers.at(i)["name"].fail("duplicate finger name '" + dev.fingers[i].name + "'");
+      if (dev.fingers[j].name == f.name) {
+        fingers.at(i)["name"].fail("duplicate finger name '" + f.name + "'");
+      }
+      if (f.unit >= 0 && dev.fingers[j].unit == f.unit) {
+        fingers.at(i)["unit"].fail("unit " + std::to_string(f.unit) + " is also finger " +
+                                   std::to_string(j) + "'s ('" + dev.fingers[j].name +
+                                   "'); expected one unit per finger");
       }
     }
+    for (int k = 0; k < f.geometry.n; ++k) p_WA_all.push_back(f.geometry.p_WA[k]);
+    if (dev.string_count() > kMaxConfigStrings) {
+      fingers.at(i)["fulcrums"].fail("this finger brings the device to " +
+                                     std::to_string(dev.string_count()) +
+                                     " strings; expected at most " +
+                                     std::to_string(kMaxConfigStrings) +
+                                     " in all (the wire protocol's limit)");
+    }
+  }
+  if (!inside_convex_hull(p_WA_all, dev.p_W_centre)) {
+    const auto& c = dev.p_W_centre;
+    std::ostringstream os;
+    os << "the frame centre (" << c.x() << ", " << c.y() << ", " << c.z()
+       << ") m is not inside the fulcrums' convex hull; expected the point the fingertips are "
+          "zeroed at, inside the frame";
+    if (auto node = root.find("frame_centre")) node->fail(os.str());
+    root.fail(os.str());
   }
   return dev;
 }

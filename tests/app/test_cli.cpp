@@ -407,8 +407,9 @@ TEST(Cli, ReplayOfARecordingWithANonFiniteFitWritesNoNull) {
   fs::remove_all(d);
 }
 
-/// configs/spidar8.yaml with every fulcrum moved 1 m along x: the scripted user's fingertips at
-/// the cube are then far outside the device's workspace, which the servo loop latches.
+/// configs/spidar8.yaml with every fulcrum, and the frame centre with them (a centre outside the
+/// fulcrums' hull is a config error), moved 1 m along x: the scripted user's fingertips at the
+/// cube are then far outside the device's workspace, which the servo loop latches.
 std::string shifted_config(const std::string& dir) {
   std::istringstream in(slurp_file("configs/spidar8.yaml"));
   std::ostringstream out;
@@ -420,11 +421,14 @@ std::string shifted_config(const std::string& dir) {
     if (std::regex_match(line, m, fulcrum)) {
       out << m[1] << std::stod(m[2]) + 1.0 << m[3] << "\n";
       ++shifted;
+    } else if (line.rfind("frame_centre: [0.0, 0.0, 0.0]", 0) == 0) {
+      out << "frame_centre: [1.0, 0.0, 0.0]\n";
+      ++shifted;
     } else {
       out << line << "\n";
     }
   }
-  EXPECT_EQ(shifted, 24);
+  EXPECT_EQ(shifted, 25);
   std::filesystem::create_directories(dir);
   const std::string path = dir + "/shifted.yaml";
   std::ofstream(path) << out.str();

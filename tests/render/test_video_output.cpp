@@ -35,6 +35,31 @@ TEST(VideoOutput, PngRoundTrip) {
   std::filesystem::remove_all(dir);
 }
 
+// Whole or not at all: written through a symbolic link (which stays a link); a directory or a
+// device in the way is an error naming the path, and leaves no temporary file behind.
+TEST(VideoOutput, PngIsWrittenWholeThroughLinksOrNotAtAll) {
+  namespace fs = std::filesystem;
+  const auto dir = scratch("png_atomic");
+  fs::create_directories(dir / "real");
+  fs::create_symlink(dir / "real" / "frame.png", dir / "frame.png");
+  const cv::Mat img = test_frame(1);
+  ASSERT_TRUE(write_png((dir / "frame.png").string(), img).ok());
+  EXPECT_TRUE(fs::is_symlink(dir / "frame.png"));
+  EXPECT_EQ(cv::norm(cv::imread((dir / "real" / "frame.png").string()), img, cv::NORM_INF), 0.0);
+
+  fs::create_directories(dir / "taken.png");
+  const Status st = write_png((dir / "taken.png").string(), img);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find((dir / "taken.png").string() + ": is a directory"), std::string::npos)
+      << st.error().message;
+  fs::create_symlink("/dev/full", dir / "full.png");
+  EXPECT_FALSE(write_png((dir / "full.png").string(), img).ok());
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(dir)) files += e.path().filename().string().find(".tmp") != std::string::npos;
+  EXPECT_EQ(files, 0) << "a temporary file was left behind";
+  fs::remove_all(dir);
+}
+
 TEST(VideoOutput, WritesAPlayableFileAndSaysWhichFormat) {
   const auto dir = scratch("video");
   auto video = VideoOutput::open((dir / "clip.mp4").string(), 160, 120, 10);

@@ -123,6 +123,44 @@ TEST(DeviceConfig, OtherMistakesGiveClearErrors) {
   EXPECT_NE(parse_error(two).find("duplicate finger name 'grip'"), std::string::npos);
 }
 
+// Ranges a hostile or careless config got past the loader (issue 17): units, names, how many
+// fingers and strings, and where the frame centre is.
+TEST(DeviceConfig, UnitsNamesCountsAndTheFrameCentreAreChecked) {
+  const std::string s8 = read_file(testing::source_path("configs/spidar8.yaml"));
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = s8;
+    const auto pos = t.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    t.replace(pos, from.size(), to);
+    return parse_error(t, "s8.yaml");
+  };
+  EXPECT_NE(with("unit: 3\n", "unit: 2\n").find("fingers[1].unit: unit 2 is also finger 0's ('left_thumb'); expected one unit per finger"),
+            std::string::npos) << with("unit: 3\n", "unit: 2\n");
+  EXPECT_NE(with("unit: 3\n", "unit: 99\n").find("fingers[1].unit: expected a unit number 0..7 (one per fingertip), got 99"),
+            std::string::npos) << with("unit: 3\n", "unit: 99\n");
+  EXPECT_NE(with("unit: 3\n", "unit: -1\n").find("got -1"), std::string::npos);
+  EXPECT_NE(with("name: left_index", "name: \"\"").find("fingers[1].name: expected a non-empty finger name"),
+            std::string::npos) << with("name: left_index", "name: \"\"");
+  const std::string far = with("frame_centre: [0.0, 0.0, 0.0]", "frame_centre: [100.0, 0.0, 0.0]");
+  EXPECT_NE(far.find("s8.yaml:"), std::string::npos) << far;
+  EXPECT_NE(far.find("frame_centre: the frame centre (100, 0, 0) m is not inside the fulcrums' convex hull"),
+            std::string::npos) << far;
+  // Just inside the frame (the fulcrums reach x = ±0.366 m) is fine.
+  EXPECT_EQ(with("frame_centre: [0.0, 0.0, 0.0]", "frame_centre: [0.3, 0.0, 0.0]"), "no error");
+
+  // A ninth finger, and more strings than the protocol carries.
+  const std::string g4 = read_file(testing::source_path("configs/spidar-g4.yaml"));
+  std::string nine = g4;
+  for (int i = 0; i < 8; ++i)
+    nine += "  - name: extra" + std::to_string(i) + "\n    fulcrums: [[-0.3, -0.3, -0.3], [0.3, -0.3, -0.3], [0, 0.3, -0.3], [0, 0, 0.3]]\n";
+  EXPECT_NE(parse_error(nine).find("fingers: expected at most 8 fingers, got 9"), std::string::npos) << parse_error(nine);
+  std::string many = g4;
+  for (int i = 0; i < 7; ++i)
+    many += "  - name: extra" + std::to_string(i) + "\n    fulcrums: [[-0.3, -0.3, -0.3], [0.3, -0.3, -0.3], [0, 0.3, -0.3], [0, 0, 0.3], [0.1, 0.1, 0.3]]\n";
+  EXPECT_NE(parse_error(many).find("fingers[6].fulcrums: this finger brings the device to 34 strings; expected at most 32 in all (the wire protocol's limit)"),
+            std::string::npos) << parse_error(many);
+}
+
 TEST(DeviceConfig, MissingFileIsAClearError) {
   try {
     load_device_config("/no/such/spidar.yaml");

@@ -5,6 +5,8 @@
 ///
 /// Priorities used by spidar-mr (higher runs first): servo loop 80, serial device emulator 70,
 /// physics thread 60. Everything else (frame thread, camera, GUI) stays SCHED_OTHER.
+#include <pthread.h>
+
 #include "spidar/core/result.hpp"
 
 namespace spidar::core {
@@ -14,5 +16,12 @@ Status set_fifo_priority(int priority);
 
 /// Pins the calling thread to `cpu` (0-based; −1 = the last online CPU). Error names the CPU.
 Status pin_to_cpu(int cpu);
+
+/// Lets `thread`, which its own scheduling starves, run again so that it can see a stop request
+/// and end: SCHED_OTHER (priority 0) on every CPU the calling thread may use. Called from another
+/// thread, e.g. for a thread pinned at SCHED_FIFO to a CPU that a higher-priority task holds, or
+/// one put at SCHED_IDLE beside busy threads. Both changes are tried; the error names the first
+/// that failed.
+Status release_starved_thread(pthread_t thread);
 
 }  // namespace spidar::core

@@ -81,7 +81,11 @@ struct ServoConfig {
   /// New readings in a row on which the device's clock (`device_time_us`) may not advance while
   /// the host's does; reaching it latches kFaultFrozenClock. ≥ 2. 10 = 10 ms at 1 kHz.
   int max_frozen_clock_readings = 10;
-  double max_seconds = 0.0;       ///< > 0: stop by itself after this long
+  /// > 0: stop by itself after this long [s]. The servo thread ends itself that long after its
+  /// first timed cycle; the monitor thread ends the loop by the wall clock at most
+  /// kMaxSecondsGrace_s later whatever the servo thread does (a starved thread that never runs
+  /// cannot hold up the end; see ServoLoop::stop).
+  double max_seconds = 0.0;
   /// Runs in the servo thread before the first cycle (tests: allocation counters).
   std::function<void()> on_thread_start;
 };
@@ -103,7 +107,14 @@ struct ServoStats {
   /// bound; …" (FaultLog::describe). Empty when no fault is latched.
   std::string fault_message;
   bool realtime_scheduling = false; ///< SCHED_FIFO was granted
+  /// The servo thread did not end within a stall window of the stop request (the scheduler starved
+  /// it) and was moved to normal scheduling on every CPU so that it could end.
+  bool released_at_end = false;
 };
+
+/// How much later than ServoConfig::max_seconds the monitor ends a loop whose servo thread has not
+/// ended itself [s] (its first read may take a device handshake).
+inline constexpr double kMaxSecondsGrace_s = 0.5;
 
 class ServoLoop {
  public:
@@ -118,9 +129,15 @@ class ServoLoop {
   /// Starts the servo and monitor threads. Errors if already running, the device is closed, or
   /// its link cannot carry the rate (`Device::check_rate`).
   Status start();
-  /// Stops the threads (device left in its safe state). Idempotent.
+  /// Stops the threads (device left in its safe state). Idempotent. Bounded in time even when the
+  /// servo thread is starved (pinned at SCHED_FIFO to a CPU a higher-priority task holds, or at
+  /// SCHED_IDLE beside busy threads): if it has not ended one stall window (stall_limit_s, at
+  /// least 1 ms) after the request, the monitor thread moves it to SCHED_OTHER on every CPU
+  /// (core::release_starved_thread) so that it runs, sees the request and ends. Only a machine
+  /// whose every CPU is held by higher-priority tasks can still hold it up.
   void stop();
-  /// Blocks until the loop ends by itself (max_seconds, a device fault) or `stop()`.
+  /// Blocks until the loop ends by itself (max_seconds by the wall clock, a device fault) or
+  /// `stop()`.
   void wait();
   bool running() const { return running_.load(std::memory_order_acquire); }
 
@@ -144,7 +161,10 @@ class ServoLoop {
 
  private:
   void run();
-  void monitor();
+  void monitor(pthread_t servo_thread);
+  /// After a stop request (stop_ set): waits up to `window_ns` for the servo thread to end, then
+  /// releases it (see stop()). Monitor thread.
+  void end_servo_thread(pthread_t servo_thread, std::int64_t window_ns);
   /// Latches `faults`; for the bits not latched before, records the text (printf `format`).
   /// Returns the newly latched bits. No allocation.
   std::uint32_t latch(std::uint32_t faults, const char* format, ...) noexcept
@@ -177,6 +197,8 @@ class ServoLoop {
   std::uint64_t repeated_readings_ = 0, longest_repeat_ = 0;
   FaultLog fault_log_;
   bool realtime_granted_ = false;
+  std::int64_t start_ns_ = 0;  ///< when start() was called (monotonic) [ns]
+  std::atomic<bool> released_at_end_{false};
 
   core::SampleRing<FingertipSample, 1024> ring_;
   std::atomic<bool> running_{false}, stop_{false}, estop_{false};

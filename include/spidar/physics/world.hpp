@@ -14,19 +14,12 @@
 #include "spidar/core/result.hpp"
 #include "spidar/core/scene_snapshot.hpp"
 #include "spidar/physics/coupling.hpp"
+#include "spidar/physics/mjcf_proxies.hpp"
 
 struct mjModel_;
 struct mjData_;
 
 namespace spidar::physics {
-
-struct ProxyParams {
-  int count = 8;             ///< one per device fingertip
-  double radius = 0.008;     ///< [m]
-  double mass = 0.01;        ///< [kg]; gravity is compensated
-  double friction = 1.0;     ///< sliding friction against objects
-  double torsional_friction = 0.002;  ///< [m]; keeps a pinched object from pivoting
-};
 
 struct WorldParams {
   ProxyParams proxy;
@@ -107,9 +100,5 @@ class World {
   std::vector<StepHook> hooks_, post_hooks_;
   std::shared_ptr<const std::vector<MeshData>> meshes_;
 };
-
-/// The MJCF text of the proxies (bodies named proxy_0..proxy_{n−1}) inserted before the scene's
-/// last </worldbody>; exposed for tests. Errors if the text has no </worldbody>.
-Result<std::string> inject_proxies(const std::string& mjcf, const ProxyParams& proxy);
 
 }  // namespace spidar::physics

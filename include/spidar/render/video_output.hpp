@@ -17,7 +17,8 @@ class VideoWriter;
 
 namespace spidar::render {
 
-/// Writes an image as PNG, creating missing parent folders. Error names the path.
+/// Writes an image as PNG, creating missing parent folders, whole or not at all
+/// (core::write_file_atomic, without fsync). Error names the path.
 Status write_png(const std::string& path, const cv::Mat& image);
 
 enum class VideoFormat { kMp4H264, kMp4Mpeg4, kAviMjpg };

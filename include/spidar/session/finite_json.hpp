@@ -8,8 +8,8 @@
 namespace spidar::session {
 
 /// SpidarError naming the JSON path (e.g. "/haptic/jitter_p99_us") of the first number in `j`
-/// that is NaN or infinite, which nlohmann::json would write as null; `what` names the output
-/// ("report.json"). Call before writing any JSON.
+/// that is NaN or infinite, which nlohmann::json would write as null, or of the first null;
+/// `what` names the output ("report.json"). Call before writing any JSON.
 void require_finite_json(const nlohmann::json& j, std::string_view what);
 
 /// A vector as a JSON array [x, y, z].

@@ -12,10 +12,16 @@
 
 namespace spidar::strings {
 
+/// The most fingertips and strings a device config may have: the servo loop's samples carry 8
+/// fingertips and the wire protocol (docs/protocol.md) 32 strings (device::kMaxFingers and
+/// device::kMaxDeviceStrings, checked equal where both are known).
+inline constexpr int kMaxConfigFingers = 8;
+inline constexpr int kMaxConfigStrings = 32;
+
 struct FingerConfig {
   std::string name;                      ///< e.g. "left_index"
   std::string hand;                      ///< "left", "right" or empty
-  int unit = -1;                         ///< the device's unit number, if documented
+  int unit = -1;                         ///< the device's unit number 0..7 if documented, else −1
   PointGeometry geometry;                ///< fulcrums [m], world, with closed-form constants
   std::vector<EncoderChannel> channels;  ///< one per string
 };
@@ -42,7 +48,10 @@ struct DeviceConfig {
   CommandRange command_range() const;
 };
 
-/// Parses and validates a device config. Throws core::ConfigError naming file:line: key.
+/// Parses and validates a device config. Throws core::ConfigError naming file:line: key. Besides
+/// types and ranges: finger names non-empty and unique, units 0..7 and unique, at most
+/// kMaxConfigFingers fingers and kMaxConfigStrings strings, and the frame centre inside the convex
+/// hull of all fulcrums.
 DeviceConfig parse_device_config(const core::ConfigNode& root);
 /// Loads and validates a device config file.
 DeviceConfig load_device_config(const std::string& path);
