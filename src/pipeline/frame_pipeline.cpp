@@ -245,8 +245,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     out->models[h] = s.models[h];
     // Personalisation: this frame's evidence on the hand's sizes; the next fit uses the estimate.
     if (p.personalise_shape) {
-      const hand::HandParams* prior = cold ? nullptr : &s.previous[h];
-      if (s.shape[h].add_frame(q, obs, image, prior, p.registration)) s.models[h] = s.shape[h].model();
+      if (s.shape[h].add_frame(q, obs, image, p.registration)) s.models[h] = s.shape[h].model();
     }
     out->shapes[h] = s.shape[h].estimate();
   }

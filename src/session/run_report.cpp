@@ -254,7 +254,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                                           {"sigma_width_m", e.sigma_width_m},
                                           {"length_frozen", e.length_frozen},
                                           {"width_frozen", e.width_frozen},
-                                          {"frames_used", e.frames_used}};
+                                          {"keyframes", e.keyframes},
+                                          {"solves", e.solves}};
     }
     shape["personalised"] = s.personalised;
     reg["hand_shape"] = shape;

@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
   if (a.no_balls) p.registration.joint_ball_sigma_px = 1000;
   if (a.no_wrist) p.registration.wrist_sigma_px = 1000;
   p.personalise_shape = a.personalise;
-  if (a.shape_w > 0) p.shape_estimator.frame_weight = a.shape_w;
+  if (a.shape_w > 0) p.shape_estimator.solve_every = static_cast<int>(a.shape_w);
   if (a.shape_dq > 0) p.shape_estimator.min_pose_change = a.shape_dq;
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models);

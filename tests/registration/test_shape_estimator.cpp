@@ -61,7 +61,7 @@ Outcome run(double length_m, double width_m, int frames, std::uint32_t seed) {
     for (int f = 0; f < hand::kFingertipCount; ++f) tip += (fp.p_W_fingertip[f] - pts.p_W_fingertip[f]).norm() / 4;
     if (k == 0) out.tip_error_first_mm = 1e3 * tip;
     out.tip_error_last_mm = 1e3 * tip;
-    est.add_frame(fit, obs, image, &prior, rp);
+    est.add_frame(fit, obs, image, rp);
   }
   out.estimate = est.estimate();
   return out;
@@ -73,17 +73,18 @@ TEST_P(KnownSizes, LengthMovesTowardTheTruthAsEvidenceAccumulates) {
   const auto [L, W] = GetParam();
   const Outcome o = run(L, W, 400, 7);
   const ShapeEstimate& e = o.estimate;
-  std::printf("truth L %.4f W %.4f: estimate L %.4f (σ %.2f mm) W %.4f (σ %.2f mm), %d frames used; "
+  std::printf("truth L %.4f W %.4f: estimate L %.4f (σ %.2f mm) W %.4f (σ %.2f mm), %d keyframes; "
               "fingertips %.2f -> %.2f mm\n",
               L, W, e.length_m, 1e3 * e.sigma_length_m, e.width_m, 1e3 * e.sigma_width_m,
-              e.frames_used, o.tip_error_first_mm, o.tip_error_last_mm);
-  // Measured 2026-11-24 (400 frames, no forgetting): L 0.2082 for 0.209, 0.1855 for 0.171,
-  // 0.1965 for 0.1976, 0.1848 for 0.171; widths within 1.5–9 mm. The length always moves toward
-  // the truth but a small hand's stops short (issue 14 keeps the 2 % target open): what is
-  // asserted is the direction and the narrowing of the evidence, not the target.
+              e.keyframes, o.tip_error_first_mm, o.tip_error_last_mm);
+  // Measured 2026-11-24 (400 frames, 24 keyframes): L 0.2089 for 0.209, 0.1873 for 0.171,
+  // 0.1990 for 0.1976, 0.1839 for 0.171; widths 0.4–9 mm off. The length always moves toward the
+  // truth, but a small hand's stops short (issue 14 keeps the 2 % target open): what is asserted
+  // is the direction and the narrowing of the evidence, not the target.
   EXPECT_LT(std::abs(e.length_m - L), std::abs(0.19 - L));
-  EXPECT_LT(e.sigma_length_m, 0.5 * ShapeEstimatorParams{}.prior_sigma_length_m);
-  EXPECT_GT(e.frames_used, 50);
+  EXPECT_LT(e.sigma_length_m, 0.25 * ShapeEstimatorParams{}.prior_sigma_length_m);
+  EXPECT_GE(e.keyframes, ShapeEstimatorParams{}.min_keyframes);
+  EXPECT_GE(e.solves, 1);
   EXPECT_TRUE(std::isfinite(e.width_m));
 }
 
@@ -97,8 +98,8 @@ TEST(ShapeEstimator, StaysWithinItsBoundAndFreezesNothingWithoutEvidence) {
   HandObservation none;  // no fingertips: nothing to learn
   ImageEvidence image;
   hand::HandParams q = test::reaching_hands(0)[1];
-  EXPECT_FALSE(est.add_frame(q, none, image, nullptr, RegistrationParams{}));
-  EXPECT_EQ(est.estimate().frames_used, 0);
+  EXPECT_FALSE(est.add_frame(q, none, image, RegistrationParams{}));
+  EXPECT_EQ(est.estimate().keyframes, 0);
   EXPECT_DOUBLE_EQ(est.estimate().length_m, 0.19);
   // A far too long hand: the estimate stops at +15 %.
   const Outcome o = run(0.26, 0.085, 300, 3);
@@ -108,17 +109,17 @@ TEST(ShapeEstimator, StaysWithinItsBoundAndFreezesNothingWithoutEvidence) {
 
 TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
-  bool enabled = true;
+  bool enabled = false;
   const ShapeEstimatorParams p = parse_shape_estimator_params(root["personalisation"], &enabled);
-  EXPECT_FALSE(enabled);
-  EXPECT_DOUBLE_EQ(p.frame_weight, ShapeEstimatorParams{}.frame_weight);
-  const auto bad = core::ConfigNode::Parse("personalisation:\n  frame_weight: -1\n", "bad.yaml");
+  EXPECT_TRUE(enabled);  // on in the shipped settings
+  EXPECT_EQ(p.keyframes, ShapeEstimatorParams{}.keyframes);
+  const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
     parse_shape_estimator_params(bad["personalisation"], &enabled);
-    FAIL() << "accepted a negative frame weight";
+    FAIL() << "accepted a negative pose change";
   } catch (const core::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("frame_weight"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("min_pose_change"), std::string::npos) << e.what();
   }
 }
 

@@ -2,27 +2,27 @@
 /// Online hand-shape personalisation: each hand's length and width [m] estimated while the
 /// session runs, from the evidence the pose fits already use, with no calibration step.
 ///
-/// After each frame's pose fit θ, the residuals the shape should explain (the string-measured
-/// fingertips in 3D and the bracelet's projected wrist, residuals.hpp, with the temporal prior on
-/// θ) are linearised in both the pose θ (17) and the shape β = (length, width):
-///   r(θ + Δθ, β + Δβ) ≈ r + J_θ Δθ + J_β Δβ      (J_β by central differences of the model)
-/// and the pose is marginalised out (Schur complement), giving this frame's information on β
-/// alone:  S = J_βᵀJ_β − J_βᵀJ_θ (J_θᵀJ_θ)⁻¹ J_θᵀJ_β,  g = −(J_βᵀr − J_βᵀJ_θ (J_θᵀJ_θ)⁻¹ J_θᵀr).
-/// The evidence accumulates in information form, as a Kalman filter on a constant parameter
-/// (Tkach et al. 2017, "Online generative model personalization for hand tracking"):
-///   H ← λ H + w S,   β ← β + H⁻¹ w g   (λ ≤ 1 forgets old, badly linearised evidence),
-/// starting from the given profile with its prior σ. Consecutive frames repeat much of the same
-/// evidence, so each frame counts with weight w < 1, and only frames whose pose moved since the
-/// last used one are used (several poses make the shape observable; one pose does not separate
-/// a longer finger from a more flexed one). A parameter whose σ = √(H⁻¹)ᵢᵢ falls below its
-/// freeze threshold is frozen: later frames no longer move it (Monado's hand-size schedule does
-/// the same with a time budget).
+/// The estimator keeps a small set of keyframes: frames whose pose differs from every kept one
+/// (one pose does not separate a longer finger from a more flexed one; several do), each with its
+/// observation (the string-measured fingertips in 3D and the bracelet's projected wrist) and its
+/// pose. Every `solve_every` used frames it re-estimates the shape β = (length, width) over all
+/// keyframes, as in the batch step of Tkach et al. 2017 ("Online generative model personalization
+/// for hand tracking"), by Gauss-Newton on
+///   Σ_k ‖r_k(θ_k, β)‖² + ‖β − β₀‖²_{Σ₀⁻¹}
+/// with each keyframe's pose θ_k re-fitted at the current β (so no evidence stays linearised at an
+/// old, wrong size) and marginalised out (Schur complement): with J_θ, J_β the Jacobians of r_k
+/// (J_β by central differences of the model),
+///   S_k = J_βᵀJ_β − J_βᵀJ_θ (J_θᵀJ_θ)⁻¹ J_θᵀJ_β,   g_k = −(J_βᵀ − J_βᵀJ_θ (J_θᵀJ_θ)⁻¹ J_θᵀ) r_k,
+///   (Σ S_k + Σ₀⁻¹) Δβ = Σ g_k + Σ₀⁻¹ (β₀ − β).
+/// σ = √diag((Σ S_k + Σ₀⁻¹)⁻¹) is the estimate's uncertainty; a size whose σ falls below its
+/// freeze threshold is frozen (Monado's hand-size schedule likewise stops adapting once sure).
 ///
 /// The image's joint-ball and silhouette terms are left out on purpose: they compare the model's
 /// capsules and skin with a real hand's outline, whose systematic differences (knuckles, pads,
 /// tissue) would bias the sizes; the strings and the bracelet measure points of the skeleton.
 
 #include <array>
+#include <vector>
 
 #include "spidar/core/config.hpp"
 #include "spidar/hand/hand_model.hpp"
@@ -31,63 +31,64 @@
 namespace spidar::registration {
 
 struct ShapeEstimatorParams {
-  double prior_sigma_length_m = 0.015;  ///< σ of the starting profile's length [m]
-  double prior_sigma_width_m = 0.008;   ///< σ of its width [m]
-  /// The accumulated information decays by this factor per used frame (1 = never forget).
-  /// Measured (tests/registration/test_shape_estimator.cpp): without forgetting a small hand's
-  /// length locks in short of the truth (0.1855 m for 0.171 m); with 0.97 the estimates wander
-  /// (±5 mm). Neither is good enough yet; 1 is the default.
-  double forgetting = 1.0;
-  double frame_weight = 0.3;            ///< w: how much one frame counts (0, 1]
-  double min_pose_change = 0.02;        ///< use a frame once θ moved this much (norm, m/rad)
-  double freeze_sigma_length_m = 0.0005;  ///< freeze the length once its σ is below this [m]
-  double freeze_sigma_width_m = 0.0005;   ///< ... the width [m]
-  double max_step_m = 0.002;            ///< largest change of either size per frame [m]
-  /// The estimate stays within this share of the starting sizes (0.15: ±15 %). Width and finger
-  /// abduction trade off in the strings' evidence; without a bound, a poorly observed width can
-  /// run away (seen on the simulated rig: 0.0935 m estimated as 0.054 m).
+  double prior_sigma_length_m = 0.015;  ///< σ₀ of the starting profile's length [m]
+  double prior_sigma_width_m = 0.008;   ///< σ₀ of its width [m]
+  int keyframes = 24;                   ///< kept (the oldest is replaced)
+  double min_pose_change = 0.15;        ///< a keyframe differs from every kept one by this (‖Δθ‖, m/rad)
+  int solve_every = 10;                 ///< re-estimate after this many new keyframes
+  int min_keyframes = 6;                ///< no estimate before this many keyframes
+  int iterations = 4;                   ///< Gauss-Newton iterations per re-estimate
+  double freeze_sigma_length_m = 0.0003;  ///< freeze the length once its σ is below this [m]
+  double freeze_sigma_width_m = 0.0003;   ///< ... the width [m]
+  /// The estimate stays within this share of the starting sizes (0.15: ±15 %).
   double max_relative_change = 0.15;
-  double difference_step_m = 1e-4;      ///< central-difference step of J_β [m]
+  double difference_step_m = 1e-4;  ///< central-difference step of J_β [m]
 };
 
 /// The estimate of one hand.
 struct ShapeEstimate {
   double length_m = 0;
   double width_m = 0;
-  double sigma_length_m = 0;  ///< √(H⁻¹) [m]
+  double sigma_length_m = 0;  ///< [m]
   double sigma_width_m = 0;
   bool length_frozen = false;
   bool width_frozen = false;
-  int frames_used = 0;
+  int keyframes = 0;  ///< keyframes held
+  int solves = 0;     ///< re-estimates made
 };
 
 class ShapeEstimator {
  public:
-  /// Starts from `start` (its length and width; sides, coupling and limits are kept).
-  ShapeEstimator(const hand::HandModel& start, const ShapeEstimatorParams& params = {});
-  /// Adds one frame's evidence: `q` the pose fitted with model(), `observation` and `image` what
-  /// the fit used (only the camera of `image` is used), `prior` the fit's temporal prior (may be
-  /// null). Returns true when the sizes changed (model() was rebuilt).
+  /// Starts from `start` (its length and width; side, coupling and limits are kept).
+  explicit ShapeEstimator(const hand::HandModel& start, const ShapeEstimatorParams& params = {});
+  /// Offers one frame: `q` the pose fitted with model(), `observation` what the fit used, `image`
+  /// its camera (only the camera is used), `fit_params` the fit's settings. Returns true when the
+  /// sizes changed (model() was rebuilt).
   bool add_frame(const hand::HandParams& q, const HandObservation& observation,
-                 const ImageEvidence& image, const hand::HandParams* prior,
-                 const RegistrationParams& fit_params);
+                 const ImageEvidence& image, const RegistrationParams& fit_params);
   const hand::HandModel& model() const { return model_; }
   const ShapeEstimate& estimate() const { return estimate_; }
 
  private:
+  struct Keyframe {
+    hand::HandParams q;
+    HandObservation observation;
+  };
+  bool solve(const vision::Camera* camera, const RegistrationParams& fit_params);
+
   ShapeEstimatorParams p_;
   hand::HandModel model_;
-  Eigen::Matrix2d H_ = Eigen::Matrix2d::Zero();
-  hand::HandParams last_used_;
-  bool have_last_ = false;
-  ShapeEstimate estimate_;
   double start_length_m_ = 0, start_width_m_ = 0;
+  std::vector<Keyframe> keyframes_;
+  std::size_t next_slot_ = 0;
+  int new_since_solve_ = 0;
+  ShapeEstimate estimate_;
 };
 
 /// Reads a `personalisation:` map (every key optional): enabled (bool, into `*enabled`),
-/// prior_sigma_length_m, prior_sigma_width_m, frame_weight, min_pose_change,
-/// freeze_sigma_length_m, freeze_sigma_width_m, max_step_m, max_relative_change. Throws core::ConfigError naming
-/// file:line: key and the expected range.
+/// prior_sigma_length_m, prior_sigma_width_m, keyframes, min_pose_change, solve_every,
+/// min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m, max_relative_change.
+/// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
 /// The model `m` with other sizes (same side, coupling and limits). Fails on invalid sizes.
