@@ -56,6 +56,8 @@ Action add_demo(CLI::App& app) {
   cmd->add_option("--compositor", o->compositor, "paper: the paper's cut-outs; depth: matte + model depth")
       ->check(CLI::IsMember({"paper", "depth"}))
       ->capture_default_str();
+  cmd->add_flag("--fixed-hand-size", o->fixed_hand_size,
+                "keep the model hand's sizes (default: estimate each hand's length and width online)");
   cmd->add_flag("--silhouette", o->silhouette,
                 "register with the silhouette term too (default: the paper's joint-balls)");
   cmd->add_flag("!--no-video", o->video, "do not write mixed_reality.mp4");

@@ -23,6 +23,7 @@ struct DemoOptions {
   bool window = false;
   std::string compositor = "depth";
   bool silhouette = false;         ///< the silhouette term in the main registration
+  bool fixed_hand_size = false;    ///< no online hand-size personalisation (on in the demo)
   bool video = true;
 };
 

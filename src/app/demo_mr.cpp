@@ -83,6 +83,10 @@ int run_mr_demo(const DemoOptions& o) {
   sp.pipeline = session::pipeline_params(resolve_data_path("configs/vision.yaml"),
                                          resolve_data_path("configs/registration.yaml"), o.silhouette,
                                          *mode, scene.initial_r_W_hand());
+  // The demo personalises the hands' sizes online (registration/shape_estimator.hpp) unless told
+  // not to; `run` follows configs/registration.yaml (off: a recording does not yet store the size
+  // estimates, so a replay could not reproduce fits made with them).
+  sp.pipeline.personalise_shape = !o.fixed_hand_size;
   sp.compare = true;  // the same registration with the silhouette term switched the other way
   sp.seconds = seconds;
   sp.end_with_script = true;
@@ -173,6 +177,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.video_path = video ? video->path() : "";
   summary.video_format = video ? render::video_format_name(video->format()) : "";
   summary.main_silhouette = o.silhouette;
+  summary.personalised = !o.fixed_hand_size;
   summary.compositor = o.compositor;
   summary.width = o.width;
   summary.height = o.height;

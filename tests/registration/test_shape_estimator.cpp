@@ -109,9 +109,9 @@ TEST(ShapeEstimator, StaysWithinItsBoundAndFreezesNothingWithoutEvidence) {
 
 TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
-  bool enabled = false;
+  bool enabled = true;
   const ShapeEstimatorParams p = parse_shape_estimator_params(root["personalisation"], &enabled);
-  EXPECT_TRUE(enabled);  // on in the shipped settings
+  EXPECT_FALSE(enabled);  // off in the shipped settings (the demo turns it on)
   EXPECT_EQ(p.keyframes, ShapeEstimatorParams{}.keyframes);
   const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
