@@ -97,7 +97,7 @@ def main():
 <mujoco model="rubiks_cube">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="0.001" gravity="0 0 -9.81" cone="elliptic" solver="Newton" iterations="30"
-          tolerance="1e-8" noslip_iterations="4"/>
+          tolerance="1e-8" noslip_iterations="0" impratio="100"/>
   <size nconmax="600" njmax="3000"/>
   <visual><global offwidth="1280" offheight="720"/></visual>
   <asset>

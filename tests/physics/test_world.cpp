@@ -154,7 +154,7 @@ TEST(World, TwoFingerPinchHoldsA100gBoxForFiveSeconds) {
   double lift = 0;
   const double slip = grasp_and_hold({Vec3(-0.028, 0, 0), Vec3(0.028, 0, 0)}, &lift);
   RecordProperty("pinch_slip_mm", std::to_string(slip * 1e3));
-  EXPECT_LT(slip, 5e-3);
+  EXPECT_LT(slip, 1e-3);
   EXPECT_GT(lift, 0.045);
 }
 
@@ -164,7 +164,7 @@ TEST(World, FourFingerGraspHoldsA100gBoxForFiveSeconds) {
       {Vec3(0, -0.028, 0), Vec3(-0.012, 0.028, 0.008), Vec3(0, 0.028, -0.004), Vec3(0.012, 0.028, 0.008)},
       &lift);
   RecordProperty("grasp_slip_mm", std::to_string(slip * 1e3));
-  EXPECT_LT(slip, 5e-3);
+  EXPECT_LT(slip, 1e-3);
   EXPECT_GT(lift, 0.045);
 }
 
