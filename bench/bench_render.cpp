@@ -78,6 +78,23 @@ void RenderSceneAndHands(benchmark::State& state) {
 }
 BENCHMARK(RenderSceneAndHands)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
 
+/// Render + read-back of one target at 640×480 (arg: 0 nothing but a 1-target sync read of hand id,
+/// 1 colour, 2 depth, 3 hand depth, 4 hand id): where the read-back's time goes.
+void RenderReadOne(benchmark::State& state) {
+  if (!context()) return state.SkipWithError("no headless GL");
+  const vision::Camera cam = camera(640);
+  const SceneSnapshot scene = cube_scene_with_hands();
+  auto renderer = render::Renderer::create(*context(), cam.width(), cam.height()).value();
+  render::RenderTargets t;
+  const unsigned which[] = {render::kHandId, render::kColour, render::kDepth, render::kHandDepth, render::kHandId};
+  const auto k = static_cast<std::size_t>(state.range(0));
+  for (auto _ : state) {
+    if (!renderer->render(scene, cam).ok() || !renderer->read(&t, which[k]).ok())
+      state.SkipWithError("render failed");
+  }
+}
+BENCHMARK(RenderReadOne)->DenseRange(1, 4)->Unit(benchmark::kMillisecond);
+
 struct CompositeFixture {
   render::RenderTargets targets;
   vision::ChromaKeyResult key;

@@ -20,6 +20,7 @@
 #include "signal_scope.hpp"
 #include "spidar/physics/mujoco_log.hpp"
 #include "spidar/render/video_output.hpp"
+#include "spidar/session/async_sinks.hpp"
 #include "spidar/session/output_sinks.hpp"
 #include "spidar/session/rig.hpp"
 #include "spidar/session/rig_inputs.hpp"
@@ -102,7 +103,7 @@ int run_mr_demo(const DemoOptions& o) {
   session::SimulatedRig rig(cfg, scene, camera, truth_models, rp);
   auto run = session::Session::create(rig, scene, *context, camera, models, sp);
 
-  session::TruthScorer scorer(*context, camera, models, truth_models, sp.pipeline, *scene.monitor);
+  session::TruthScorer scorer(camera, truth_models, sp.pipeline);
   std::unique_ptr<render::VideoOutput> video;
   std::unique_ptr<session::VideoSink> video_sink;
   if (o.video) {
@@ -113,7 +114,7 @@ int run_mr_demo(const DemoOptions& o) {
     video_sink = std::make_unique<session::VideoSink>(*video);
   }
   session::KeyframeSink keyframes(
-      (fs::path(o.out) / "keyframes").string(), {1.9, 3.0, 4.5, 8.5, 10.2}, *mode, models, camera,
+      (fs::path(o.out) / "keyframes").string(), {1.9, 3.0, 4.5, 8.5, 10.2}, *mode, camera,
       [&scorer, &task](const session::FrameEvent& e) {
         return "t = " + std::to_string(e.t_s).substr(0, 4) + " s, " + task.phase(e.t_s) +
                ", IoU " + std::to_string(scorer.trace().frames.back().truth[0].iou).substr(0, 5);
@@ -124,7 +125,6 @@ int run_mr_demo(const DemoOptions& o) {
   std::vector<session::FrameSink*> outputs;
   if (video_sink) outputs.push_back(video_sink.get());
   outputs.push_back(&keyframes);
-  outputs.push_back(&window);
   session::SinkGroup output(outputs);  // timed: the report's output_ms
   Progress progress(task.params().duration, std::cerr);  // in script time (retries replay some)
   session::FunctionSink progress_sink(
@@ -134,9 +134,11 @@ int run_mr_demo(const DemoOptions& o) {
         progress.update(task.script_time(m.t_s), status_line(m, task));
       },
       [&](const session::SessionSummary&) { progress.finish(); });
-  run->add_sink(scorer);
-  run->add_sink(output);
-  run->add_sink(progress_sink);
+  // The window on the frame thread (its GL context lives there); scoring, video, keyframes and
+  // the progress line on the output thread, off the pipeline's critical path.
+  session::AsyncSinks off_path({&scorer, &output, &progress_sink});
+  run->add_sink(window);
+  run->add_sink(off_path);
 
   std::cout << "spidar-mr demo: mixed-reality Rubik's cube on a simulated " << cfg.name << "\n"
             << "  scene " << scene_path << (cube ? "" : " (no cube: reaching for the nearest object)")

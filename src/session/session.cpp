@@ -158,6 +158,8 @@ Session::Step Session::step() {
         (params_.end_with_script && scene_.task->finished(t_s)))
       return Step::kPastEnd;
     t_last_s_ = t_s;
+    // The frame thread's context (a sink on this thread may have made its own current).
+    if (auto st = context_.make_current(); !st) throw SpidarError("frame thread: " + st.error().message);
     FrameEvent e;
     if (!take_inputs(t_exp, &e.servo)) return Step::kSkipped;  // a stall: no servo samples around it
 
@@ -172,7 +174,9 @@ Session::Step Session::step() {
       if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !render); !st)
         throw SpidarError(st.error().message);
       if (render) e.compared = &alt_result_;
+      e.compare_ms = core::ns_to_s(core::monotonic_ns() - e.t_done_ns) * 1e3;
     }
+    if (scene_.monitor) e.cube = scene_.monitor->status().read();
     e.index = frames_;
     e.t_exposure_ns = t_exp;
     e.t_s = t_s;

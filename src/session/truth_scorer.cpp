@@ -7,16 +7,30 @@
 
 namespace spidar::session {
 
-TruthScorer::TruthScorer(render::Context& context, const vision::Camera& camera,
-                         const std::array<hand::HandModel, 2>& models,
-                         const std::array<hand::HandModel, 2>& truth_models,
-                         const pipeline::FramePipelineParams& params, CubeMonitor& monitor)
-    : camera_(camera), models_(models), truth_models_(truth_models),
-      mode_(params.compositor.mode), monitor_(monitor) {
+TruthScorer::TruthScorer(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth_models,
+                         const pipeline::FramePipelineParams& params)
+    : camera_(camera), truth_models_(truth_models), skin_(params.model_skin), mode_(params.compositor.mode) {}
+
+TruthScorer::~TruthScorer() {
+  // Normally released in on_end on the scorer's thread; here (a run that failed) the context is
+  // made current on this thread first by the renderer's own destructor.
+  ceiling_.reset();
+  context_.reset();
+}
+
+void TruthScorer::on_start() {
+  auto ctx = render::Context::create_headless();
+  if (!ctx) throw SpidarError("ground truth: OpenGL: " + ctx.error().message);
+  context_ = std::move(ctx).value();
   // The model's ceiling: its own skin at the user's true pose and sizes (every compared frame).
-  auto c = sim::ModelCeiling::create(context, camera, truth_models, params.model_skin);
+  auto c = sim::ModelCeiling::create(*context_, camera_, truth_models_, skin_);
   if (!c) throw SpidarError(c.error().message);
   ceiling_ = std::move(c).value();
+}
+
+void TruthScorer::on_end(const SessionSummary&) {
+  ceiling_.reset();
+  context_.reset();
 }
 
 void TruthScorer::on_frame(const FrameEvent& e) {
@@ -31,6 +45,7 @@ void TruthScorer::on_frame(const FrameEvent& e) {
   m.preprocess_ms = result.timings.key_ms + result.timings.bracelet_ms + result.timings.distance_ms;
   m.stages = result.timings;
   m.film_ms = filmed.film_ms;
+  const std::int64_t t_scoring_ns = core::monotonic_ns();
   auto main_m = sim::measure_frame(filmed.frame, result, mode_, result.models, truth_models_, filmed.truth,
                                    camera_, &ws_);
   if (!main_m) throw SpidarError(main_m.error().message);
@@ -41,6 +56,10 @@ void TruthScorer::on_frame(const FrameEvent& e) {
     if (!alt_m) throw SpidarError(alt_m.error().message);
     m.truth[1] = *alt_m;
     m.compared = true;
+    if (!ceiling_) throw SpidarError("ground truth: a frame before on_start (no GL context)");
+    // Its own context, current here whatever else this thread renders (Session::step makes the
+    // frame thread's current again before the next frame).
+    if (auto st = context_->make_current(); !st) throw SpidarError("ground truth: " + st.error().message);
     auto c = ceiling_->iou(filmed.truth, filmed.frame.hand_only);
     if (!c) throw SpidarError(c.error().message);
     m.ceiling_iou = *c;
@@ -51,7 +70,7 @@ void TruthScorer::on_frame(const FrameEvent& e) {
     m.shape[h] = result.shapes[h];
     m.truth_cap_residual_mm[h] = filmed.cap_residual_m[h] * 1e3;
   }
-  if (auto s = monitor_.status().read()) {
+  if (const auto& s = e.cube) {
     m.lift_mm = s->lift * 1e3;
     m.u_angle_deg = s->u_angle * 180 / units::kPi;
     m.d_angle_deg = s->d_angle * 180 / units::kPi;
@@ -63,7 +82,8 @@ void TruthScorer::on_frame(const FrameEvent& e) {
   }
   m.servo_rate_hz = e.servo.rate_hz;
   m.servo_jitter_max_us = e.servo.jitter_max_us;
-  m.truth_ms = core::ns_to_s(core::monotonic_ns() - e.t_done_ns) * 1e3;
+  // The comparison fit (on the frame thread) and this scoring (wherever it runs).
+  m.truth_ms = e.compare_ms + core::ns_to_s(core::monotonic_ns() - t_scoring_ns) * 1e3;
   trace_.frames.push_back(m);
 }
 

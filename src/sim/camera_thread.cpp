@@ -2,11 +2,27 @@
 
 #include <chrono>
 #include <future>
+#include <utility>
 
 #include "spidar/core/clock.hpp"
 #include "spidar/render/context.hpp"
 
 namespace spidar::sim {
+
+void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to) {
+  to->index = from.index;
+  to->t_exposure_ns = from.t_exposure_ns;
+  to->t_script_s = from.t_script_s;
+  for (auto [a, b] : {std::pair{&from.frame.bgr, &to->frame.bgr}, {&from.frame.mask, &to->frame.mask},
+                      {&from.frame.hand_index, &to->frame.hand_index},
+                      {&from.frame.hand_only, &to->frame.hand_only}, {&from.frame.depth, &to->frame.depth}}) {
+    if (a->empty()) b->release();
+    else a->copyTo(*b);
+  }
+  to->truth = from.truth;
+  to->cap_residual_m = from.cap_residual_m;
+  to->film_ms = from.film_ms;
+}
 
 Result<std::unique_ptr<CameraThread>> CameraThread::start(
     const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,

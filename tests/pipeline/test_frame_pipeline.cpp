@@ -179,3 +179,48 @@ TEST_F(FramePipelineTest, DISABLED_PrintIouCeilingOfTheModelShapes) {
 
 }  // namespace
 }  // namespace spidar::pipeline
+
+namespace spidar::pipeline {
+namespace {
+
+TEST(CopyFrameResult, CopiesEveryImageDeeplyAndReusesTheTargetsBuffers) {
+  FrameResult a;
+  int k = 1;
+  std::vector<cv::Mat*> images = {&a.key.alpha, &a.key.silhouette, &a.key.foreground, &a.virt.colour,
+                                  &a.virt.depth, &a.virt.hand_depth, &a.virt.hand_id, &a.composite,
+                                  &a.composite_alpha, &a.other, &a.other_alpha};
+  for (cv::Mat* m : images) *m = cv::Mat(3, 4, CV_8UC1, cv::Scalar(k++));
+  a.hands[1].q[4] = 0.25;
+  a.restarts = 2;
+  a.timings.render_ms = 7.5;
+  FrameResult b;
+  copy_frame_result(a, &b);
+  const std::vector<cv::Mat*> copies = {&b.key.alpha, &b.key.silhouette, &b.key.foreground, &b.virt.colour,
+                                        &b.virt.depth, &b.virt.hand_depth, &b.virt.hand_id, &b.composite,
+                                        &b.composite_alpha, &b.other, &b.other_alpha};
+  std::vector<const std::uint8_t*> buffers;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    ASSERT_EQ(copies[i]->size(), images[i]->size()) << i;
+    EXPECT_NE(copies[i]->data, images[i]->data) << i;  // not a shared header
+    EXPECT_EQ(copies[i]->at<std::uint8_t>(2, 3), static_cast<int>(i) + 1) << i;
+    buffers.push_back(copies[i]->data);
+  }
+  EXPECT_DOUBLE_EQ(b.hands[1].q[4], 0.25);
+  EXPECT_EQ(b.restarts, 2);
+  EXPECT_DOUBLE_EQ(b.timings.render_ms, 7.5);
+  // Overwriting the source leaves the copy; copying again reuses the copy's buffers.
+  for (cv::Mat* m : images) m->setTo(99);
+  for (std::size_t i = 0; i < copies.size(); ++i) EXPECT_EQ(copies[i]->at<std::uint8_t>(0, 0), static_cast<int>(i) + 1);
+  copy_frame_result(a, &b);
+  for (std::size_t i = 0; i < copies.size(); ++i) {
+    EXPECT_EQ(copies[i]->data, buffers[i]) << i;
+    EXPECT_EQ(copies[i]->at<std::uint8_t>(0, 0), 99) << i;
+  }
+  // An empty image empties the copy (e.g. no second composite).
+  a.other.release();
+  copy_frame_result(a, &b);
+  EXPECT_TRUE(b.other.empty());
+}
+
+}  // namespace
+}  // namespace spidar::pipeline

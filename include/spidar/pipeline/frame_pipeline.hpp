@@ -90,6 +90,11 @@ struct FrameResult {
   FrameTimings timings;
 };
 
+/// A deep copy of `from` into `to`: every image copied (into `to`'s buffers when they already have
+/// the size and type, so a reused `to` allocates nothing), every other field assigned. A plain
+/// assignment of FrameResult would share the images, which the pipeline overwrites next frame.
+void copy_frame_result(const FrameResult& from, FrameResult* to);
+
 class FramePipeline {
  public:
   /// `models`: the registration's hand models (left, right). Error on invalid params.

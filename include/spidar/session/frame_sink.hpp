@@ -4,6 +4,7 @@
 /// video and keyframe writers, the progress bar), and a summary when the session ends.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -14,6 +15,7 @@
 #include "spidar/core/scene_snapshot.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/session/cube_monitor.hpp"
 #include "spidar/session/servo_timing.hpp"
 #include "spidar/sim/camera_thread.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
@@ -39,6 +41,10 @@ struct FrameEvent {
   const sim::FilmedFrame* filmed = nullptr;
   ServoTiming servo;  ///< the servo loop's rate and jitter since the previous frame
   bool cold_start = false;  ///< the main fit started from the rest pose, not the previous frame
+  /// The scene's cube when the frame was processed (its monitor's newest status); empty without
+  /// a cube or before the physics thread published one.
+  std::optional<CubeStatus> cube;
+  double compare_ms = 0;  ///< the comparison pipeline's cost in this frame [ms] (0 without one)
 };
 
 /// How a session ended.

@@ -30,11 +30,11 @@ class VideoSink final : public FrameSink {
 /// which during the run would drop camera frames). Throws SpidarError if a write fails.
 class KeyframeSink final : public FrameSink {
  public:
+  /// The fitted hands are drawn with the models each frame was fitted with (FrameResult::models).
   KeyframeSink(std::string dir, std::vector<double> times, render::CompositeMode mode,
-               const std::array<hand::HandModel, 2>& models, const vision::Camera& camera,
-               std::function<std::string(const FrameEvent&)> caption)
-      : dir_(std::move(dir)), times_(std::move(times)), mode_(mode), models_(models),
-        camera_(camera), caption_(std::move(caption)) {}
+               const vision::Camera& camera, std::function<std::string(const FrameEvent&)> caption)
+      : dir_(std::move(dir)), times_(std::move(times)), mode_(mode), camera_(camera),
+        caption_(std::move(caption)) {}
   void on_frame(const FrameEvent& e) override;
   void on_end(const SessionSummary& s) override;
   /// The keyframes composed so far (path, montage).
@@ -44,7 +44,6 @@ class KeyframeSink final : public FrameSink {
   std::string dir_;
   std::vector<double> times_;
   render::CompositeMode mode_;
-  std::array<hand::HandModel, 2> models_;
   vision::Camera camera_;
   std::function<std::string(const FrameEvent&)> caption_;
   std::size_t next_ = 0;

@@ -10,7 +10,6 @@
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/render/context.hpp"
-#include "spidar/session/cube_monitor.hpp"
 #include "spidar/session/frame_sink.hpp"
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/model_ceiling.hpp"
@@ -52,23 +51,27 @@ struct TruthTrace {
 
 class TruthScorer final : public FrameSink {
  public:
-  /// `context`: current on the frame thread (the ceiling renders there); `params`: the session's
-  /// main pipeline (compositor mode, model skin); `monitor`: the scene's cube. Throws SpidarError.
-  TruthScorer(render::Context& context, const vision::Camera& camera,
-              const std::array<hand::HandModel, 2>& models,
-              const std::array<hand::HandModel, 2>& truth_models,
-              const pipeline::FramePipelineParams& params, CubeMonitor& monitor);
+  /// `truth_models`: the user's hands as the synthetic camera films them; `params`: the session's
+  /// main pipeline (compositor mode, model skin). The model ceiling renders in a headless GL
+  /// context of the scorer's own, made in on_start on the thread that runs the scorer (the frame
+  /// thread, or AsyncSinks' output thread) and released in on_end there.
+  TruthScorer(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth_models,
+              const pipeline::FramePipelineParams& params);
+  ~TruthScorer() override;
+  void on_start() override;
   /// Throws SpidarError on a frame without ground truth (a real camera).
   void on_frame(const FrameEvent& e) override;
+  void on_end(const SessionSummary& s) override;
   /// The output time of the newest frame (the sinks after this one) [ms].
   void set_output_ms(double ms);
   const TruthTrace& trace() const { return trace_; }
 
  private:
   vision::Camera camera_;
-  std::array<hand::HandModel, 2> models_, truth_models_;
+  std::array<hand::HandModel, 2> truth_models_;
+  render::HandSkinParams skin_;
   render::CompositeMode mode_;
-  CubeMonitor& monitor_;
+  std::unique_ptr<render::Context> context_;
   std::unique_ptr<sim::ModelCeiling> ceiling_;
   sim::FrameTruthWorkspace ws_;
   TruthTrace trace_;

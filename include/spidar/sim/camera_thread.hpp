@@ -33,6 +33,10 @@ struct FilmedFrame {
   double film_ms = 0;              ///< cost of posing and filming [ms]
 };
 
+/// A deep copy (the images copied into `to`'s buffers when they fit, so a reused `to` allocates
+/// nothing); a FilmedFrame taken from CameraThread::frame() is only valid until the next take().
+void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to);
+
 /// Fills `out` with the true fingertip caps at t_ns (8 of them); false if there are none yet.
 using TruthAt = std::function<bool(std::int64_t t_ns, std::span<Vec3> out)>;
 

@@ -1,0 +1,73 @@
+#pragma once
+/// Sinks off the frame thread's critical path: the ground-truth scorer, the video and keyframe
+/// writers and the progress line cost as much as the pipeline itself, and the next camera frame
+/// would wait for them. AsyncSinks copies each event into one of a few slots (the camera image,
+/// the measurement, the scene, both fits with their composites, the ground truth) and runs its
+/// sinks on its own thread, the output thread, in order, while the frame thread goes on.
+///
+/// No frame is skipped: when every slot is taken (the sinks are slower than the pipeline), on_frame
+/// waits for one, and the waits are counted. The sinks' on_start, on_frame and on_end all run on
+/// the output thread, so a sink may make its own GL context there (the scorer's model ceiling).
+/// An exception from a sink is re-thrown on the frame thread at the next on_frame or at on_end
+/// (the session then stops); the sinks after it do not see that frame.
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "spidar/session/frame_sink.hpp"
+
+namespace spidar::session {
+
+class AsyncSinks final : public FrameSink {
+ public:
+  /// `sinks` must outlive this group; `slots` ≥ 1 frames may wait for (or be in) the sinks.
+  explicit AsyncSinks(std::vector<FrameSink*> sinks, int slots = 3);
+  /// Stops the output thread (the frames still queued are not delivered, no on_end).
+  ~AsyncSinks() override;
+  AsyncSinks(const AsyncSinks&) = delete;
+  AsyncSinks& operator=(const AsyncSinks&) = delete;
+
+  /// Starts the output thread and waits for the sinks' on_start there (re-throws its exception).
+  void on_start() override;
+  /// Copies the event into a free slot (waiting for one if none is) and queues it.
+  void on_frame(const FrameEvent& e) override;
+  /// Delivers every queued frame, then the sinks' on_end, on the output thread; joins it.
+  void on_end(const SessionSummary& s) override;
+
+  /// Times on_frame found every slot taken and waited, and for how long in all [ms].
+  std::uint64_t waits() const;
+  double waited_ms() const;
+
+ private:
+  struct Slot {
+    FrameEvent e;  ///< points into this slot's copies
+    cv::Mat bgr;
+    device::FingertipSample measured;
+    SceneSnapshot scene;
+    pipeline::FrameResult result, compared;
+    sim::FilmedFrame filmed;
+  };
+  void run();
+  void copy_into(const FrameEvent& from, Slot& to) const;
+  void rethrow_if_failed();
+
+  std::vector<FrameSink*> sinks_;
+  std::vector<Slot> slots_;
+  std::thread thread_;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<std::size_t> free_;    ///< slots the frame thread may fill
+  std::deque<std::size_t> queued_;   ///< slots waiting for the sinks, oldest first
+  bool started_ = false, ending_ = false, quit_ = false;
+  std::optional<SessionSummary> summary_;
+  std::exception_ptr error_;
+  std::uint64_t waits_ = 0;
+  double waited_ms_ = 0;
+};
+
+}  // namespace spidar::session

@@ -1,0 +1,146 @@
+// AsyncSinks: the sinks run on one output thread, in order, on deep copies of each event; a slow
+// sink makes the frame thread wait (no frame is skipped); a sink's exception comes back.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+#include "spidar/session/async_sinks.hpp"
+
+namespace spidar::session {
+namespace {
+
+/// Records what it saw: the thread of each call, the frame index, a pixel of each image.
+class Recorder final : public FrameSink {
+ public:
+  void on_start() override { start_thread = std::this_thread::get_id(); }
+  void on_frame(const FrameEvent& e) override {
+    frame_threads.push_back(std::this_thread::get_id());
+    indices.push_back(e.index);
+    bgr_pixel.push_back(e.bgr->at<cv::Vec3b>(1, 2)[0]);
+    composite_pixel.push_back(e.result->composite.at<cv::Vec3b>(0, 0)[1]);
+    alpha_pixel.push_back(e.result->composite_alpha.at<float>(0, 0));
+    compared.push_back(e.compared != nullptr ? e.compared->hands[1].q[3] : -1.0);
+    fingertip_x.push_back(e.measured->p_W[2][0]);
+    truth_pixel.push_back(e.filmed != nullptr ? e.filmed->frame.hand_only.at<std::uint8_t>(0, 1) : 0);
+    if (delay_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    if (throw_at >= 0 && e.index == static_cast<std::uint64_t>(throw_at)) throw std::runtime_error("sink failed");
+  }
+  void on_end(const SessionSummary& s) override {
+    end_thread = std::this_thread::get_id();
+    ended_by = s.ended_by;
+  }
+  std::thread::id start_thread, end_thread;
+  std::vector<std::thread::id> frame_threads;
+  std::vector<std::uint64_t> indices;
+  std::vector<int> bgr_pixel, composite_pixel, truth_pixel;
+  std::vector<float> alpha_pixel;
+  std::vector<double> compared, fingertip_x;
+  std::string ended_by;
+  int delay_ms = 0;
+  int throw_at = -1;
+};
+
+/// One frame's worth of buffers, overwritten for every frame as the session's are.
+struct Buffers {
+  cv::Mat bgr{4, 5, CV_8UC3, cv::Scalar::all(0)};
+  device::FingertipSample measured;
+  SceneSnapshot scene;
+  pipeline::FrameResult result, compared;
+  sim::FilmedFrame filmed;
+  Buffers() {
+    result.composite = cv::Mat(4, 5, CV_8UC3, cv::Scalar::all(0));
+    result.composite_alpha = cv::Mat(4, 5, CV_32FC1, cv::Scalar::all(0));
+    filmed.frame.hand_only = cv::Mat(4, 5, CV_8UC1, cv::Scalar::all(0));
+  }
+  /// Writes frame k's values into the shared buffers and returns the event pointing at them.
+  FrameEvent event(int k, bool with_compared) {
+    bgr.setTo(cv::Scalar::all(k));
+    result.composite.setTo(cv::Scalar::all(2 * k));
+    result.composite_alpha.setTo(0.01f * static_cast<float>(k));
+    compared.hands[1].q[3] = 10.0 * k;
+    measured.p_W[2][0] = 0.5 * k;
+    filmed.frame.hand_only.setTo(3 * k);
+    FrameEvent e;
+    e.index = static_cast<std::uint64_t>(k);
+    e.bgr = &bgr;
+    e.measured = &measured;
+    e.scene = &scene;
+    e.result = &result;
+    e.compared = with_compared ? &compared : nullptr;
+    e.filmed = &filmed;
+    return e;
+  }
+};
+
+TEST(AsyncSinks, EverySinkSeesEveryFrameInOrderOnOneOutputThreadWithItsOwnCopies) {
+  Recorder a, b;
+  b.delay_ms = 3;  // slower than the frames come: the frame thread must wait, not skip
+  Buffers buf;
+  const int n = 12;
+  {
+    AsyncSinks sinks({&a, &b}, 2);
+    sinks.on_start();
+    for (int k = 0; k < n; ++k) sinks.on_frame(buf.event(k, k % 3 == 0));
+    SessionSummary s;
+    s.ended_by = "completed";
+    sinks.on_end(s);
+  }
+  for (const Recorder* r : {&a, &b}) {
+    ASSERT_EQ(r->indices.size(), static_cast<std::size_t>(n));
+    EXPECT_NE(r->start_thread, std::this_thread::get_id());
+    EXPECT_EQ(r->end_thread, r->start_thread);
+    EXPECT_EQ(r->ended_by, "completed");
+    for (int k = 0; k < n; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      EXPECT_EQ(r->frame_threads[i], r->start_thread);
+      EXPECT_EQ(r->indices[i], static_cast<std::uint64_t>(k));
+      // The buffers were overwritten by later frames before the sinks ran: copies, not views.
+      EXPECT_EQ(r->bgr_pixel[i], k);
+      EXPECT_EQ(r->composite_pixel[i], 2 * k);
+      EXPECT_FLOAT_EQ(r->alpha_pixel[i], 0.01f * static_cast<float>(k));
+      EXPECT_DOUBLE_EQ(r->compared[i], k % 3 == 0 ? 10.0 * k : -1.0);
+      EXPECT_DOUBLE_EQ(r->fingertip_x[i], 0.5 * k);
+      EXPECT_EQ(r->truth_pixel[i], 3 * k);
+    }
+  }
+}
+
+TEST(AsyncSinks, ASinkThatThrowsStopsTheFramesAndTheErrorComesBackToTheFrameThread) {
+  Recorder a, after;
+  a.throw_at = 2;
+  Buffers buf;
+  AsyncSinks sinks({&a, &after}, 1);
+  sinks.on_start();
+  bool thrown = false;
+  for (int k = 0; k < 20 && !thrown; ++k) {
+    try {
+      sinks.on_frame(buf.event(k, false));
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "sink failed");
+      thrown = true;
+    }
+  }
+  if (!thrown) {  // the last frames were queued before the failure was known: it comes at the end
+    EXPECT_THROW(sinks.on_end(SessionSummary{}), std::runtime_error);
+  } else {
+    sinks.on_end(SessionSummary{});
+  }
+  EXPECT_EQ(a.indices.size(), 3u);      // frames 0, 1, 2: none after the failure
+  EXPECT_EQ(after.indices.size(), 2u);  // the sink after it never saw frame 2
+  EXPECT_TRUE(a.ended_by.empty());      // no on_end after a failure
+}
+
+TEST(AsyncSinks, AnOnStartThatThrowsIsReThrownByOnStart) {
+  struct Failing final : FrameSink {
+    void on_start() override { throw std::runtime_error("no GL"); }
+    void on_frame(const FrameEvent&) override {}
+  } failing;
+  AsyncSinks sinks({&failing});
+  EXPECT_THROW(sinks.on_start(), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace spidar::session
