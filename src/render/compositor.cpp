@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 
 namespace spidar::render {
@@ -22,6 +24,8 @@ Status validate(const CompositorParams& p) {
                  std::to_string(p.depth_margin_m)};
   if (p.edge_blur_px < 0 || p.edge_blur_px > 16)
     return Error{"compositor: edge_blur_px must be in 0..16, got " + std::to_string(p.edge_blur_px)};
+  if (p.carry_downsample != 1 && p.carry_downsample != 2)
+    return Error{"compositor: carry_downsample must be 1 or 2, got " + std::to_string(p.carry_downsample)};
   if (p.max_carry_px < 1 || p.max_carry_px > 4096)
     return Error{"compositor: max_carry_px must be in 1..4096, got " +
                  std::to_string(p.max_carry_px)};
@@ -82,41 +86,63 @@ Status Compositor::compose_depth(const CompositeInputs& in, cv::Mat* out) {
   const cv::Rect image(0, 0, v.colour.cols, v.colour.rows);
   roi = cv::Rect(roi.x - r, roi.y - r, roi.width + 2 * r, roi.height + 2 * r) & image;
 
-  // Virtual-hand pixels, and for every pixel near them the nearest one.
+  // Virtual-hand pixels, and for every pixel near them the nearest one (or the nearest 2×2 block
+  // holding one: its blocks start at the distance transform's roi corner).
   cv::compare(v.hand_depth, FLT_MAX, hand_mask_, cv::CMP_LT);
   vision::SilhouetteDistanceOptions dt_options;
   dt_options.max_distance_px = params_.max_carry_px;  // only pixels the carry can reach
-  dt_options.downsample = 1;                           // exact labels at full resolution
+  dt_options.downsample = params_.carry_downsample;
   if (auto s = vision::silhouette_distance(hand_mask_, &distance_, dt_options); !s) return s;
   const float unmatched = params_.show_unmatched ? 1.f : 0.f;
   const auto margin = static_cast<float>(params_.depth_margin_m);
-  const auto max_d = static_cast<float>(params_.max_carry_px);
+  const int sc = distance_.scale;
+  const auto max_d = static_cast<float>(params_.max_carry_px) / static_cast<float>(sc);  // map units
   const cv::Rect& dt = distance_.roi;
+  const int rows = v.hand_depth.rows, cols = v.hand_depth.cols;
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  // Per map cell (a pixel, or a 2×2 block from the roi's corner): the depth carried there, the
+  // front-most hand depth of the nearest cell holding a virtual-hand pixel; NaN: none in reach.
+  carried_.create(distance_.empty ? cv::Size(1, 1) : distance_.labels.size(), CV_32FC1);
+  carried_.setTo(none);
+  for (int ly = 0; !distance_.empty && ly < carried_.rows; ++ly) {
+    const int* lab = distance_.labels.ptr<int>(ly);
+    const float* dist = distance_.distance.ptr<float>(ly);
+    float* c = carried_.ptr<float>(ly);
+    for (int lx = 0; lx < carried_.cols; ++lx) {
+      const int l = lab[lx];
+      if (dist[lx] > max_d || l <= 0 || l >= static_cast<int>(distance_.label_pixel.size())) continue;
+      const cv::Point q = distance_.label_pixel[static_cast<std::size_t>(l)];
+      if (q.x < 0) continue;
+      float d = FLT_MAX;
+      for (int yy = q.y; yy < std::min(q.y + sc, rows); ++yy) {
+        const float* hd = v.hand_depth.ptr<float>(yy);
+        for (int xx = q.x; xx < std::min(q.x + sc, cols); ++xx) d = std::min(d, hd[xx]);
+      }
+      c[lx] = d;
+    }
+  }
+  // Each pixel of the roi: its map column (−1 outside the map).
+  map_column_.resize(static_cast<std::size_t>(roi.width));
+  for (int x = 0; x < roi.width; ++x) {
+    const int ix = x + roi.x;
+    const int lx = ix >= dt.x ? (ix - dt.x) / sc : -1;
+    map_column_[static_cast<std::size_t>(x)] = distance_.empty || lx >= carried_.cols ? -1 : lx;
+  }
   front_.create(roi.size(), CV_32FC1);
   for (int y = 0; y < roi.height; ++y) {
     const int iy = y + roi.y;
-    const float* depth = v.depth.ptr<float>(iy);
+    const float* depth = v.depth.ptr<float>(iy) + roi.x;
     float* f = front_.ptr<float>(y);
-    const bool row_in_dt = !distance_.empty && iy >= dt.y && iy < dt.y + dt.height;
-    const int* lab = row_in_dt ? distance_.labels.ptr<int>(iy - dt.y) : nullptr;
-    const float* dist = row_in_dt ? distance_.distance.ptr<float>(iy - dt.y) : nullptr;
+    const int ly = iy >= dt.y ? (iy - dt.y) / sc : -1;
+    if (distance_.empty || ly < 0 || ly >= carried_.rows) {
+      std::fill(f, f + roi.width, unmatched);
+      continue;
+    }
+    const float* c = carried_.ptr<float>(ly);
     for (int x = 0; x < roi.width; ++x) {
-      const int ix = x + roi.x;
-      const int dx = ix - dt.x;
-      if (!row_in_dt || dx < 0 || dx >= dt.width || dist[dx] > max_d) {
-        f[x] = unmatched;
-        continue;
-      }
-      const int l = lab[dx];
-      const cv::Point q = l > 0 && l < static_cast<int>(distance_.label_pixel.size())
-                              ? distance_.label_pixel[static_cast<std::size_t>(l)]
-                              : cv::Point(-1, -1);
-      if (q.x < 0) {
-        f[x] = unmatched;
-        continue;
-      }
-      const float carried = v.hand_depth.at<float>(q.y, q.x);
-      f[x] = carried < depth[ix] + margin ? 1.f : 0.f;
+      const int lx = map_column_[static_cast<std::size_t>(x)];
+      const float carried = lx >= 0 ? c[lx] : none;
+      f[x] = std::isnan(carried) ? unmatched : (carried < depth[x] + margin ? 1.f : 0.f);
     }
   }
   if (r > 0) cv::blur(front_, front_, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1),

@@ -39,7 +39,8 @@ Status silhouette_distance(const cv::Mat& silhouette, SilhouetteDistance* out,
   if (out->scale == 2) {
     sil.copyTo(out->silhouette_roi);
     // A 2×2 block is silhouette if any of its pixels is (blocks at an odd edge are 1 wide).
-    cv::Mat half((sil.rows + 1) / 2, (sil.cols + 1) / 2, CV_8UC1);
+    cv::Mat& half = out->scratch_half;
+    half.create((sil.rows + 1) / 2, (sil.cols + 1) / 2, CV_8UC1);
     for (int y = 0; y < half.rows; ++y) {
       const std::uint8_t* a = sil.ptr<std::uint8_t>(2 * y);
       const std::uint8_t* b = sil.ptr<std::uint8_t>(std::min(2 * y + 1, sil.rows - 1));
@@ -52,7 +53,7 @@ Status silhouette_distance(const cv::Mat& silhouette, SilhouetteDistance* out,
     sil = half;
   }
   // distanceTransform measures the distance to the nearest *zero* pixel: silhouette → 0.
-  cv::Mat inverted;
+  cv::Mat& inverted = out->scratch_inverted;
   cv::compare(sil, 0, inverted, cv::CMP_EQ);
   cv::distanceTransform(inverted, out->distance, out->labels, cv::DIST_L2, cv::DIST_MASK_5,
                         cv::DIST_LABEL_PIXEL);

@@ -2,6 +2,7 @@
 // behind, with the real matte offset from the virtual hand by a few pixels.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "spidar/render/compositor.hpp"
@@ -92,6 +93,39 @@ TEST(Compositor, DepthModeEdgesAreSoft) {
   EXPECT_LT(mid, 1.f);
   EXPECT_LT(at, mid);
   EXPECT_FLOAT_EQ(c.last_alpha().at<float>(52, 70), 0.f);
+}
+
+TEST(Compositor, DepthCarriedFromBlocksAgreesWithFullResolutionAwayFromTheCrossing) {
+  // A tilted virtual finger: its depth runs from 0.45 m (y = 20) to 0.55 m (y = 99), crossing
+  // the object's 0.5 m at y = 60; the real finger is 5 px to the right (odd, so blocks straddle).
+  Scene s = make_scene(0.5f, 5);
+  for (int y = 20; y < 100; ++y)
+    for (int x = 60; x < 80; ++x) s.virt.hand_depth.at<float>(y, x) = 0.45f + 0.1f * static_cast<float>(y - 20) / 80.f;
+  CompositorParams full, blocks;
+  full.carry_downsample = 1;
+  blocks.carry_downsample = 2;
+  Compositor a(full), b(blocks);
+  cv::Mat out_a, out_b;
+  ASSERT_TRUE(a.compose({&s.virt, s.real_fg, s.alpha}, &out_a).ok());
+  ASSERT_TRUE(b.compose({&s.virt, s.real_fg, s.alpha}, &out_b).ok());
+  int differ = 0;
+  for (int y = 0; y < out_a.rows; ++y) {
+    for (int x = 0; x < out_a.cols; ++x) {
+      if (std::abs(a.last_alpha().at<float>(y, x) - b.last_alpha().at<float>(y, x)) < 1e-6f) continue;
+      ++differ;
+      EXPECT_LE(std::abs(y - 60), 3) << "differs far from the crossing at " << x << "," << y;
+    }
+  }
+  EXPECT_LE(differ, 3 * 20);  // at most three rows of the 20 px wide finger
+  // Both show the finger over the object above the crossing and hide it below.
+  EXPECT_EQ(out_b.at<cv::Vec3b>(55, 72), kSkin);
+  EXPECT_EQ(out_b.at<cv::Vec3b>(66, 72), kObject);
+  // A bad setting is refused, naming it.
+  CompositorParams bad;
+  bad.carry_downsample = 3;
+  const auto st = validate(bad);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("carry_downsample"), std::string::npos);
 }
 
 TEST(Compositor, PaperModeCutsOutTheVirtualHand) {

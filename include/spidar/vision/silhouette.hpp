@@ -40,6 +40,7 @@ struct SilhouetteDistance {
                                        ///< top-left; entry 0 unused
   cv::Mat silhouette_roi;  ///< full-resolution silhouette over roi (scale 2 only)
   bool empty = true;  ///< no silhouette pixel at all
+  cv::Mat scratch_half, scratch_inverted;  ///< working images, reused between calls
 
   /// The silhouette pixel nearest to image pixel (x, y) (inside the roi), or nullopt if empty
   /// or outside the roi.
