@@ -74,11 +74,13 @@ ServoLoop::ServoLoop(Device& device, const strings::DeviceConfig& config, ServoC
       jitter_hist_(kBins, 0),
       compute_hist_(kBins, 0) {
   if (!(servo_.deadline_periods > 0) || !(servo_.force_timeout_s > 0) ||
-      !(servo_.stall_limit_s > 0 && servo_.stall_limit_s <= 1.0))
-    throw SpidarError("ServoLoop: expected deadline_periods > 0, force_timeout_s > 0 s and "
-                      "stall_limit_s in (0, 1] s, got " + std::to_string(servo_.deadline_periods) +
-                      ", " + std::to_string(servo_.force_timeout_s) + " s, " +
-                      std::to_string(servo_.stall_limit_s) + " s");
+      !(servo_.stall_limit_s > 0 && servo_.stall_limit_s <= 1.0) ||
+      !(servo_.force_lost_s > 0 && servo_.force_lost_s <= 10.0))
+    throw SpidarError("ServoLoop: expected deadline_periods > 0, force_timeout_s > 0 s, "
+                      "stall_limit_s in (0, 1] s and force_lost_s in (0, 10] s, got " +
+                      std::to_string(servo_.deadline_periods) + ", " + std::to_string(servo_.force_timeout_s) +
+                      " s, " + std::to_string(servo_.stall_limit_s) + " s, " +
+                      std::to_string(servo_.force_lost_s) + " s");
   if (!force_) throw SpidarError("ServoLoop: no force source");
   if (!(servo_.rate_hz >= 1.0 && servo_.rate_hz <= 100000.0)) {
     throw SpidarError("ServoLoop: rate " + std::to_string(servo_.rate_hz) +
@@ -246,6 +248,7 @@ void ServoLoop::run() {
   const std::int64_t late_limit =
       static_cast<std::int64_t>(servo_.deadline_periods * static_cast<double>(period_ns_));
   const std::int64_t stall_limit = core::s_to_ns(servo_.stall_limit_s);
+  const std::int64_t force_lost = core::s_to_ns(servo_.force_lost_s);
   std::int64_t stale_since = -1;  ///< host time the forces went stale, −1 while fresh
   while (!stop_.load(std::memory_order_acquire)) {
     core::sleep_until_ns(deadline);
@@ -302,18 +305,18 @@ void ServoLoop::run() {
     }
     force_->forces(sample_, force_frame_);
     // Stale forces are not displayed (the force source fell behind: a starved physics thread);
-    // stale for longer than the stall limit, the safe state latches.
+    // stale for longer than force_lost_s, the source is taken for gone and the safe state latches.
     const bool stale = wake - force_frame_.t_ns > core::s_to_ns(servo_.force_timeout_s);
     if (stale) {
       ++stale_force_cycles_;
       if (stale_since < 0) stale_since = force_frame_.t_ns;
-      if (wake - stale_since > stall_limit) {
+      if (wake - stale_since > force_lost) {
         device_.request_safe_state();
         latch(kFaultForceStall,
               "cycle %llu: the force source's forces are %.3f ms old (not displayed after "
-              "force_timeout_s %.3f ms; safe state after stall_limit_s %.3f ms; all fingers)",
+              "force_timeout_s %.3f ms; safe state after force_lost_s %.3f ms; all fingers)",
               cycle_no, static_cast<double>(wake - force_frame_.t_ns) * 1e-6,
-              servo_.force_timeout_s * 1e3, servo_.stall_limit_s * 1e3);
+              servo_.force_timeout_s * 1e3, servo_.force_lost_s * 1e3);
       }
     } else {
       stale_since = -1;

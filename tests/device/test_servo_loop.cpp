@@ -162,13 +162,13 @@ struct Stalling final : ForceSource {
 };
 
 // Stale forces are not displayed from the first stale cycle on; the safe state latches only once
-// they have been stale for stall_limit_s (docs/realtime.md, "When a fault latches").
-TEST(ServoLoop, StaleForcesAreNotDisplayedAndLatchAfterTheStallLimit) {
+// they have been stale for force_lost_s (docs/realtime.md, "When a fault latches").
+TEST(ServoLoop, StaleForcesAreNotDisplayedAndLatchAfterTheForceLostLimit) {
   Rig rig;
   ServoConfig cfg;
   cfg.rate_hz = 1000;
   cfg.force_timeout_s = 0.005;
-  cfg.stall_limit_s = 0.05;
+  cfg.force_lost_s = 0.05;
   cfg.deadline_periods = 1000;  // about the forces' age, not the scheduler
   auto source = std::make_shared<Stalling>();
   ServoLoop loop(rig.rec, spidar8(), cfg, source);
@@ -197,7 +197,7 @@ TEST(ServoLoop, StaleForcesAreNotDisplayedAndLatchAfterTheStallLimit) {
     }
   }
   ASSERT_GE(t_fault, 0);
-  EXPECT_GE(t_fault - t_fresh, core::s_to_ns(cfg.stall_limit_s));
+  EXPECT_GE(t_fault - t_fresh, core::s_to_ns(cfg.force_lost_s));
   EXPECT_GE(loop.stats().stale_force_cycles, 1u);
   EXPECT_GE(rig.rec.safe_requests(), 1);
   EXPECT_TRUE(loop.stats().fault_message.find("force_stall: cycle ") != std::string::npos)
@@ -460,6 +460,16 @@ TEST(ServoLoop, BadSetupIsAnError) {
   ServoConfig negative;
   negative.max_repeated_readings = -1;
   EXPECT_THROW(ServoLoop(rig.rec, spidar8(), negative, std::make_shared<ZeroForce>()), SpidarError);
+  for (double lost : {0.0, 10.5}) {  // the force source's loss cannot be waited for forever
+    ServoConfig c;
+    c.force_lost_s = lost;
+    try {
+      ServoLoop l(rig.rec, spidar8(), c, std::make_shared<ZeroForce>());
+      ADD_FAILURE() << "force_lost_s " << lost << " accepted";
+    } catch (const SpidarError& e) {
+      EXPECT_NE(std::string(e.what()).find("force_lost_s"), std::string::npos) << e.what();
+    }
+  }
   rig.sim.close();
   ServoLoop loop(rig.rec, spidar8(), ServoConfig{}, std::make_shared<ZeroForce>());
   auto st = loop.start();

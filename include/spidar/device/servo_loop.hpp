@@ -60,11 +60,15 @@ struct ServoConfig {
   /// A cycle that wakes or ends this many periods late counts as a deadline miss; > 0.
   double deadline_periods = 5.0;
   double force_timeout_s = 0.02;  ///< forces older than this are not displayed [s], > 0
-  /// A stall this long latches the safe state [s]: the loop late by it (kFaultDeadlineMiss), no
-  /// cycle completed in it (kFaultWatchdog, the monitor thread), or forces stale for it
-  /// (kFaultForceStall, counted from when they went stale). In (0, 1] s: a device's safety
-  /// cannot be switched off by a large value.
+  /// A stall this long latches the safe state [s]: the loop late by it (kFaultDeadlineMiss) or no
+  /// cycle completed in it (kFaultWatchdog, the monitor thread): the motors held old commands that
+  /// long. In (0, 1] s: a device's safety cannot be switched off by a large value.
   double stall_limit_s = 0.1;
+  /// Forces stale this long latch kFaultForceStall [s], counted from when they went stale: the
+  /// force source is gone. Stale forces are already not displayed (minimum tension) after
+  /// force_timeout_s, so nothing pulls on a finger meanwhile and a starved physics thread on a
+  /// busy machine degrades the display rather than ending the session. In (0, 10] s.
+  double force_lost_s = 1.0;
   /// Consecutive cycles that may run on a repeated (late) device reading; one more trips the
   /// safe state (kFaultStaleCounts). 20 cycles = 5 ms at 4 kHz, 20 ms at 1 kHz.
   int max_repeated_readings = 20;
