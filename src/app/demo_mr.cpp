@@ -136,7 +136,7 @@ int run_mr_demo(const DemoOptions& o) {
       [&](const session::SessionSummary&) { progress.finish(); });
   // The window on the frame thread (its GL context lives there); scoring, video, keyframes and
   // the progress line on the output thread, off the pipeline's critical path.
-  session::AsyncSinks off_path({&scorer, &output, &progress_sink});
+  session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 10);
   run->add_sink(window);
   run->add_sink(off_path);
 

@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -19,6 +20,14 @@ Status set_fifo_priority(int priority) {
     return Error{std::string("SCHED_FIFO ") + std::to_string(priority) + " not permitted (" +
                  std::strerror(rc) + "); grant CAP_SYS_NICE or rtprio in limits.conf"};
   }
+  return Ok{};
+}
+
+Status set_nice(int nice) {
+  if (nice < 0 || nice > 19) return Error{"nice must be in 0..19, got " + std::to_string(nice)};
+  // Linux: a thread's nice value is per thread (its tid), not per process.
+  if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice) != 0)
+    return Error{"could not set nice " + std::to_string(nice) + " (" + std::strerror(errno) + ")"};
   return Ok{};
 }
 

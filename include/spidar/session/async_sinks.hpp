@@ -26,7 +26,9 @@ namespace spidar::session {
 class AsyncSinks final : public FrameSink {
  public:
   /// `sinks` must outlive this group; `slots` ≥ 1 frames may wait for (or be in) the sinks.
-  explicit AsyncSinks(std::vector<FrameSink*> sinks, int slots = 3);
+  /// `nice` (0..19): the output thread's niceness, so that on a busy machine it yields to the
+  /// frame thread and catches up in the gaps (the slots bound how far it may fall behind).
+  explicit AsyncSinks(std::vector<FrameSink*> sinks, int slots = 3, int nice = 0);
   /// Stops the output thread (the frames still queued are not delivered, no on_end).
   ~AsyncSinks() override;
   AsyncSinks(const AsyncSinks&) = delete;
@@ -66,6 +68,7 @@ class AsyncSinks final : public FrameSink {
   bool started_ = false, ending_ = false, quit_ = false;
   std::optional<SessionSummary> summary_;
   std::exception_ptr error_;
+  int nice_ = 0;
   std::uint64_t waits_ = 0;
   double waited_ms_ = 0;
 };
