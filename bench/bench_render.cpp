@@ -95,6 +95,24 @@ void RenderReadOne(benchmark::State& state) {
 }
 BENCHMARK(RenderReadOne)->DenseRange(1, 4)->Unit(benchmark::kMillisecond);
 
+/// An empty scene at 640×480, rendered and read back (arg as RenderReadOne; 5: all four): the
+/// fixed cost of the targets' clears and read-back, whatever the scene holds.
+void RenderEmpty(benchmark::State& state) {
+  if (!context()) return state.SkipWithError("no headless GL");
+  const vision::Camera cam = camera(640);
+  const SceneSnapshot scene;
+  auto renderer = render::Renderer::create(*context(), cam.width(), cam.height()).value();
+  render::RenderTargets t;
+  const unsigned which[] = {render::kHandId, render::kColour, render::kDepth, render::kHandDepth, render::kHandId,
+                            render::kAllTargets};
+  const auto k = static_cast<std::size_t>(state.range(0));
+  for (auto _ : state) {
+    if (!renderer->render(scene, cam).ok() || !renderer->read(&t, which[k]).ok())
+      state.SkipWithError("render failed");
+  }
+}
+BENCHMARK(RenderEmpty)->Arg(4)->Arg(5)->Unit(benchmark::kMillisecond);
+
 struct CompositeFixture {
   render::RenderTargets targets;
   vision::ChromaKeyResult key;
