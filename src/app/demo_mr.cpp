@@ -89,6 +89,7 @@ int run_mr_demo(const DemoOptions& o) {
   // estimates, so a replay could not reproduce fits made with them).
   sp.pipeline.personalise_shape = !o.fixed_hand_size;
   sp.compare = true;  // the same registration with the silhouette term switched the other way
+  sp.defer_compare_picture = true;  // its picture on the output thread (AsyncSinks)
   sp.seconds = seconds;
   sp.end_with_script = true;
 
@@ -137,6 +138,7 @@ int run_mr_demo(const DemoOptions& o) {
   // The window on the frame thread (its GL context lives there); scoring, video, keyframes and
   // the progress line on the output thread, off the pipeline's critical path.
   session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 10);
+  off_path.picture_comparisons(camera, models, *run->comparison_params());
   run->add_sink(window);
   run->add_sink(off_path);
 

@@ -257,9 +257,29 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     tm.total_ms = ms_since(t_start);
     return Ok{};
   }
+  if (auto st = picture(bgr, world, out); !st) return st;
+  tm.total_ms = ms_since(t_start);
+  return Ok{};
+}
+
+Status FramePipeline::picture(const cv::Mat& bgr, const SceneSnapshot& world, FrameResult* out) {
+  if (out == nullptr) return Error{"frame pipeline: no output given"};
+  Impl& s = *impl_;
+  const FramePipelineParams& p = s.params;
+  if (bgr.empty() || bgr.type() != CV_8UC3 || bgr.cols != s.camera.width() ||
+      bgr.rows != s.camera.height()) {
+    return Error{"frame pipeline: expected a CV_8UC3 frame of " + std::to_string(s.camera.width()) +
+                 "x" + std::to_string(s.camera.height()) + " px, got " + std::to_string(bgr.cols) +
+                 "x" + std::to_string(bgr.rows)};
+  }
+  if (out->key.alpha.size() != bgr.size())
+    return Error{"frame pipeline: picture needs the frame's matte (FrameResult::key) from its fit"};
+  FrameTimings& tm = out->timings;
+  // The hand models the fit used (the sizes a personalising fit had reached).
+  const std::array<hand::HandModel, 2>& models = out->models;
 
   // The virtual scene with the fitted hands (hidden: they only give depth).
-  t0 = Clock::now();
+  auto t0 = Clock::now();
   s.scene.t_s = world.t_s;
   s.scene.shapes = world.shapes;
   if (p.skinned_hands) {
@@ -267,25 +287,25 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     // than half a millimetre since they were built.
     bool resized = false;
     for (int h = 0; h < 2; ++h) {
-      const auto& d = s.models[h].shape.dimensions;
+      const auto& d = models[h].shape.dimensions;
       resized = resized || std::abs(d.length - s.skin_dims[h].length) > 5e-4 ||
                 std::abs(d.width - s.skin_dims[h].width) > 5e-4;
     }
     if (!s.meshes || s.world_meshes != world.meshes.get() || resized) {
-      for (int h = 0; h < 2; ++h) s.skin_dims[h] = s.models[h].shape.dimensions;
+      for (int h = 0; h < 2; ++h) s.skin_dims[h] = models[h].shape.dimensions;
       auto meshes = std::make_shared<std::vector<MeshData>>();
       if (world.meshes) *meshes = *world.meshes;
-      for (int h = 0; h < 2; ++h) s.skins[h] = render::build_hand_skin(s.models[h], p.model_skin, meshes.get());
+      for (int h = 0; h < 2; ++h) s.skins[h] = render::build_hand_skin(models[h], p.model_skin, meshes.get());
       s.meshes = std::move(meshes);
       s.world_meshes = world.meshes.get();
     }
     s.scene.meshes = s.meshes;
     for (int h = 0; h < 2; ++h)
-      render::pose_hand_skin(s.models[h], s.skins[h], out->hands[h], p.model_skin, &s.scene);
+      render::pose_hand_skin(models[h], s.skins[h], out->hands[h], p.model_skin, &s.scene);
   } else {
     s.scene.meshes = world.meshes;
     for (int h = 0; h < 2; ++h)
-      render::append_hand_shapes(hand::hand_render_shapes(s.models[h], out->hands[h]), &s.scene);
+      render::append_hand_shapes(hand::hand_render_shapes(models[h], out->hands[h]), &s.scene);
   }
   render::RenderParams rp;
   rp.hands = render::HandDrawMode::kHidden;
@@ -310,7 +330,6 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     if (auto st = compose(s.other, &out->other, &out->other_alpha); !st) return st;
   }
   tm.composite_ms = ms_since(t0);
-  tm.total_ms = ms_since(t_start);
   return Ok{};
 }
 

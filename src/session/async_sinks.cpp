@@ -5,6 +5,8 @@
 #include <future>
 #include <stdexcept>
 
+#include "spidar/core/result.hpp"
+
 #include "spidar/core/realtime.hpp"
 
 namespace spidar::session {
@@ -24,6 +26,41 @@ AsyncSinks::~AsyncSinks() {
   if (thread_.joinable()) thread_.join();
 }
 
+void AsyncSinks::picture_comparisons(const vision::Camera& camera,
+                                     const std::array<hand::HandModel, 2>& models,
+                                     const pipeline::FramePipelineParams& params) {
+  if (started_) throw std::logic_error("async sinks: picture_comparisons after on_start");
+  pictures_ = std::make_unique<Pictures>();
+  pictures_->camera = camera;
+  pictures_->models = models;
+  pictures_->params = params;
+}
+
+void AsyncSinks::start_pictures() {
+  if (!pictures_) return;
+  auto ctx = render::Context::create_headless();
+  if (!ctx) throw SpidarError("comparison pictures: OpenGL: " + ctx.error().message);
+  pictures_->context = std::move(ctx).value();
+  auto pipe = pipeline::FramePipeline::create(*pictures_->context, pictures_->camera, pictures_->models,
+                                              pictures_->params);
+  if (!pipe) throw SpidarError("comparison pictures: " + pipe.error().message);
+  pictures_->pipeline = std::move(pipe).value();
+}
+
+void AsyncSinks::make_picture(Slot& slot) {
+  FrameEvent& e = slot.e;
+  if (!e.compared_picture_pending || e.compared == nullptr) return;
+  if (!pictures_ || !pictures_->pipeline)
+    throw SpidarError("comparison pictures: a frame's picture was left pending but nobody makes it "
+                      "(AsyncSinks::picture_comparisons)");
+  const auto t0 = std::chrono::steady_clock::now();
+  if (auto st = pictures_->context->make_current(); !st) throw SpidarError("comparison pictures: " + st.error().message);
+  if (auto st = pictures_->pipeline->picture(slot.bgr, slot.scene, &slot.compared); !st)
+    throw SpidarError("comparison pictures: " + st.error().message);
+  e.compared_picture_pending = false;
+  e.compare_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 void AsyncSinks::on_start() {
   if (started_) return;
   started_ = true;
@@ -32,8 +69,13 @@ void AsyncSinks::on_start() {
   thread_ = std::thread([this, &ready] {
     if (nice_ > 0) (void)core::set_nice(nice_);  // best effort: a normal share otherwise
     try {
+      start_pictures();
       for (FrameSink* k : sinks_) k->on_start();
     } catch (...) {
+      if (pictures_) {  // its GL objects go on this thread, with their context
+        pictures_->pipeline.reset();
+        pictures_->context.reset();
+      }
       ready.set_exception(std::current_exception());
       return;
     }
@@ -109,6 +151,16 @@ void AsyncSinks::on_frame(const FrameEvent& e) {
 }
 
 void AsyncSinks::run() {
+  // However the thread ends, the pictures' GL objects go with their context on this thread.
+  struct ReleasePictures {
+    Pictures* p;
+    ~ReleasePictures() {
+      if (p == nullptr) return;
+      if (p->context) (void)p->context->make_current();
+      p->pipeline.reset();
+      p->context.reset();
+    }
+  } release{pictures_.get()};
   for (;;) {
     std::size_t k = 0;
     {
@@ -121,6 +173,7 @@ void AsyncSinks::run() {
     }
     bool failed = false;
     try {
+      make_picture(slots_[k]);
       for (FrameSink* sink : sinks_) sink->on_frame(slots_[k].e);
     } catch (...) {
       std::lock_guard lock(mutex_);

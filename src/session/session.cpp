@@ -171,9 +171,11 @@ Session::Step Session::step() {
     // compare_every-th frame (a sample of the run; it costs as much as the main pipeline).
     if (alt_) {
       const bool render = frames_ % static_cast<std::uint64_t>(std::max(1, params_.compare_every)) == 0;
-      if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !render); !st)
+      const bool here = render && !params_.defer_compare_picture;
+      if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !here); !st)
         throw SpidarError(st.error().message);
       if (render) e.compared = &alt_result_;
+      e.compared_picture_pending = render && !here;
       e.compare_ms = core::ns_to_s(core::monotonic_ns() - e.t_done_ns) * 1e3;
     }
     if (scene_.monitor) e.cube = scene_.monitor->status().read();

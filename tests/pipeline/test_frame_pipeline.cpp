@@ -105,6 +105,47 @@ TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) 
               tip_sum / n, iou_sum / n, occ / n, occ_paper / n, bracelets, 2 * n);
 }
 
+// A fit made with registration_only and pictured later by another pipeline (on another context,
+// as AsyncSinks does on its thread) is the picture process() makes in one go.
+TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  p.personalise_shape = true;  // the picture must use the sizes this frame's fit used
+  sim::RubiksTask task({});
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(1.5, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  auto full = FramePipeline::create(*context_, camera_, models_, p).value();
+  auto fit = FramePipeline::create(*context_, camera_, models_, p).value();
+  auto other_context = render::Context::create_headless().value();
+  auto painter = FramePipeline::create(*other_context, camera_, models_, p).value();
+  sim::UserHands user(truth_models_, task);
+  sim::SyntheticFrame frame;
+  FrameResult a, b;
+  int frames = 0;
+  for (double t = 1.5; t < 2.2; t += 1.0 / 30, ++frames) {
+    const auto sample = pose_user(user, task, t);
+    const auto& truth = user.params();
+    ASSERT_TRUE(context_->make_current().ok());
+    ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+    ASSERT_TRUE(full->process(frame.bgr, sample, scene_, &a).ok());
+    ASSERT_TRUE(fit->process(frame.bgr, sample, scene_, &b, true).ok());
+    ASSERT_TRUE(other_context->make_current().ok());
+    ASSERT_TRUE(painter->picture(frame.bgr, scene_, &b).ok());
+    for (int h = 0; h < 2; ++h) ASSERT_LT((a.hands[h].q - b.hands[h].q).norm(), 1e-12) << t;
+    EXPECT_EQ(cv::norm(a.virt.hand_depth, b.virt.hand_depth, cv::NORM_INF), 0.0) << t;
+    EXPECT_EQ(cv::norm(a.composite, b.composite, cv::NORM_INF), 0.0) << t;
+    EXPECT_EQ(cv::norm(a.other_alpha, b.other_alpha, cv::NORM_INF), 0.0) << t;
+  }
+  // A result without its matte cannot be pictured.
+  FrameResult empty;
+  const auto st = painter->picture(frame.bgr, scene_, &empty);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("matte"), std::string::npos) << st.error().message;
+  ASSERT_TRUE(context_->make_current().ok());
+}
+
 TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {
   auto pipe = FramePipeline::create(*context_, camera_, models_, {}).value();
   FrameResult r;

@@ -111,6 +111,12 @@ class FramePipeline {
   /// With `registration_only` it stops after fitting the hands (no rendering, no composites).
   Status process(const cv::Mat& bgr, const device::FingertipSample& fingertips,
                  const SceneSnapshot& scene, FrameResult* out, bool registration_only = false);
+  /// The picture of a fit made elsewhere (a process() with registration_only, possibly by another
+  /// FramePipeline on another thread): renders `scene` with out->hands posed on out->models
+  /// (hidden, for depth) into out->virt and composes out->composite (and out->other) from `bgr`
+  /// and out->key. The context this pipeline was created with must be current. Error on a bad
+  /// frame or a result without its matte.
+  Status picture(const cv::Mat& bgr, const SceneSnapshot& scene, FrameResult* out);
   /// Shows an image (e.g. the composite) in the window of `context` (error when headless).
   Status present(render::Context& context, const cv::Mat& bgr);
   /// Forgets the previous frame (the next one is a cold start).

@@ -14,12 +14,15 @@
 #include <cstdint>
 #include <deque>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
 #include <vector>
 
+#include "spidar/render/context.hpp"
 #include "spidar/session/frame_sink.hpp"
+#include "spidar/vision/camera.hpp"
 
 namespace spidar::session {
 
@@ -34,6 +37,11 @@ class AsyncSinks final : public FrameSink {
   AsyncSinks(const AsyncSinks&) = delete;
   AsyncSinks& operator=(const AsyncSinks&) = delete;
 
+  /// Makes the pictures the session left pending (FrameEvent::compared_picture_pending) on the
+  /// output thread, before the sinks see the frame, with a FramePipeline of `params` and a
+  /// headless GL context of its own (created in on_start there). Call before on_start.
+  void picture_comparisons(const vision::Camera& camera, const std::array<hand::HandModel, 2>& models,
+                           const pipeline::FramePipelineParams& params);
   /// Starts the output thread and waits for the sinks' on_start there (re-throws its exception).
   void on_start() override;
   /// Copies the event into a free slot (waiting for one if none is) and queues it.
@@ -58,7 +66,19 @@ class AsyncSinks final : public FrameSink {
   void copy_into(const FrameEvent& from, Slot& to) const;
   void rethrow_if_failed();
 
+  /// The comparison's pictures (picture_comparisons), made on the output thread.
+  struct Pictures {
+    vision::Camera camera;
+    std::array<hand::HandModel, 2> models;
+    pipeline::FramePipelineParams params;
+    std::unique_ptr<render::Context> context;
+    std::unique_ptr<pipeline::FramePipeline> pipeline;
+  };
+  void start_pictures();
+  void make_picture(Slot& slot);
+
   std::vector<FrameSink*> sinks_;
+  std::unique_ptr<Pictures> pictures_;
   std::vector<Slot> slots_;
   std::thread thread_;
   mutable std::mutex mutex_;

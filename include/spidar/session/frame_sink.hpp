@@ -37,6 +37,9 @@ struct FrameEvent {
   /// The comparison pipeline (silhouette term switched the other way), rendered this frame;
   /// null when the session has no comparison or skipped its rendering in this frame.
   const pipeline::FrameResult* compared = nullptr;
+  /// `compared` holds the comparison's fit but not yet its picture (SessionParams::
+  /// defer_compare_picture): AsyncSinks::picture_comparisons makes it before its sinks see it.
+  bool compared_picture_pending = false;
   /// What the synthetic camera filmed (ground truth); null for real cameras.
   const sim::FilmedFrame* filmed = nullptr;
   ServoTiming servo;  ///< the servo loop's rate and jitter since the previous frame

@@ -32,6 +32,10 @@ struct SessionParams {
   /// (it must track) and rendered every `compare_every`-th frame (FrameEvent::compared).
   bool compare = false;
   int compare_every = 5;
+  /// The comparison's picture (render and composites) is left to a sink on another thread
+  /// (AsyncSinks::picture_comparisons): the frame thread fits it only, and FrameEvent::compared
+  /// carries the fit with compared_picture_pending set.
+  bool defer_compare_picture = false;
   /// One blank frame through each pipeline before the clock starts (GL programs, skins and
   /// workspaces cost ~130 ms on the first frame; in the run they would drop the camera's first
   /// frames); the fits are reset after it, so the first real frame is a cold start.
@@ -103,6 +107,8 @@ class Session {
   const device::ServoLoop& servo() const;
   sim::PhysicsThreadStats physics_stats() const;
   pipeline::FramePipeline& pipeline() { return *pipe_; }
+  /// The comparison pipeline's params (the silhouette term switched); null without a comparison.
+  const pipeline::FramePipelineParams* comparison_params() const { return alt_ ? &alt_->params() : nullptr; }
   const SessionParams& params() const { return params_; }
 
  private:
