@@ -105,15 +105,12 @@ int run_mr_demo(const DemoOptions& o) {
   auto run = session::Session::create(rig, scene, *context, camera, models, sp);
 
   session::TruthScorer scorer(camera, truth_models, sp.pipeline);
-  std::unique_ptr<render::VideoOutput> video;
+  // The video is opened on the output thread (VideoSink::on_start), so that the encoder's threads
+  // run at its niceness too.
   std::unique_ptr<session::VideoSink> video_sink;
-  if (o.video) {
-    auto v = render::VideoOutput::open((fs::path(o.out) / "mixed_reality.mp4").string(), o.width,
-                                       o.height, o.fps);
-    if (!v) throw SpidarError(v.error().message);
-    video = std::move(v).value();
-    video_sink = std::make_unique<session::VideoSink>(*video);
-  }
+  if (o.video)
+    video_sink = std::make_unique<session::VideoSink>((fs::path(o.out) / "mixed_reality.mp4").string(),
+                                                      o.width, o.height, o.fps);
   session::KeyframeSink keyframes(
       (fs::path(o.out) / "keyframes").string(), {1.9, 3.0, 4.5, 8.5, 10.2}, *mode, camera,
       [&scorer, &task](const session::FrameEvent& e) {
@@ -178,6 +175,7 @@ int run_mr_demo(const DemoOptions& o) {
   if (cube) {
     for (char f : std::string("UDFBRL")) summary.face_deg[f] = cube->face_angle(f) * 180 / units::kPi;
   }
+  const render::VideoOutput* video = video_sink ? video_sink->video() : nullptr;
   summary.video_path = video ? video->path() : "";
   summary.video_format = video ? render::video_format_name(video->format()) : "";
   summary.main_silhouette = o.silhouette;

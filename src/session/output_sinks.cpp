@@ -7,11 +7,22 @@
 
 namespace spidar::session {
 
-void VideoSink::on_frame(const FrameEvent& e) {
-  if (auto st = video_.write(e.result->composite); !st) throw SpidarError(st.error().message);
+void VideoSink::on_start() {
+  if (video_ != nullptr) return;
+  auto v = render::VideoOutput::open(path_, width_, height_, fps_);
+  if (!v) throw SpidarError(v.error().message);
+  own_ = std::move(v).value();
+  video_ = own_.get();
 }
 
-void VideoSink::on_end(const SessionSummary& /*s*/) { video_.close(); }
+void VideoSink::on_frame(const FrameEvent& e) {
+  if (video_ == nullptr) throw SpidarError("video: " + path_ + " is not open (no on_start)");
+  if (auto st = video_->write(e.result->composite); !st) throw SpidarError(st.error().message);
+}
+
+void VideoSink::on_end(const SessionSummary& /*s*/) {
+  if (video_ != nullptr) video_->close();
+}
 
 void KeyframeSink::on_frame(const FrameEvent& e) {
   if (next_ >= times_.size() || e.t_s < times_[next_]) return;

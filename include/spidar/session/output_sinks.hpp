@@ -16,12 +16,25 @@ namespace spidar::session {
 /// Every frame's composite into `video` (closed at the end). Throws SpidarError if a write fails.
 class VideoSink final : public FrameSink {
  public:
-  explicit VideoSink(render::VideoOutput& video) : video_(video) {}
+  /// Writes into a video opened by the caller.
+  explicit VideoSink(render::VideoOutput& video) : video_(&video) {}
+  /// Opens `path` (render::VideoOutput::open) in on_start, on the thread that runs the sink: the
+  /// encoder's own threads then share that thread's priority (e.g. AsyncSinks' nice output
+  /// thread). on_start throws SpidarError if it cannot be opened.
+  VideoSink(std::string path, int width, int height, double fps)
+      : path_(std::move(path)), width_(width), height_(height), fps_(fps) {}
+  void on_start() override;
   void on_frame(const FrameEvent& e) override;
   void on_end(const SessionSummary& s) override;
+  /// The video written to (null before on_start when the sink opens it).
+  const render::VideoOutput* video() const { return video_; }
 
  private:
-  render::VideoOutput& video_;
+  render::VideoOutput* video_ = nullptr;
+  std::unique_ptr<render::VideoOutput> own_;
+  std::string path_;
+  int width_ = 0, height_ = 0;
+  double fps_ = 0;
 };
 
 /// At each of `times` [s] (ascending), the first frame at or after it: a keyframe montage
