@@ -311,6 +311,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"capacity_fps", quantile(pipe_ms, 0.5) > 0 ? 1000.0 / quantile(pipe_ms, 0.5) : 0.0},
         {"dropped_frames", s.dropped},  // also at the top level (older readers)
         {"dropped_pct", frames + s.dropped > 0 ? 100.0 * s.dropped / static_cast<double>(frames + s.dropped) : 0.0},
+        {"output_waits", s.output_waits},
+        {"output_wait_ms", s.output_wait_ms},
         {"stage_ms_median",
          {{"chroma_key", quantile(column(t, [](const MrFrame& m) { return m.stages.key_ms; }), 0.5)},
           {"bracelets", quantile(column(t, [](const MrFrame& m) { return m.stages.bracelet_ms; }), 0.5)},

@@ -23,6 +23,10 @@ using MrTrace = TruthTrace;
 struct MrSummary {
   double seconds = 0, wall_s = 0;
   int dropped = 0;
+  /// Times the frame thread found every output slot taken and waited for the output thread
+  /// (AsyncSinks::waits), and for how long in all [ms].
+  std::uint64_t output_waits = 0;
+  double output_wait_ms = 0;
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;
   int turns = 0;
