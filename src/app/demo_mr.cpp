@@ -166,6 +166,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.seconds = end.t_last_s;
   summary.wall_s = end.wall_s;
   summary.dropped = static_cast<int>(end.camera_frames) - static_cast<int>(trace.frames.size());
+  summary.camera_skipped = static_cast<int>(end.camera_skipped);
   summary.output_waits = off_path.waits();
   summary.output_wait_ms = off_path.waited_ms();
   summary.servo = end.servo;

@@ -237,6 +237,7 @@ SessionSummary Session::stop(const std::string& ended_by) {
   s.t_last_s = t_last_s_;
   s.frames = frames_;
   s.camera_frames = rig_.camera().delivered();
+  s.camera_skipped = rig_.camera().skipped();
   if (haptic_) {
     s.servo = haptic_->loop().stats();
     s.physics = haptic_->physics().stats();

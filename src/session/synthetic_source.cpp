@@ -45,6 +45,7 @@ class SyntheticSource final : public FrameSource {
   bool ended() const override { return stopped_ && thread_ && !thread_->error().empty(); }
   std::string error() const override { return stopped_ && thread_ ? thread_->error() : std::string(); }
   std::uint64_t delivered() const override { return thread_ ? thread_->filmed() : 0; }
+  std::uint64_t skipped() const override { return thread_ ? thread_->skipped() : 0; }
   void stop() override {
     if (thread_ && !stopped_) thread_->stop();
     stopped_ = true;

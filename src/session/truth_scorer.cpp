@@ -1,5 +1,6 @@
 #include "spidar/session/truth_scorer.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "spidar/core/clock.hpp"
@@ -45,6 +46,9 @@ void TruthScorer::on_frame(const FrameEvent& e) {
   m.preprocess_ms = result.timings.key_ms + result.timings.bracelet_ms + result.timings.distance_ms;
   m.stages = result.timings;
   m.film_ms = filmed.film_ms;
+  const auto camera_index = static_cast<std::int64_t>(filmed.index);
+  m.dropped_before = static_cast<int>(std::max<std::int64_t>(0, camera_index - last_camera_index_ - 1));
+  last_camera_index_ = camera_index;
   const std::int64_t t_scoring_ns = core::monotonic_ns();
   auto main_m = sim::measure_frame(filmed.frame, result, mode_, result.models, truth_models_, filmed.truth,
                                    camera_, &ws_);

@@ -100,6 +100,7 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
     while (t_exp + params_.readout_ns < now) {
       t_exp += period_ns;
       ++index;
+      skipped_.fetch_add(1, std::memory_order_acq_rel);
     }
   }
 }

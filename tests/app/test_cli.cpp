@@ -270,12 +270,27 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_TRUE(exists(dir + "/registration_error.png"));
   EXPECT_TRUE(exists(dir + "/fingertip_forces.png"));
   EXPECT_TRUE(exists(dir + "/loop_timing.png"));
-  {  // frames.csv: a header and one row per processed frame
+  {  // frames.csv: a header and one row per processed frame; the exposures missing before each
+     // frame add up to at most the run's drops and camera skips (those after the last processed
+     // frame are in no row)
     std::ifstream csv(dir + "/frames.csv");
     std::string line;
-    int rows = -1;
-    while (std::getline(csv, line)) ++rows;
+    int rows = -1, dropped_column = -1, dropped_sum = 0;
+    while (std::getline(csv, line)) {
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+      if (rows++ < 0) {
+        for (std::size_t k = 0; k < cells.size(); ++k)
+          if (cells[k] == "dropped_before") dropped_column = static_cast<int>(k);
+        ASSERT_GE(dropped_column, 0) << line;
+      } else if (dropped_column < static_cast<int>(cells.size())) {
+        dropped_sum += std::stoi(cells[static_cast<std::size_t>(dropped_column)]);
+      }
+    }
     EXPECT_EQ(rows, j["frames"].get<int>());
+    EXPECT_GE(dropped_sum, 0);
+    EXPECT_LE(dropped_sum, j["pipeline"]["dropped_frames"].get<int>() + j["pipeline"]["camera_skipped_frames"].get<int>());
   }
   EXPECT_TRUE(exists(j["video"]["path"].get<std::string>()));
   // The first keyframe is due at 1.9 s; the first frame processed after it names the file (under

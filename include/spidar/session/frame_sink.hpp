@@ -57,6 +57,7 @@ struct SessionSummary {
   double t_last_s = 0;                 ///< FrameEvent::t_s of the last frame before the end [s]
   std::uint64_t frames = 0;            ///< processed
   std::uint64_t camera_frames = 0;     ///< delivered by the camera (processed or dropped)
+  std::uint64_t camera_skipped = 0;    ///< exposures the camera itself did not deliver (FrameSource::skipped)
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;
   std::string camera_error;            ///< why the camera stopped, if it failed

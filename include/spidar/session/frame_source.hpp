@@ -49,6 +49,9 @@ class FrameSource {
   virtual std::string error() const = 0;
   /// Frames delivered so far (taken or dropped).
   virtual std::uint64_t delivered() const = 0;
+  /// Frames the source itself failed to produce at its rate (a simulated camera on a busy
+  /// machine); 0 for sources that deliver whatever they get.
+  virtual std::uint64_t skipped() const { return 0; }
   /// Stops the thread. Idempotent.
   virtual void stop() = 0;
 };

@@ -22,7 +22,8 @@ using MrTrace = TruthTrace;
 
 struct MrSummary {
   double seconds = 0, wall_s = 0;
-  int dropped = 0;
+  int dropped = 0;        ///< delivered by the camera but not processed (the frame thread was busy)
+  int camera_skipped = 0;  ///< exposures the simulated camera itself fell behind on
   /// Times the frame thread found every output slot taken and waited for the output thread
   /// (AsyncSinks::waits), and for how long in all [ms].
   std::uint64_t output_waits = 0;

@@ -4,6 +4,7 @@
 /// on compared frames, the cube, forces and servo timing — the per-frame trace the demo's report
 /// is made of.
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -27,6 +28,10 @@ struct TruthFrame {
   double film_ms = 0;          ///< synthetic camera (simulation cost, not pipeline) [ms]
   double truth_ms = 0;         ///< ground-truth posture, comparison fit, metrics [ms]
   double output_ms = 0;        ///< video and keyframes [ms]
+  /// Camera exposures missing just before this one: delivered but not processed (the frame thread
+  /// was still busy) or not filmed in time by the simulated camera; the first frame counts those
+  /// since the camera started.
+  int dropped_before = 0;
   /// [0]: the main registration, [1]: the comparison (silhouette term switched the other way).
   std::array<sim::FrameTruthMetrics, 2> truth{};
   bool compared = false;  ///< truth[1] measured in this frame
@@ -75,6 +80,7 @@ class TruthScorer final : public FrameSink {
   std::unique_ptr<sim::ModelCeiling> ceiling_;
   sim::FrameTruthWorkspace ws_;
   TruthTrace trace_;
+  std::int64_t last_camera_index_ = -1;
 };
 
 }  // namespace spidar::session

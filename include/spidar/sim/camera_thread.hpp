@@ -63,6 +63,9 @@ class CameraThread {
   const FilmedFrame& frame() const { return frames_.front(); }
   /// Frames filmed so far.
   std::uint64_t filmed() const { return filmed_.load(std::memory_order_acquire); }
+  /// Exposures this thread let pass without filming them because it was late (on a busy machine
+  /// the simulated camera itself falls behind its rate; a real camera would not).
+  std::uint64_t skipped() const { return skipped_.load(std::memory_order_acquire); }
   /// The error that stopped the thread, if any (read after stop()).
   const std::string& error() const { return error_; }
   void stop();
@@ -77,6 +80,7 @@ class CameraThread {
   TruthAt truth_at_;
   core::TripleBuffer<FilmedFrame> frames_;
   std::atomic<std::uint64_t> filmed_{0};
+  std::atomic<std::uint64_t> skipped_{0};
   std::atomic<bool> stop_{false};
   std::string error_;
   std::thread thread_;
