@@ -116,7 +116,7 @@ const std::array<hand::HandModel, 2>& FramePipeline::models() const { return imp
 
 Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample& tips,
                               const SceneSnapshot& world, FrameResult* out,
-                              bool registration_only) {
+                              bool registration_only, const vision::ChromaKeyResult* matte) {
   if (out == nullptr) return Error{"frame pipeline: no output given"};
   Impl& s = *impl_;
   const FramePipelineParams& p = s.params;
@@ -129,9 +129,15 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   const auto t_start = Clock::now();
   FrameTimings& tm = out->timings;
 
-  // Chroma key.
+  // Chroma key (or the one given for this image).
   auto t0 = Clock::now();
-  if (auto st = s.keyer.apply(bgr, &out->key); !st) return st;
+  if (matte != nullptr) {
+    if (matte->alpha.size() != bgr.size() || matte->silhouette.size() != bgr.size())
+      return Error{"frame pipeline: the matte given is not the frame's size"};
+    out->key = *matte;  // shares its images
+  } else if (auto st = s.keyer.apply(bgr, &out->key); !st) {
+    return st;
+  }
   tm.key_ms = ms_since(t0);
 
   // Bracelets, predicted from the previous frame's wrists.

@@ -172,7 +172,11 @@ Session::Step Session::step() {
     if (alt_) {
       const bool render = frames_ % static_cast<std::uint64_t>(std::max(1, params_.compare_every)) == 0;
       const bool here = render && !params_.defer_compare_picture;
-      if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !here); !st)
+      // The same image keyed with the same params: the main pipeline's matte.
+      const bool same_key = alt_->params().chroma_key == pipe_->params().chroma_key;
+      if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !here,
+                                  same_key ? &result_.key : nullptr);
+          !st)
         throw SpidarError(st.error().message);
       if (render) e.compared = &alt_result_;
       e.compared_picture_pending = render && !here;

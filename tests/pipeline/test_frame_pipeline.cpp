@@ -105,8 +105,9 @@ TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) 
               tip_sum / n, iou_sum / n, occ / n, occ_paper / n, bracelets, 2 * n);
 }
 
-// A fit made with registration_only and pictured later by another pipeline (on another context,
-// as AsyncSinks does on its thread) is the picture process() makes in one go.
+// A fit made with registration_only from another pipeline's matte, and pictured later by a third
+// pipeline (on another context, as AsyncSinks does on its thread), is the fit and the picture
+// process() makes in one go.
 TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) {
   const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
   FramePipelineParams p;
@@ -130,7 +131,8 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
     ASSERT_TRUE(context_->make_current().ok());
     ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
     ASSERT_TRUE(full->process(frame.bgr, sample, scene_, &a).ok());
-    ASSERT_TRUE(fit->process(frame.bgr, sample, scene_, &b, true).ok());
+    // The fit keys nothing itself: it is given the full pipeline's matte of this image.
+    ASSERT_TRUE(fit->process(frame.bgr, sample, scene_, &b, true, &a.key).ok());
     ASSERT_TRUE(other_context->make_current().ok());
     ASSERT_TRUE(painter->picture(frame.bgr, scene_, &b).ok());
     for (int h = 0; h < 2; ++h) ASSERT_LT((a.hands[h].q - b.hands[h].q).norm(), 1e-12) << t;
@@ -138,6 +140,13 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
     EXPECT_EQ(cv::norm(a.composite, b.composite, cv::NORM_INF), 0.0) << t;
     EXPECT_EQ(cv::norm(a.other_alpha, b.other_alpha, cv::NORM_INF), 0.0) << t;
   }
+  // A matte of another size is refused.
+  vision::ChromaKeyResult small;
+  small.alpha = cv::Mat(4, 4, CV_32FC1, cv::Scalar(0));
+  small.silhouette = cv::Mat(4, 4, CV_8UC1, cv::Scalar(0));
+  ASSERT_TRUE(context_->make_current().ok());
+  EXPECT_FALSE(fit->process(frame.bgr, device::FingertipSample{}, scene_, &b, true, &small).ok());
+  ASSERT_TRUE(other_context->make_current().ok());
   // A result without its matte cannot be pictured.
   FrameResult empty;
   const auto st = painter->picture(frame.bgr, scene_, &empty);

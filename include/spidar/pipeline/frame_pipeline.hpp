@@ -109,8 +109,12 @@ class FramePipeline {
   /// Processes one frame: `bgr` the camera image (camera's size), `fingertips` the servo sample
   /// at its exposure time, `scene` the virtual world. Error on a bad frame (naming what).
   /// With `registration_only` it stops after fitting the hands (no rendering, no composites).
+  /// `matte`: this image's chroma key made by another pipeline with the same chroma-key params
+  /// (the comparison fit reuses the main pipeline's instead of keying the frame again); it is
+  /// shared, not copied, into out->key. Error if its size is not the frame's.
   Status process(const cv::Mat& bgr, const device::FingertipSample& fingertips,
-                 const SceneSnapshot& scene, FrameResult* out, bool registration_only = false);
+                 const SceneSnapshot& scene, FrameResult* out, bool registration_only = false,
+                 const vision::ChromaKeyResult* matte = nullptr);
   /// The picture of a fit made elsewhere (a process() with registration_only, possibly by another
   /// FramePipeline on another thread): renders `scene` with out->hands posed on out->models
   /// (hidden, for depth) into out->virt and composes out->composite (and out->other) from `bgr`

@@ -26,6 +26,7 @@ struct ChromaKeyParams {
   int cleanup_radius_px = 1;    ///< radius of an opening then closing of the silhouette; 0 = off
   bool despill = true;          ///< write `foreground` with blue spill removed on the edge band
   double spill_limit = 1.0;     ///< B ≤ spill_limit · max(R, G) on the edge band
+  bool operator==(const ChromaKeyParams&) const = default;
 };
 
 /// Checks ranges (s_foreground < s_background within [−1, 1], thresholds in (0, 1), ...).
