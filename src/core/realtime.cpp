@@ -24,10 +24,13 @@ Status set_fifo_priority(int priority) {
 }
 
 Status set_nice(int nice) {
-  if (nice < 0 || nice > 19) return Error{"nice must be in 0..19, got " + std::to_string(nice)};
+  if (nice < -20 || nice > 19) return Error{"nice must be in -20..19, got " + std::to_string(nice)};
   // Linux: a thread's nice value is per thread (its tid), not per process.
-  if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice) != 0)
-    return Error{"could not set nice " + std::to_string(nice) + " (" + std::strerror(errno) + ")"};
+  if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice) != 0) {
+    const int e = errno;
+    return Error{"could not set nice " + std::to_string(nice) + " (" + std::strerror(e) + ")" +
+                 (e == EPERM || e == EACCES ? "; grant CAP_SYS_NICE or nice in limits.conf" : "")};
+  }
   return Ok{};
 }
 

@@ -13,7 +13,7 @@ namespace spidar::session {
 
 AsyncSinks::AsyncSinks(std::vector<FrameSink*> sinks, int slots, int nice)
     : sinks_(std::move(sinks)), slots_(static_cast<std::size_t>(slots < 1 ? 1 : slots)),
-      nice_(std::clamp(nice, 0, 19)) {
+      nice_(std::clamp(nice, -20, 19)) {
   for (std::size_t k = slots_.size(); k-- > 0;) free_.push_back(k);
 }
 
@@ -67,7 +67,7 @@ void AsyncSinks::on_start() {
   std::promise<void> ready;
   auto started = ready.get_future();
   thread_ = std::thread([this, &ready] {
-    if (nice_ > 0) (void)core::set_nice(nice_);  // best effort: a normal share otherwise
+    if (nice_ != 0) (void)core::set_nice(nice_);  // best effort: a normal share otherwise
     try {
       start_pictures();
       for (FrameSink* k : sinks_) k->on_start();

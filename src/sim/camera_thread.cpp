@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/core/realtime.hpp"
 #include "spidar/render/context.hpp"
 
 namespace spidar::sim {
@@ -59,6 +60,7 @@ bool CameraThread::take() { return frames_.update(); }
 void CameraThread::run(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
                        const SyntheticCameraParams& film_params, const RubiksTask& task,
                        std::function<void(Status)> ready) {
+  (void)core::set_nice(params_.nice);  // best effort (see CameraThreadParams::nice)
   // The GL context lives (and is current) on this thread only.
   auto ctx = render::Context::create_headless();
   if (!ctx) return ready(Error{"camera thread: OpenGL: " + ctx.error().message});

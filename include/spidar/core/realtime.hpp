@@ -14,10 +14,10 @@ namespace spidar::core {
 /// SCHED_FIFO at `priority` (1..99) for the calling thread. Error names the reason.
 Status set_fifo_priority(int priority);
 
-/// Lowers the calling thread's share of the CPU among normal (SCHED_OTHER) threads: nice `nice`
-/// (0..19; 10 gets about a tenth of a nice-0 thread's share when both want the CPU). Work that
-/// may lag, such as scoring and writing outputs, then yields to the frame thread. No privileges
-/// needed. Error names the reason.
+/// The calling thread's share of the CPU among normal (SCHED_OTHER) threads: nice `nice` (−20..19;
+/// each step is about 1.25× the share; 10 gets about a tenth of a nice-0 thread's share when both
+/// want the CPU). Raising it needs no privilege; below the current value needs CAP_SYS_NICE (or
+/// `nice` in limits.conf), and the error says so.
 Status set_nice(int nice);
 
 /// Pins the calling thread to `cpu` (0-based; −1 = the last online CPU). Error names the CPU.

@@ -29,8 +29,7 @@ namespace spidar::session {
 class AsyncSinks final : public FrameSink {
  public:
   /// `sinks` must outlive this group; `slots` ≥ 1 frames may wait for (or be in) the sinks.
-  /// `nice` (0..19): the output thread's niceness, so that on a busy machine it yields to the
-  /// frame thread and catches up in the gaps (the slots bound how far it may fall behind).
+  /// `nice` (−20..19, best effort): the output thread's niceness (core::set_nice).
   explicit AsyncSinks(std::vector<FrameSink*> sinks, int slots = 3, int nice = 0);
   /// Stops the output thread (the frames still queued are not delivered, no on_end).
   ~AsyncSinks() override;

@@ -44,6 +44,10 @@ struct CameraThreadParams {
   double fps = 30.0;
   std::int64_t t0_ns = 0;        ///< script time 0 (host monotonic) [ns]
   std::int64_t readout_ns = 2'000'000;  ///< wait after the exposure before filming [ns]
+  /// The thread's niceness (core::set_nice, best effort): the simulated camera is hardware, which
+  /// films at its rate whatever the host does, so it goes before the frame thread and the outputs
+  /// that share the CPU with it. Needs CAP_SYS_NICE below 0; without it, a normal share.
+  int nice = -10;
 };
 
 class CameraThread {
