@@ -2,20 +2,14 @@
 
 #include <fstream>
 
+#include "config_error_of.hpp"
 #include "spidar/core/config.hpp"
 #include "spidar/core/pose.hpp"
 
 namespace spidar::core {
 namespace {
 
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using testing::error_of;
 
 TEST(ConfigNode, ReadsTypedValues) {
   auto root = ConfigNode::Parse("a: 1.5\nb: [1, 2, 3]\nc: hello\nd: true\ne: 7\n", "t.yaml");

@@ -9,6 +9,7 @@
 #include <functional>
 #include <future>
 
+#include "config_error_of.hpp"
 #include "spidar/core/config.hpp"
 #include "temp_dir.hpp"
 
@@ -17,15 +18,7 @@ namespace {
 
 using testing::TempDir;
 
-/// The ConfigError message of `fn`, or "no error". Any other exception fails the test.
-std::string error_of(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using testing::error_of;
 
 const std::string kTooDeep = "expected at most 64 levels of nested maps and sequences";
 

@@ -35,19 +35,22 @@ TEST(ServoLoop, RunsAndKeepsOrderedStatistics) {
   Rig rig;
   ServoConfig cfg;
   cfg.rate_hz = 1000;
-  cfg.max_seconds = 0.4;
   // Not a timing test: a loaded machine (or a sanitizer) may wake the thread late; the deadline
-  // watchdog has its own tests.
+  // watchdog has its own tests. It runs for a number of cycles, not for a time.
   cfg.deadline_periods = 1000;
   cfg.stall_limit_s = 1.0;
   ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<ZeroForce>());
+  const auto t0 = std::chrono::steady_clock::now();
   ASSERT_TRUE(loop.start().ok());
-  loop.wait();
+  wait_for_cycles(loop, 150);
+  loop.stop();
+  const double ran_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto s = loop.stats();
   EXPECT_EQ(s.faults, 0u) << fault_names(s.faults) << " " << s.fault_message;
-  EXPECT_GT(s.cycles, 100u);
-  // Never faster than its rate: 0.4 s at 1 kHz, plus the untimed first cycle and edges.
-  EXPECT_LE(s.cycles, 404u);
+  EXPECT_GE(s.cycles, 150u);
+  // Never faster than its rate (an upper bound, which a slow machine cannot break): at most one
+  // cycle per period of the time it ran, plus the untimed first cycle and edges.
+  EXPECT_LE(static_cast<double>(s.cycles), ran_s * cfg.rate_hz + 4.0);
   EXPECT_EQ(static_cast<std::uint64_t>(rig.rec.writes()), s.cycles);
   EXPECT_GT(s.rate_hz, 0.0);
   EXPECT_LE(s.jitter_p50_us, s.jitter_p99_us);
@@ -318,7 +321,7 @@ TEST(ServoLoop, DisconnectEndsTheLoopCleanlyWithTheFault) {
   EXPECT_TRUE(s.faults & kFaultDisconnected);
   EXPECT_NE(s.fault_message.find("disconnected"), std::string::npos);
   EXPECT_GE(rig.rec.safe_requests(), 1);
-  EXPECT_GT(s.cycles, 10u);
+  EXPECT_GT(s.cycles, 0u);  // it ran before the disconnect (how many cycles is a matter of speed)
 }
 
 TEST(ServoLoop, EmergencyStopHoldsMinimumTensionUntilReset) {
