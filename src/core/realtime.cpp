@@ -1,11 +1,13 @@
 #include "spidar/core/realtime.hpp"
 
 #include <pthread.h>
+#include <fcntl.h>
 #include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -32,6 +34,36 @@ Status set_nice(int nice) {
                  (e == EPERM || e == EACCES ? "; grant CAP_SYS_NICE or nice in limits.conf" : "")};
   }
   return Ok{};
+}
+
+Result<CpuLatencyRequest> CpuLatencyRequest::open(int max_latency_us) {
+  if (max_latency_us < 0) return Error{"CPU latency request: expected >= 0 us, got " + std::to_string(max_latency_us)};
+  const int fd = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (fd < 0) {
+    const int e = errno;
+    return Error{std::string("/dev/cpu_dma_latency: ") + std::strerror(e) +
+                 (e == EACCES || e == EPERM ? " (needs root or write access)" : "")};
+  }
+  const std::int32_t value = max_latency_us;
+  if (::write(fd, &value, sizeof value) != static_cast<ssize_t>(sizeof value)) {
+    const int e = errno;
+    ::close(fd);
+    return Error{std::string("/dev/cpu_dma_latency: write: ") + std::strerror(e)};
+  }
+  return CpuLatencyRequest(fd);
+}
+
+CpuLatencyRequest& CpuLatencyRequest::operator=(CpuLatencyRequest&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = other.fd_;
+    other.fd_ = -1;
+  }
+  return *this;
+}
+
+CpuLatencyRequest::~CpuLatencyRequest() {
+  if (fd_ >= 0) ::close(fd_);
 }
 
 Status pin_to_cpu(int cpu) {

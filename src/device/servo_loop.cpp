@@ -2,6 +2,7 @@
 
 #include "spidar/core/realtime.hpp"
 
+#include <optional>
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -229,6 +230,7 @@ void ServoLoop::end_servo_thread(pthread_t servo_thread, std::int64_t window_ns)
 
 void ServoLoop::run() {
   if (servo_.on_thread_start) servo_.on_thread_start();
+  std::optional<core::CpuLatencyRequest> cpu_latency;
   if (servo_.realtime) {
     const Status rt = core::set_fifo_priority(80);
     realtime_granted_ = rt.ok();
@@ -238,6 +240,13 @@ void ServoLoop::run() {
     }
     if (const Status pin = core::pin_to_cpu(servo_.cpu); !pin.ok()) {
       spdlog::warn("servo loop: {}", pin.error().message);
+    }
+    // Idle CPUs poll rather than halt while the loop runs (core::CpuLatencyRequest).
+    if (auto qos = core::CpuLatencyRequest::open(0)) {
+      cpu_latency.emplace(std::move(qos).value());  // withdrawn when this thread's loop ends
+    } else {
+      spdlog::warn("servo loop: {}; idle CPUs may sleep deeply between cycles, expect more jitter",
+                   qos.error().message);
     }
   }
   if (!(faults_.load() & kSafeStateFaults)) device_.clear_safe_state();

@@ -33,5 +33,16 @@ TEST(Realtime, SetNiceRefusesValuesOutsideItsRange) {
   }
 }
 
+// Held, the request is in force; where the file cannot be opened (no root) the error names it.
+TEST(Realtime, CpuLatencyRequestHoldsTheFileOrSaysWhy) {
+  auto r = CpuLatencyRequest::open(0);
+  if (!r) {
+    EXPECT_NE(r.error().message.find("/dev/cpu_dma_latency"), std::string::npos) << r.error().message;
+    return;
+  }
+  CpuLatencyRequest moved = std::move(r).value();  // moving keeps one open request
+  EXPECT_FALSE(CpuLatencyRequest::open(-1).ok());
+}
+
 }  // namespace
 }  // namespace spidar::core
