@@ -40,6 +40,15 @@ hand::HandParams cold_start(const hand::HandModel& model, const Vec3& r_W_hand,
   return q;
 }
 
+/// The camera frame a pipeline can take: CV_8UC3 of the camera's size; else an error saying so.
+Status check_frame(const cv::Mat& bgr, const vision::Camera& camera) {
+  if (!bgr.empty() && bgr.type() == CV_8UC3 && bgr.cols == camera.width() && bgr.rows == camera.height())
+    return Ok{};
+  return Error{"frame pipeline: expected a CV_8UC3 frame of " + std::to_string(camera.width()) + "x" +
+               std::to_string(camera.height()) + " px, got " + std::to_string(bgr.cols) + "x" +
+               std::to_string(bgr.rows)};
+}
+
 }  // namespace
 
 struct FramePipeline::Impl {
@@ -120,12 +129,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   if (out == nullptr) return Error{"frame pipeline: no output given"};
   Impl& s = *impl_;
   const FramePipelineParams& p = s.params;
-  if (bgr.empty() || bgr.type() != CV_8UC3 || bgr.cols != s.camera.width() ||
-      bgr.rows != s.camera.height()) {
-    return Error{"frame pipeline: expected a CV_8UC3 frame of " + std::to_string(s.camera.width()) +
-                 "x" + std::to_string(s.camera.height()) + " px, got " + std::to_string(bgr.cols) +
-                 "x" + std::to_string(bgr.rows)};
-  }
+  if (auto st = check_frame(bgr, s.camera); !st) return st;
   const auto t_start = Clock::now();
   FrameTimings& tm = out->timings;
 
@@ -272,12 +276,7 @@ Status FramePipeline::picture(const cv::Mat& bgr, const SceneSnapshot& world, Fr
   if (out == nullptr) return Error{"frame pipeline: no output given"};
   Impl& s = *impl_;
   const FramePipelineParams& p = s.params;
-  if (bgr.empty() || bgr.type() != CV_8UC3 || bgr.cols != s.camera.width() ||
-      bgr.rows != s.camera.height()) {
-    return Error{"frame pipeline: expected a CV_8UC3 frame of " + std::to_string(s.camera.width()) +
-                 "x" + std::to_string(s.camera.height()) + " px, got " + std::to_string(bgr.cols) +
-                 "x" + std::to_string(bgr.rows)};
-  }
+  if (auto st = check_frame(bgr, s.camera); !st) return st;
   if (out->key.alpha.size() != bgr.size())
     return Error{"frame pipeline: picture needs the frame's matte (FrameResult::key) from its fit"};
   FrameTimings& tm = out->timings;
