@@ -55,17 +55,23 @@ void FramePipeline640x480(benchmark::State& state) {
   auto pipe = pipeline::FramePipeline::create(*ctx.value(), camera, models, p).value();
   pipeline::FrameResult r;
   for (int k = 0; k < 5; ++k) (void)pipe->process(frame.bgr, tips, scene, &r);  // settle
-  double reg = 0, render = 0, composite = 0;
+  double key = 0, bracelets = 0, distance = 0, reg = 0, render = 0, composite = 0;
   for (auto _ : state) {
     if (auto st = pipe->process(frame.bgr, tips, scene, &r); !st) {
       state.SkipWithError(st.error().message.c_str());
       break;
     }
+    key += r.timings.key_ms;
+    bracelets += r.timings.bracelet_ms;
+    distance += r.timings.distance_ms;
     reg += r.timings.registration_ms;
     render += r.timings.render_ms;
     composite += r.timings.composite_ms;
   }
   const double n = static_cast<double>(state.iterations());
+  state.counters["key_ms"] = key / n;
+  state.counters["bracelet_ms"] = bracelets / n;
+  state.counters["distance_ms"] = distance / n;
   state.counters["registration_ms"] = reg / n;
   state.counters["render_ms"] = render / n;
   state.counters["composite_ms"] = composite / n;

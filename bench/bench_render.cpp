@@ -78,6 +78,32 @@ void RenderSceneAndHands(benchmark::State& state) {
 }
 BENCHMARK(RenderSceneAndHands)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
 
+/// Where the raster time goes at 640×480 (all four targets read back): the scene split by part.
+/// Arg 0: everything; 1: without the static world (shapes of body 0, the table); 2: the static
+/// world only; 3: the hands only; 4: the moving objects only (no hands, no world).
+void RenderScenePart(benchmark::State& state) {
+  if (!context()) return state.SkipWithError("no headless GL");
+  const vision::Camera cam = camera(640);
+  const SceneSnapshot full = cube_scene_with_hands();
+  SceneSnapshot scene = full;
+  const auto part = state.range(0);
+  scene.shapes.clear();
+  for (const Shape& sh : full.shapes) {
+    const bool hand = sh.hand >= 0, world = !hand && sh.body <= 0;
+    const bool keep = part == 0 || (part == 1 && !world) || (part == 2 && world) ||
+                      (part == 3 && hand) || (part == 4 && !hand && !world);
+    if (keep) scene.shapes.push_back(sh);
+  }
+  auto renderer = render::Renderer::create(*context(), cam.width(), cam.height()).value();
+  render::RenderTargets t;
+  for (auto _ : state) {
+    if (!renderer->render(scene, cam).ok() || !renderer->read(&t).ok())
+      state.SkipWithError("render failed");
+  }
+  state.counters["shapes"] = static_cast<double>(scene.shapes.size());
+}
+BENCHMARK(RenderScenePart)->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
+
 /// Render + read-back of one target at 640×480 (arg: 0 nothing but a 1-target sync read of hand id,
 /// 1 colour, 2 depth, 3 hand depth, 4 hand id): where the read-back's time goes.
 void RenderReadOne(benchmark::State& state) {

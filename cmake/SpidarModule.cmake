@@ -8,8 +8,10 @@ target_compile_options(spidar_build_flags INTERFACE
   $<$<BOOL:${SPIDAR_WERROR}>:-Werror>)
 if(SPIDAR_SANITIZE)
   target_compile_options(spidar_build_flags INTERFACE
-    -fsanitize=${SPIDAR_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all
-    $<$<BOOL:${SPIDAR_NO_SANITIZE}>:-fno-sanitize=${SPIDAR_NO_SANITIZE}>)
+    -fsanitize=${SPIDAR_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  if(SPIDAR_NO_SANITIZE)
+    target_compile_options(spidar_build_flags INTERFACE -fno-sanitize=${SPIDAR_NO_SANITIZE})
+  endif()
   target_link_options(spidar_build_flags INTERFACE -fsanitize=${SPIDAR_SANITIZE})
   # Tests that repeat one computation over many cases run one case in sanitizer builds (they
   # check numbers there, which the release build checks in full; the sanitizers check memory).

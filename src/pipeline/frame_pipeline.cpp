@@ -96,6 +96,9 @@ Result<std::unique_ptr<FramePipeline>> FramePipeline::create(
   if (auto s = registration::validate(params.registration); !s) return s.error();
   if (auto s = vision::validate(params.bracelet); !s) return s.error();
   if (auto s = render::validate(params.compositor); !s) return s.error();
+  if (params.skinned_hands) {
+    if (auto s = render::validate(params.model_skin); !s) return Error{"frame pipeline: model_skin: " + s.error().message};
+  }
   for (const auto& hand_fingers : params.fingers) {
     for (int f : hand_fingers) {
       if (f < 0 || f >= device::kMaxFingers)

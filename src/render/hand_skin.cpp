@@ -1,6 +1,8 @@
 #include "spidar/render/hand_skin.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <numbers>
 
 #include "spidar/hand/render_geometry.hpp"
@@ -81,6 +83,26 @@ MeshData rounded_box(const Vec3& half, double e, int slices, int stacks) {
   return m;
 }
 
+Status validate(const HandSkinParams& p) {
+  auto range = [](const char* name, int v, int lo, int hi) -> Status {
+    if (v >= lo && v <= hi) return Ok{};
+    return Error{std::string("hand skin: ") + name + " must be in " + std::to_string(lo) + ".." +
+                 std::to_string(hi) + ", got " + std::to_string(v)};
+  };
+  if (auto s = range("bone_slices", p.bone_slices, 6, 64); !s) return s;
+  if (auto s = range("bone_rings", p.bone_rings, 2, 32); !s) return s;
+  if (auto s = range("palm_slices", p.palm_slices, 8, 64); !s) return s;
+  if (auto s = range("palm_stacks", p.palm_stacks, 4, 64); !s) return s;
+  if (!(std::isfinite(p.taper) && p.taper >= 0 && p.taper < 1))
+    return Error{"hand skin: taper must be in [0, 1), got " + std::to_string(p.taper)};
+  if (!(std::isfinite(p.palm_fullness) && p.palm_fullness > 0 && p.palm_fullness <= 3))
+    return Error{"hand skin: palm_fullness must be in (0, 3], got " + std::to_string(p.palm_fullness)};
+  if (!(std::isfinite(p.forearm_length_m) && p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
+    return Error{"hand skin: forearm_length_m must be in [0, 0.5] m, got " +
+                 std::to_string(p.forearm_length_m)};
+  return Ok{};
+}
+
 HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
                          std::vector<MeshData>* meshes) {
   HandSkin skin;
@@ -88,16 +110,19 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
   const hand::HandRenderShapes rest = hand::hand_render_shapes(model, hand::HandParams{});
   for (const hand::Capsule& c : rest.capsules) {
     const double len = (c.p_W_b - c.p_W_a).norm();
-    meshes->push_back(tapered_segment((1 + p.taper) * c.radius, (1 - p.taper) * c.radius, len));
+    meshes->push_back(tapered_segment((1 + p.taper) * c.radius, (1 - p.taper) * c.radius, len,
+                                      p.bone_slices, p.bone_rings));
     skin.bones.push_back({static_cast<int>(meshes->size()) - 1, c.finger});
   }
   const Vec3 h = rest.boxes.at(0).half_extents;
-  meshes->push_back(rounded_box(Vec3(1.05 * h.x(), h.y() * 1.02, p.palm_fullness * h.z())));
+  meshes->push_back(rounded_box(Vec3(1.05 * h.x(), h.y() * 1.02, p.palm_fullness * h.z()), 0.45,
+                                p.palm_slices, p.palm_stacks));
   skin.palm_mesh = static_cast<int>(meshes->size()) - 1;
   skin.wrist_radius = 0.62 * h.x();
   if (p.forearm_length_m > 0) {
     meshes->push_back(
-        tapered_segment(skin.wrist_radius, 1.15 * skin.wrist_radius, p.forearm_length_m));
+        tapered_segment(skin.wrist_radius, 1.15 * skin.wrist_radius, p.forearm_length_m,
+                        std::max(p.bone_slices, 16), p.bone_rings));
     skin.forearm_mesh = static_cast<int>(meshes->size()) - 1;
   }
   return skin;

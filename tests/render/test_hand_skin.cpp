@@ -1,0 +1,90 @@
+// The model hand's skin (render/hand_skin.hpp): its tessellation and its parameter checks.
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <limits>
+#include <opencv2/core.hpp>
+
+#include "gl_test_support.hpp"
+#include "spidar/render/hand_skin.hpp"
+#include "spidar/render/renderer.hpp"
+#include "spidar/vision/camera.hpp"
+#include "synthetic_hands.hpp"
+
+namespace spidar {
+namespace {
+
+/// Triangles of both hands' skins and their silhouette (hand pixels, forearm included) at `q`.
+struct SkinPicture {
+  std::size_t triangles = 0;
+  cv::Mat mask;
+};
+
+SkinPicture draw_skin(const render::HandSkinParams& p, const std::array<hand::HandParams, 2>& q) {
+  const auto models = render::test::truth_models();
+  auto meshes = std::make_shared<std::vector<MeshData>>();
+  std::array<render::HandSkin, 2> skins;
+  for (int h = 0; h < 2; ++h) skins[h] = render::build_hand_skin(models[h], p, meshes.get());
+  SkinPicture out;
+  for (const MeshData& m : *meshes) out.triangles += m.faces.size() / 3;
+  SceneSnapshot scene;
+  scene.meshes = meshes;
+  for (int h = 0; h < 2; ++h) render::pose_hand_skin(models[h], skins[h], q[h], p, &scene);
+  const vision::Camera cam = vision::default_rig_camera();
+  auto renderer = render::Renderer::create(*render::test::gl_context()).value();
+  EXPECT_TRUE(renderer->render(scene, cam).ok());
+  render::RenderTargets t;
+  EXPECT_TRUE(renderer->read(&t, render::kHandId).ok());
+  out.mask = t.hand_id != 0;
+  return out;
+}
+
+double skin_mask_iou(const cv::Mat& a, const cv::Mat& b) {
+  const double inter = cv::countNonZero(a & b), uni = cv::countNonZero(a | b);
+  return uni > 0 ? inter / uni : 1.0;
+}
+
+TEST(HandSkin, CoarseTessellationKeepsTheSilhouetteWithHalfTheTriangles) {
+  SPIDAR_REQUIRE_GL();
+  render::HandSkinParams fine;  // the tessellation before the pipeline's budget cut
+  fine.bone_slices = 16;
+  fine.bone_rings = 6;
+  fine.palm_slices = 24;
+  fine.palm_stacks = 16;
+  const render::HandSkinParams coarse;  // the defaults
+  // Reaching (fingers spread) and two other hand positions (a different view of the fingers).
+  for (double dx : {0.0, 0.03, -0.04}) {
+    const auto q = render::test::reaching_hands(dx);
+    const SkinPicture a = draw_skin(fine, q), b = draw_skin(coarse, q);
+    ASSERT_GT(cv::countNonZero(a.mask), 5000) << "the hands must be in view (dx " << dx << ")";
+    EXPECT_LT(static_cast<double>(b.triangles), 0.5 * static_cast<double>(a.triangles))
+        << b.triangles << " vs " << a.triangles;
+    const double score = skin_mask_iou(a.mask, b.mask);
+    std::cout << "dx " << dx << ": " << b.triangles << " triangles vs " << a.triangles
+              << ", silhouette IoU " << score << "\n";
+    EXPECT_GT(score, 0.98) << "dx " << dx;
+  }
+}
+
+TEST(HandSkin, ValidateNamesTheFieldOutOfRange) {
+  EXPECT_TRUE(render::validate(render::HandSkinParams{}).ok());
+  render::HandSkinParams p;
+  p.bone_slices = 2;
+  auto s = render::validate(p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("bone_slices"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("6..64"), std::string::npos) << s.error().message;
+  p = {};
+  p.palm_stacks = 1000;
+  s = render::validate(p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("palm_stacks"), std::string::npos) << s.error().message;
+  p = {};
+  p.taper = std::numeric_limits<double>::quiet_NaN();
+  s = render::validate(p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("taper"), std::string::npos) << s.error().message;
+}
+
+}  // namespace
+}  // namespace spidar
