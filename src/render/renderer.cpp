@@ -129,8 +129,14 @@ struct Renderer::Impl {
   std::vector<MeshSet> mesh_sets;
   CpuMesh staging;  // a changed mesh on its way to the GPU (reused: no allocation per frame)
   // Per frame, reused: instances per draw key (primitive, then meshes), objects and hands.
-  std::vector<std::vector<Instance>> object_batches, hand_batches;
+  std::vector<std::vector<Instance>> object_batches, hand_batches, static_batches;
   std::vector<Instance> upload;
+  // The static world (RenderParams::cache_static): its colour, depth target and depth buffer,
+  // drawn once and copied in each frame while `static_key` (its instances and the view) holds.
+  GLuint static_fbo = 0, static_depth_rb = 0;
+  GLuint static_tex[2] = {};  // colour RGBA8, depth R32F
+  bool static_valid = false;
+  std::vector<float> static_key, key_scratch;
   GLuint present_fbo = 0, present_tex = 0;
   int present_w = 0, present_h = 0;
 
@@ -160,6 +166,38 @@ struct Renderer::Impl {
     gl::DeleteTextures(4, tex);
     fbo = depth_rb = 0;
     for (auto& t : tex) t = 0;
+    if (static_fbo) gl::DeleteFramebuffers(1, &static_fbo);
+    if (static_depth_rb) gl::DeleteRenderbuffers(1, &static_depth_rb);
+    gl::DeleteTextures(2, static_tex);
+    static_fbo = static_depth_rb = 0;
+    for (auto& t : static_tex) t = 0;
+    static_valid = false;
+  }
+
+  /// The static world's targets (the first two of the main targets' formats, and the depth
+  /// buffer's), made on first use.
+  Status create_static_targets() {
+    gl::GenFramebuffers(1, &static_fbo);
+    gl::BindFramebuffer(GL_FRAMEBUFFER, static_fbo);
+    gl::GenTextures(2, static_tex);
+    const GLint internal[2] = {GL_RGBA8, GL_R32F};
+    const GLenum format[2] = {GL_RGBA, GL_RED};
+    const GLenum type[2] = {GL_UNSIGNED_BYTE, GL_FLOAT};
+    for (int i = 0; i < 2; ++i) {
+      gl::BindTexture(GL_TEXTURE_2D, static_tex[i]);
+      gl::TexImage2D(GL_TEXTURE_2D, 0, internal[i], width, height, 0, format[i], type[i], nullptr);
+      gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      gl::FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
+                               GL_TEXTURE_2D, static_tex[i], 0);
+    }
+    gl::GenRenderbuffers(1, &static_depth_rb);
+    gl::BindRenderbuffer(GL_RENDERBUFFER, static_depth_rb);
+    gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, static_depth_rb);
+    if (gl::CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      return Error{"renderer: static-world targets incomplete"};
+    return gl::check_gl("renderer: creating static-world targets");
   }
 
   Status create_program() {
@@ -331,16 +369,19 @@ struct Renderer::Impl {
   }
 
   /// Sorts the snapshot's shapes into per-mesh instance batches.
-  void batch(const SceneSnapshot& scene, const std::vector<GpuMesh>* meshes) {
+  /// Static shapes (`split_static`): the world body's (body 0) primitives; its meshes stay with
+  /// the objects, since a mesh's contents can change under the same instance.
+  void batch(const SceneSnapshot& scene, const std::vector<GpuMesh>* meshes, bool split_static) {
     const std::size_t keys = kPrimitiveCount + (meshes ? meshes->size() : 0);
-    for (auto* batches : {&object_batches, &hand_batches}) {
+    for (auto* batches : {&object_batches, &hand_batches, &static_batches}) {
       batches->resize(keys);
       for (auto& b : *batches) b.clear();
     }
     for (const Shape& s : scene.shapes) {
       if (!s.X_WS.p.allFinite() || !s.X_WS.R.coeffs().allFinite() || !s.size.allFinite()) continue;
       const bool hand = s.hand >= 0;
-      auto& batches = hand ? hand_batches : object_batches;
+      const bool fixed = split_static && !hand && s.body == 0 && s.type != Shape::Type::kMesh;
+      auto& batches = hand ? hand_batches : (fixed ? static_batches : object_batches);
       const std::uint8_t id = hand ? encode_hand_id(s.hand, s.finger) : 0;
       const double tiny = 1e-9;  // degenerate sizes stay invertible for the normals
       auto add = [&](int key, const Pose& X, const Vec3& scale, float capsule = 0.f) {
@@ -366,6 +407,60 @@ struct Renderer::Impl {
           break;
       }
     }
+  }
+
+  /// Pass 2's start when there are static shapes: brings the static world's cache up to date
+  /// (drawn again only when its instances or the view changed) and copies its colour, depth
+  /// target and depth buffer into the frame's targets. Static instances sit in the instance
+  /// buffer from `first` on. Leaves the main targets bound for drawing.
+  Status draw_static(const Eigen::Matrix4f& view, const Eigen::Matrix4f& projection,
+                     const Eigen::Vector3f& light, const RenderParams& params,
+                     const std::vector<GpuMesh>* meshes, std::size_t first) {
+    key_scratch.clear();
+    for (std::size_t k = 0; k < static_batches.size(); ++k) {
+      if (static_batches[k].empty()) continue;
+      key_scratch.push_back(static_cast<float>(k));
+      for (const Instance& inst : static_batches[k]) {
+        const auto* f = reinterpret_cast<const float*>(&inst);
+        key_scratch.insert(key_scratch.end(), f, f + sizeof(Instance) / sizeof(float));
+      }
+    }
+    key_scratch.insert(key_scratch.end(), view.data(), view.data() + 16);
+    key_scratch.insert(key_scratch.end(), projection.data(), projection.data() + 16);
+    key_scratch.insert(key_scratch.end(), {light.x(), light.y(), light.z(), params.ambient,
+                                           params.background_rgb[0], params.background_rgb[1],
+                                           params.background_rgb[2]});
+    if (!static_fbo) {
+      if (auto st = create_static_targets(); !st) return st;
+    }
+    if (!static_valid || key_scratch != static_key) {
+      gl::BindFramebuffer(GL_FRAMEBUFFER, static_fbo);
+      const GLenum targets[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+      gl::DrawBuffers(2, targets);
+      const float inf = std::numeric_limits<float>::infinity();
+      const float bg[4] = {params.background_rgb[0], params.background_rgb[1],
+                           params.background_rgb[2], 1.f};
+      const float far_value[4] = {inf, inf, inf, inf};
+      gl::ClearBufferfv(GL_COLOR, 0, bg);
+      gl::ClearBufferfv(GL_COLOR, 1, far_value);
+      gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
+      draw(static_batches, first, meshes);
+      static_key.swap(key_scratch);
+      static_valid = true;
+    }
+    // Same sizes and formats, nearest: a plain copy (Mesa copies the resource's region).
+    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, static_fbo);
+    gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
+    for (GLenum i = 0; i < 2; ++i) {
+      gl::ReadBuffer(GL_COLOR_ATTACHMENT0 + i);
+      GLenum only[4] = {GL_NONE, GL_NONE, GL_NONE, GL_NONE};
+      only[i] = GL_COLOR_ATTACHMENT0 + i;
+      gl::DrawBuffers(4, only);
+      gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    return gl::check_gl("renderer: static world");
   }
 
   const GpuMesh& mesh_of(std::size_t key, const std::vector<GpuMesh>* meshes) const {
@@ -427,17 +522,19 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
     if (auto s = r.create_targets(camera.width(), camera.height()); !s) return s;
   }
   const std::vector<GpuMesh>* meshes = r.meshes_for(scene);
-  r.batch(scene, meshes);
+  r.batch(scene, meshes, params.cache_static);
   if (params.hands == HandDrawMode::kVisible && !params.hands_keep_colour)
     for (auto& b : r.hand_batches)
       for (auto& inst : b) std::copy(params.visible_hand_rgba.begin(), params.visible_hand_rgba.end(), inst.rgba);
 
-  // One upload: object instances, then hand instances.
+  // One upload: object instances, then hand instances, then static ones.
   r.upload.clear();
-  for (auto* batches : {&r.object_batches, &r.hand_batches})
+  for (auto* batches : {&r.object_batches, &r.hand_batches, &r.static_batches})
     for (auto& b : *batches) r.upload.insert(r.upload.end(), b.begin(), b.end());
-  std::size_t object_count = 0;
+  std::size_t object_count = 0, hand_count = 0, static_count = 0;
   for (auto& b : r.object_batches) object_count += b.size();
+  for (auto& b : r.hand_batches) hand_count += b.size();
+  for (auto& b : r.static_batches) static_count += b.size();
   gl::BindBuffer(GL_ARRAY_BUFFER, r.instance_vbo);
   const std::size_t bytes = std::max<std::size_t>(r.upload.size(), 1) * sizeof(Instance);
   if (bytes > r.instance_capacity) {
@@ -483,7 +580,7 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
 
   // Pass 1: hands into hand depth and hand id. With visible hands and no scene objects, colour
   // too: nothing could occlude them, so the separate colour pass below is not needed.
-  const bool hands_only = object_count == 0 && params.hands == HandDrawMode::kVisible;
+  const bool hands_only = object_count + static_count == 0 && params.hands == HandDrawMode::kVisible;
   const GLenum hand_targets[4] = {hands_only ? GLenum{GL_COLOR_ATTACHMENT0} : GLenum{GL_NONE}, GL_NONE,
                                   GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
   gl::DrawBuffers(4, hand_targets);
@@ -492,9 +589,16 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
     gl::BindVertexArray(0);
     return gl::check_gl("renderer: render");
   }
-  // Pass 2: the scene into colour and depth, with a fresh depth buffer.
-  gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
+  // Pass 2: the scene into colour and depth, with a fresh depth buffer: the static world's
+  // (colour, depth target and depth buffer copied from its cache), then the moving objects.
   const GLenum scene_targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_NONE};
+  if (static_count > 0) {
+    if (auto st = r.draw_static(view, projection, light, params, meshes, object_count + hand_count); !st)
+      return st;
+    gl::BindFramebuffer(GL_FRAMEBUFFER, r.fbo);
+  } else {
+    gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
+  }
   gl::DrawBuffers(4, scene_targets);
   r.draw(r.object_batches, 0, meshes);
   // Debugging: visible hands occlude the scene's colour (not its depth target).

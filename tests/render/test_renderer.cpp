@@ -279,6 +279,79 @@ TEST(Renderer, ChangedMeshesAreUploadedAgainWhenTheirVersionChanges) {
   }
 }
 
+/// Pixels where two renders' targets differ (any of the four).
+int differing_pixels(const RenderTargets& a, const RenderTargets& b) {
+  cv::Mat diff = a.hand_id != b.hand_id;
+  cv::Mat c;
+  cv::compare(a.depth, b.depth, c, cv::CMP_NE);
+  diff |= c;
+  cv::compare(a.hand_depth, b.hand_depth, c, cv::CMP_NE);
+  diff |= c;
+  cv::Mat colour_diff;
+  cv::absdiff(a.colour, b.colour, colour_diff);
+  cv::cvtColor(colour_diff, c, cv::COLOR_BGR2GRAY);
+  diff |= c > 0;
+  return cv::countNonZero(diff);
+}
+
+TEST(Renderer, CachedStaticWorldGivesTheSameTargetsAndFollowsChanges) {
+  SPIDAR_REQUIRE_GL();
+  // A table (the world body's plane), a static block on it, a moving box sunk into the table (so
+  // the copied depth buffer must hide its lower part) and a hand capsule in front of it.
+  SceneSnapshot scene;
+  Shape table;
+  table.type = Shape::Type::kPlane;
+  table.size = Vec3(0.3, 0.3, 0);
+  table.body = 0;
+  table.rgba = {0.6f, 0.5f, 0.4f, 1.f};
+  scene.shapes.push_back(table);
+  Shape block = box_shape(Pose{Quat::Identity(), Vec3(-0.06, 0.04, 0.02)}, Vec3(0.02, 0.02, 0.02),
+                          {0.9f, 0.9f, 0.1f, 1.f});
+  block.body = 0;
+  scene.shapes.push_back(block);
+  Shape moving = box_shape(Pose{Quat::Identity(), Vec3(0.02, 0.0, 0.01)}, Vec3(0.03, 0.03, 0.03));
+  moving.body = 3;
+  scene.shapes.push_back(moving);
+  Shape finger = capsule_shape(Vec3(-0.02, -0.02, 0.06), Vec3(0.05, 0.01, 0.07), 0.008);
+  finger.hand = 0;
+  finger.finger = 1;
+  scene.shapes.push_back(finger);
+
+  auto cached = Renderer::create(*gl_context()).value();
+  auto reference = Renderer::create(*gl_context()).value();
+  RenderParams uncached;
+  uncached.cache_static = false;
+  auto compare = [&](const SceneSnapshot& sc, const vision::Camera& cam, RenderParams params,
+                     const char* what) {
+    RenderParams ref = params;
+    ref.cache_static = false;
+    RenderTargets a, b;
+    ASSERT_TRUE(cached->render(sc, cam, params).ok());
+    ASSERT_TRUE(cached->read(&a).ok());
+    ASSERT_TRUE(reference->render(sc, cam, ref).ok());
+    ASSERT_TRUE(reference->read(&b).ok());
+    ASSERT_GT(cv::countNonZero(b.depth < 1e3f), 1000) << what << ": the scene must be in view";
+    EXPECT_EQ(differing_pixels(a, b), 0) << what;
+  };
+  const vision::Camera cam = vision::default_rig_camera();
+  compare(scene, cam, {}, "first frame (cache drawn)");
+  compare(scene, cam, {}, "second frame (cache copied)");
+  scene.shapes[2].X_WS.p.x() += 0.02;  // the moving box moves: the cache still holds
+  compare(scene, cam, {}, "moved object");
+  scene.shapes[1].X_WS.p.y() -= 0.03;  // the static block moves: the cache must be redrawn
+  compare(scene, cam, {}, "moved static block");
+  compare(scene, odd_camera(), {}, "another camera and image size");
+  compare(scene, cam, {}, "back to the first camera");
+  RenderParams visible;
+  visible.hands = HandDrawMode::kVisible;
+  visible.ambient = 0.6f;
+  compare(scene, cam, visible, "visible hands, other light");
+  // Without the static shapes, nothing is copied: the targets are cleared as before.
+  SceneSnapshot moving_only = scene;
+  moving_only.shapes.erase(moving_only.shapes.begin(), moving_only.shapes.begin() + 2);
+  compare(moving_only, cam, {}, "no static shapes");
+}
+
 TEST(Renderer, ResizesToTheCamera) {
   SPIDAR_REQUIRE_GL();
   auto renderer = Renderer::create(*gl_context(), 64, 48).value();

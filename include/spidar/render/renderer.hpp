@@ -61,6 +61,10 @@ struct RenderParams {
   /// Direction toward the light in the camera frame C (x right, y down, z forward); normalised.
   Vec3 light_dir_C{-0.3, -0.7, -0.65};
   float ambient = 0.35f;  ///< fraction of the colour lit without the light
+  /// Draw the static world (the primitives of body 0, the physics world body: a table, a frame)
+  /// once and copy it into each frame while those shapes, the camera and the light stay the
+  /// same. Software GL pays per covered pixel, and a table covers most of the image.
+  bool cache_static = true;
 };
 
 /// Which targets read() copies back.
