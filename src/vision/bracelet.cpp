@@ -136,8 +136,19 @@ double bracelet_confidence(const BraceletCandidate& c, const BraceletParams& p,
 void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, BraceletWorkspace* ws,
                               double expected_length_px) {
   ws->candidates.clear();
-  const int n = cv::connectedComponentsWithStats(mask, ws->labels, ws->stats, ws->centroids, 8,
-                                                 CV_32S);
+  // Labelling only within the red pixels' bounding box (the bands are a small part of the frame);
+  // the stats are moved to image coordinates, the labels stay relative to the box's corner.
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.area() == 0) return;
+  const cv::Point label_origin = box.tl();
+  ws->labels_buffer.create(mask.size(), CV_32S);  // once: the box's labels are a view into it
+  ws->labels = ws->labels_buffer(cv::Rect(0, 0, box.width, box.height));
+  const int n = cv::connectedComponentsWithStats(mask(box), ws->labels, ws->stats, ws->centroids,
+                                                 8, CV_32S);
+  for (int i = 1; i < n; ++i) {
+    ws->stats.at<int>(i, cv::CC_STAT_LEFT) += label_origin.x;
+    ws->stats.at<int>(i, cv::CC_STAT_TOP) += label_origin.y;
+  }
   // Pieces: components large enough to be part of a band (a band cut by a finger gives pieces
   // smaller than a whole band).
   std::vector<int> pieces;
@@ -161,9 +172,9 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
     const cv::Rect r = rect(pieces[a]);
     Accum& q = acc_of[static_cast<std::size_t>(a)];
     for (int y = r.y; y < r.y + r.height; ++y) {
-      const int* lab = ws->labels.ptr<int>(y);
+      const int* lab = ws->labels.ptr<int>(y - label_origin.y);
       for (int x = r.x; x < r.x + r.width; ++x) {
-        if (lab[x] != pieces[a]) continue;
+        if (lab[x - label_origin.x] != pieces[a]) continue;
         q.n += 1;
         q.sx += x;
         q.sy += y;
@@ -245,9 +256,9 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
     for (int id : members) {
       const cv::Rect r = rect(id);
       for (int y = r.y; y < r.y + r.height; ++y) {
-        const int* lab = ws->labels.ptr<int>(y);
+        const int* lab = ws->labels.ptr<int>(y - label_origin.y);
         for (int x = r.x; x < r.x + r.width; ++x) {
-          if (lab[x] != id) continue;
+          if (lab[x - label_origin.x] != id) continue;
           const Vec2 d(x - c.x(), y - c.y());
           const double t = d.dot(axis), s = d.dot(across);
           t_min = std::min(t_min, t);

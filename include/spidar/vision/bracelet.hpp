@@ -93,7 +93,9 @@ struct BraceletPrediction {
 
 /// Reusable buffers, so that per-frame detection does not allocate after the first frame.
 struct BraceletWorkspace {
-  cv::Mat mask, labels, stats, centroids;
+  cv::Mat mask, stats, centroids;
+  cv::Mat labels;         ///< the labels of the red pixels' bounding box (a view of labels_buffer)
+  cv::Mat labels_buffer;  ///< frame-sized
   std::vector<BraceletCandidate> candidates;
 };
 
