@@ -147,6 +147,11 @@ void RubiksTask::scheduled_goals(const Plan& plan, double t_run, const GraspFram
   for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f) goal[f] = (1.0 - w) * from[f] + w * goal[f];
 }
 
+Vec3 RubiksTask::contact_normal(int f) const {
+  const Contacts c = contacts(p_);
+  return face_normal(f >= 4 ? c.right[f - 4] : c.left[f], p_.half);
+}
+
 Vec3 RubiksTask::squeeze_path(double t, int f) const {
   const Contacts c = contacts(p_);
   const bool right = f >= 4;

@@ -8,8 +8,46 @@
 #include "spidar/sim/user_hands.hpp"
 
 namespace spidar::sim {
+namespace {
 
-void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, double dt_s) {
+/// The hand with its finger joints' ranges narrowed by `margin` [rad] at both ends (a range
+/// narrower than twice the margin shrinks to its middle); the wrist stays free.
+hand::HandModel with_inset_limits(const hand::HandModel& model, double margin) {
+  hand::HandModel m = model;
+  for (int p = hand::kThumbCmcFlexion; p < hand::kParamCount; ++p) {
+    double& lo = m.limits.lower[p];
+    double& hi = m.limits.upper[p];
+    if (!std::isfinite(lo) || !std::isfinite(hi)) continue;
+    const double d = std::min(margin, 0.5 * (hi - lo));
+    lo += d;
+    hi -= d;
+  }
+  return m;
+}
+
+/// A fitted touching position (grasp frame) kept on its hand's layers, `closed` (0 open … 1
+/// closed) of the way: a fingertip on a side face keeps its proxy sphere (radius r) 1 mm clear of
+/// the boundary between the top and the middle layer (z = pitch / 2), below it for the left
+/// (holding) hand, above it for the right (turning) hand. Fingers spread by the limit margin would
+/// otherwise press on the other hand's layer and hold it against the turn (lockstep physics, the
+/// demo's user, margin 0.1 rad: the left index reached the top layer and the first turn stopped at
+/// 62°). The script's own contacts keep 4.4 mm (left index) and 5.3 mm (right hand).
+/// `n`: the outward normal of the contact's face (a contact on the top face is left as it is).
+Vec3 keep_grip(const Vec3& fitted, const Vec3& n, double closed, bool left, const RubiksTaskParams& tp) {
+  constexpr double kGap = 0.001;  // [m]
+  if (std::abs(n.z()) > 0.5) return fitted;
+  const double boundary = 0.5 * tp.pitch;
+  const double z = left ? std::min(fitted.z(), boundary - tp.proxy_radius - kGap)
+                        : std::max(fitted.z(), boundary + tp.proxy_radius + kGap);
+  Vec3 p = fitted;
+  p.z() += closed * (z - p.z());
+  return p;
+}
+
+}  // namespace
+
+void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, double dt_s,
+                              double limit_margin_rad) {
   fit_dt_ = std::clamp(dt_s, 1e-3, 0.1);
   // A little past the end, so that the last interval interpolates between fitted samples.
   const auto n = static_cast<std::size_t>(std::ceil((p_.duration + 0.5) / fit_dt_)) + 2;
@@ -18,6 +56,11 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
     const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
     std::vector<std::array<Vec3, 4>> table(n);
     fit_shift_max_[h] = 0.0;
+    // Fitted inside the joint ranges by the margin: the device's caps lie past the touching
+    // positions (pressed into the faces, pulled by the strings) and the user's fingers must be
+    // able to follow them there, not already be at a limit.
+    const double margin = std::max(0.0, limit_margin_rad);
+    const hand::HandModel model = with_inset_limits(hands[h], margin);
     hand::HandParams q = script_nominal_local(0.0, side);
     std::vector<hand::HandParams> poses(n);
     for (std::size_t k = 0; k < n; ++k) {
@@ -30,12 +73,21 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
       }
       const hand::HandParams prior = script_nominal_local(t, side);
       // Warm start along the script; the first sample from the nominal pose, with more rounds.
-      for (int r = 0; r < (k == 0 ? 8 : 2); ++r)
-        solver.fit(hands[h], obs, registration::ImageEvidence{}, &prior, &q);
+      // With a margin, then again toward the nearest positions that keep the grip (keep_grip), so
+      // that the hand takes them (moving its other fingers and wrist for it).
+      registration::HandObservation target = obs;
+      for (int pass = 0; pass < (margin > 0 ? 2 : 1); ++pass) {
+        for (int r = 0; r < (k == 0 ? 8 : 2); ++r)
+          solver.fit(model, target, registration::ImageEvidence{}, &prior, &q);
+        const hand::HandPoints pts = hand::forward_kinematics(model, q);
+        for (int f = 0; f < hand::kFingertipCount; ++f)
+          target.p_W_fingertip[f] =
+              margin > 0 ? keep_grip(pts.p_W_fingertip[f], contact_normal(4 * h + f), closeness(t, side), h == 0, p_)
+                         : pts.p_W_fingertip[f];
+      }
       poses[k] = q;
-      const hand::HandPoints pts = hand::forward_kinematics(hands[h], q);
       for (int f = 0; f < hand::kFingertipCount; ++f) {
-        table[k][f] = pts.p_W_fingertip[f];
+        table[k][f] = target.p_W_fingertip[f];
         fit_shift_max_[h] = std::max(fit_shift_max_[h], (table[k][f] - obs.p_W_fingertip[f]).norm());
       }
     }

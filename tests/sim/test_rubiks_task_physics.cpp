@@ -4,24 +4,17 @@
 // are checked without the timing of a busy machine.
 #include <gtest/gtest.h>
 
-#include "source_path.hpp"
-
 #include <array>
 #include <string>
 #include <cmath>
 #include <cstdio>
 
+#include "lockstep_task.hpp"
 #include "spidar/core/units.hpp"
-#include "spidar/device/simulated_spidar.hpp"
-#include "spidar/physics/rubiks_cube.hpp"
-#include "spidar/physics/world.hpp"
 #include "spidar/hand/hand_config.hpp"
-#include "spidar/sim/rubiks_task.hpp"
 
 namespace spidar::sim {
 namespace {
-
-using spidar::test::source;
 
 struct TaskRun {
   double lift_max_m = 0;
@@ -33,43 +26,24 @@ struct TaskRun {
 
 /// `fit`: the user's hands the script is fitted to (RubiksTask::fit_to_hands), or nullptr.
 TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr) {
-  auto world = physics::World::Load(source("scenes/rubiks_cube.xml")).value();
-  auto cube = physics::RubiksCube::Attach(*world).value();
-  RubiksTaskParams tp;
-  tp.proxy_radius = world->params().proxy.radius;
-  tp.p_W_cube = cube.core_pose().p;
-  const Pose X0 = cube.core_pose();
-  RubiksTask task(tp);
-  if (fit) task.fit_to_hands(*fit);
-  core::Latest<CubePoseSample> pose;
-  task.track(&pose);
-  std::vector<Vec3> x(8), v(8, Vec3::Zero()), goal(8);
-  task.goals(0.0, goal);
-  x = goal;
-  world->place_proxies(x);
-  const device::FingertipImpedance imp;  // the simulated device's human fingertip
-  const double dt = world->timestep();
   TaskRun r;
-  for (int s = 0; s * dt < tp.duration; ++s) {
-    const Pose X = cube.core_pose();
-    pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
-    task.goals(s * dt, goal);
-    const auto f_proxy = world->coupling_forces();  // the fingertip feels the opposite
-    for (int i = 0; i < 8; ++i) {
-      for (int k = 0; k < 4; ++k) {  // semi-implicit Euler at dt / 4
-        const Vec3 a = (imp.stiffness * (goal[i] - x[i]) - imp.damping * v[i] - f_proxy[i]) / imp.mass;
-        v[i] += a * dt / 4;
-        x[i] += v[i] * dt / 4;
-      }
-    }
-    world->step(x, v);
-    r.lift_max_m = std::max(r.lift_max_m, X.p.z() - X0.p.z());
-    for (int f = 1; f < 6; ++f)
-      r.other_faces_max_rad[f] = std::max(r.other_faces_max_rad[f], std::abs(cube.face_angle("UDFBRL"[f])));
-  }
-  r.quarter_turns_u = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
-  r.unlocks = cube.layer_unlocks();
-  r.solved = cube.is_solved();
+  double z0 = 0;
+  bool first = true;
+  run_lockstep(
+      [&](RubiksTask& task) {
+        if (fit) task.fit_to_hands(*fit);
+      },
+      [&](double, std::span<const Vec3>, const physics::RubiksCube& cube) {
+        const Pose X = cube.core_pose();
+        if (first) z0 = X.p.z(), first = false;  // the start (the first step barely moves it)
+        r.lift_max_m = std::max(r.lift_max_m, X.p.z() - z0);
+        for (int f = 1; f < 6; ++f)
+          r.other_faces_max_rad[f] = std::max(r.other_faces_max_rad[f], std::abs(cube.face_angle("UDFBRL"[f])));
+        // At the end: U's angle, the unlocks, solved or not (kept from the last step).
+        r.quarter_turns_u = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+        r.unlocks = cube.layer_unlocks();
+        r.solved = cube.is_solved();
+      });
   return r;
 }
 

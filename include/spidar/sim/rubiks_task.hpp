@@ -94,7 +94,20 @@ class RubiksTask final : public device::FingertipSource {
   /// Without it the goals are the script's contact layout, which a hand of another size may not
   /// reach (adjacent caps closer than fingers are wide): the user's fingers could then not be
   /// where the device's caps are. Call before the task is shared with other threads.
-  void fit_to_hands(const std::array<hand::HandModel, 2>& hands, double dt_s = 0.01);
+  ///
+  ///
+  /// `limit_margin_rad`: the fit keeps the finger joints this far inside their ranges [rad], and
+  /// (with a margin > 0) side contacts on their hand's layers, clear of the top/middle boundary.
+  /// With 0 the fitted layout has the index and ring abduction at their limits (the script's caps
+  /// are closer together than fingers are), so where the device's caps actually are (pressed past
+  /// the touching positions, pulled apart by their strings) is partly out of the user's reach:
+  /// the camera's ground truth then misses the caps by up to 3.5–4.3 mm in the demo. A margin of
+  /// 0.1 rad makes them reachable on the lockstep physics (tests/sim/test_user_hands_physics.cpp:
+  /// within 0.6 mm, both turns made) but spreads the fingers, which changes the grasp: in the
+  /// demo (threads, strings) the second turn then failed in 4 of 4 runs. Off by default until the
+  /// grasp is re-tuned for it.
+  void fit_to_hands(const std::array<hand::HandModel, 2>& hands, double dt_s = 0.01,
+                    double limit_margin_rad = 0.0);
   /// How far the fitted paths move the script's goals, per hand (max over the script) [m].
   const std::array<double, 2>& fit_shift_max_m() const { return fit_shift_max_; }
   /// Follow the cube's published pose (must outlive the task); nullptr = the start pose.
@@ -168,6 +181,8 @@ class RubiksTask final : public device::FingertipSource {
   /// impedance): zero while open, `squeeze` along the face's inward normal when closed. A finger
   /// stops at the face; its touching position is script_path − squeeze_path.
   Vec3 squeeze_path(double t_s, int f) const;
+  /// Outward normal of the face finger f (0..7) grasps, in its hand's grasp frame.
+  Vec3 contact_normal(int f) const;
   /// The nominal pose of one hand in its grasp frame (before yaw and lift): the pose fitted to
   /// the hand's path when fit_to_hands was called, else script_nominal_local.
   hand::HandParams nominal_local(double t_s, hand::Side side) const;
