@@ -110,9 +110,8 @@ TEST_P(PressedCaps, UserHandsReachTheCapsAndTheLayerTurnsTwice) {
 
 INSTANTIATE_TEST_SUITE_P(
     Users, PressedCaps,
-    ::testing::Values(User{"user"}, User{"scaled", 1.0, 1.0},
-                      User{"scaled", 0.9, 0.9}, User{"scaled", 1.1, 1.1},
-                      User{"scaled", 1.1, 0.9, hand::Coupling::kLinear},
+    // The demo's user, the corners of ±10 % (each ~6 s of lockstep physics: four, not six).
+    ::testing::Values(User{"user"}, User{"scaled", 0.9, 0.9}, User{"scaled", 1.1, 1.1},
                       User{"scaled", 0.9, 1.1, hand::Coupling::kLinear}),
     [](const ::testing::TestParamInfo<User>& p) { return std::to_string(p.index) + "_" + p.param.name; });
 
