@@ -1,6 +1,8 @@
 // RubiksTask::fit_to_hands: the script's fingertip paths made reachable by the user's own hands.
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <thread>
 
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
@@ -51,8 +53,11 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
   fit_dt_ = std::clamp(dt_s, 1e-3, 0.1);
   // A little past the end, so that the last interval interpolates between fitted samples.
   const auto n = static_cast<std::size_t>(std::ceil((p_.duration + 0.5) / fit_dt_)) + 2;
-  registration::SuccessiveAdjustment solver(fingertip_ik_params(UserHandsParams{}));
-  for (int h = 0; h < 2; ++h) {
+  // Each hand on its own thread (the right one on a second thread): the hands share nothing but
+  // the script, which is read-only here, and each writes only its own entries. Same results as
+  // one after the other, in half the time on two cores (Scene::load's longest step).
+  auto fit_hand = [&](int h) {
+    registration::SuccessiveAdjustment solver(fingertip_ik_params(UserHandsParams{}));
     const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
     std::vector<std::array<Vec3, 4>> table(n);
     fit_shift_max_[h] = 0.0;
@@ -93,7 +98,23 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
     }
     fitted_[h] = std::move(table);
     fitted_q_[h] = std::move(poses);
+  };
+  std::exception_ptr right_failed;
+  std::thread right([&] {
+    try {
+      fit_hand(1);
+    } catch (...) {
+      right_failed = std::current_exception();
+    }
+  });
+  try {
+    fit_hand(0);
+  } catch (...) {
+    right.join();
+    throw;
   }
+  right.join();
+  if (right_failed) std::rethrow_exception(right_failed);
 }
 
 }  // namespace spidar::sim
