@@ -174,30 +174,39 @@ struct Renderer::Impl {
     static_valid = false;
   }
 
-  /// The static world's targets (the first two of the main targets' formats, and the depth
-  /// buffer's), made on first use.
+  /// The static world's targets: the main targets' first two formats (colour, depth) and a depth
+  /// buffer, made on first use.
   Status create_static_targets() {
-    gl::GenFramebuffers(1, &static_fbo);
-    gl::BindFramebuffer(GL_FRAMEBUFFER, static_fbo);
-    gl::GenTextures(2, static_tex);
-    const GLint internal[2] = {GL_RGBA8, GL_R32F};
-    const GLenum format[2] = {GL_RGBA, GL_RED};
-    const GLenum type[2] = {GL_UNSIGNED_BYTE, GL_FLOAT};
-    for (int i = 0; i < 2; ++i) {
-      gl::BindTexture(GL_TEXTURE_2D, static_tex[i]);
+    return make_targets(2, &static_fbo, static_tex, &static_depth_rb, "static-world targets");
+  }
+
+  /// A framebuffer of the current size with the first `count` of the target formats (colour RGBA8,
+  /// depth R32F, hand depth R32F, hand id R8UI) as colour attachments 0.. and a 32-bit float
+  /// depth buffer. Leaves it bound.
+  Status make_targets(int count, GLuint* fb, GLuint* textures, GLuint* depth_buffer, const char* what) {
+    const GLint internal[4] = {GL_RGBA8, GL_R32F, GL_R32F, GL_R8UI};
+    const GLenum format[4] = {GL_RGBA, GL_RED, GL_RED, GL_RED_INTEGER};
+    const GLenum type[4] = {GL_UNSIGNED_BYTE, GL_FLOAT, GL_FLOAT, GL_UNSIGNED_BYTE};
+    gl::GenFramebuffers(1, fb);
+    gl::BindFramebuffer(GL_FRAMEBUFFER, *fb);
+    gl::GenTextures(count, textures);
+    for (int i = 0; i < count; ++i) {
+      gl::BindTexture(GL_TEXTURE_2D, textures[i]);
       gl::TexImage2D(GL_TEXTURE_2D, 0, internal[i], width, height, 0, format[i], type[i], nullptr);
       gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
       gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
       gl::FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
-                               GL_TEXTURE_2D, static_tex[i], 0);
+                               GL_TEXTURE_2D, textures[i], 0);
     }
-    gl::GenRenderbuffers(1, &static_depth_rb);
-    gl::BindRenderbuffer(GL_RENDERBUFFER, static_depth_rb);
+    gl::GenRenderbuffers(1, depth_buffer);
+    gl::BindRenderbuffer(GL_RENDERBUFFER, *depth_buffer);
     gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
-    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, static_depth_rb);
-    if (gl::CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      return Error{"renderer: static-world targets incomplete"};
-    return gl::check_gl("renderer: creating static-world targets");
+    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth_buffer);
+    const GLenum status = gl::CheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE)
+      return Error{std::string("renderer: ") + what + " " + std::to_string(width) + "x" +
+                   std::to_string(height) + " incomplete (status 0x" + std::to_string(status) + ")"};
+    return gl::check_gl((std::string("renderer: creating ") + what).c_str());
   }
 
   Status create_program() {
@@ -231,29 +240,7 @@ struct Renderer::Impl {
     destroy_targets();
     width = w;
     height = h;
-    gl::GenFramebuffers(1, &fbo);
-    gl::BindFramebuffer(GL_FRAMEBUFFER, fbo);
-    gl::GenTextures(4, tex);
-    const GLint internal[4] = {GL_RGBA8, GL_R32F, GL_R32F, GL_R8UI};
-    const GLenum format[4] = {GL_RGBA, GL_RED, GL_RED, GL_RED_INTEGER};
-    const GLenum type[4] = {GL_UNSIGNED_BYTE, GL_FLOAT, GL_FLOAT, GL_UNSIGNED_BYTE};
-    for (int i = 0; i < 4; ++i) {
-      gl::BindTexture(GL_TEXTURE_2D, tex[i]);
-      gl::TexImage2D(GL_TEXTURE_2D, 0, internal[i], w, h, 0, format[i], type[i], nullptr);
-      gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      gl::FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
-                               GL_TEXTURE_2D, tex[i], 0);
-    }
-    gl::GenRenderbuffers(1, &depth_rb);
-    gl::BindRenderbuffer(GL_RENDERBUFFER, depth_rb);
-    gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
-    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
-    const GLenum status = gl::CheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE)
-      return Error{"renderer: offscreen targets " + std::to_string(w) + "x" + std::to_string(h) +
-                   " incomplete (status 0x" + std::to_string(status) + ")"};
-    return gl::check_gl("renderer: creating targets");
+    return make_targets(4, &fbo, tex, &depth_rb, "offscreen targets");
   }
 
   GpuMesh upload_mesh(const CpuMesh& cpu) {
