@@ -58,6 +58,9 @@ Action add_demo(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--fixed-hand-size", o->fixed_hand_size,
                 "keep the model hand's sizes (default: estimate each hand's length and width online)");
+  cmd->add_flag("--shaped-fingers", o->shaped_fingers,
+                "the simulated user's fingertips yield only where their fingers can move (stiffness "
+                "ellipsoids from their hands): their hands then reach the device's caps");
   cmd->add_flag("--silhouette", o->silhouette,
                 "register with the silhouette term too (default: the paper's joint-balls)");
   cmd->add_flag("!--no-video", o->video, "do not write mixed_reality.mp4");

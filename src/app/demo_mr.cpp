@@ -67,7 +67,7 @@ int run_mr_demo(const DemoOptions& o) {
   auto mode = render::parse_composite_mode(o.compositor);
   if (!mode) throw UsageError("--compositor: " + mode.error().message);
   // The scripted user plays until its task is done (retries included), by --seconds at most.
-  auto scene_r = session::Scene::load(scene_path, truth_models, o.seconds);
+  auto scene_r = session::Scene::load(scene_path, truth_models, {o.seconds, o.shaped_fingers});
   if (!scene_r) throw UsageError("--scene: " + scene_r.error().message);
   session::Scene& scene = *scene_r.value();
   const auto& cube = scene.cube;

@@ -37,6 +37,7 @@ SimulatedSpidar::SimulatedSpidar(const strings::DeviceConfig& config, SimulatedS
   x_.assign(nf, config.p_W_centre);
   v_.assign(nf, Vec3::Zero());
   goal_.assign(nf, config.p_W_centre);
+  hold_.assign(static_cast<std::size_t>(nf), FingertipHold{});
   force_.assign(nf, Vec3::Zero());
   commands_.assign(strings_.size(), info_.command_min);
   applied_ = commands_;
@@ -45,6 +46,7 @@ SimulatedSpidar::SimulatedSpidar(const strings::DeviceConfig& config, SimulatedS
 Status SimulatedSpidar::open() {
   t_s_ = 0;
   source_->goals(0.0, goal_);
+  take_holds();
   x_ = goal_;
   for (auto& v : v_) v.setZero();
   for (auto& s : strings_) s.tension = strings::command_to_tension(config_.motor, info_.command_min);
@@ -81,12 +83,16 @@ void SimulatedSpidar::step(double dt) {
     const double len = d.norm();
     if (len > 1e-9) force_[s.finger] += s.tension * d / len;
   }
-  const auto& imp = params_.impedance;
-  for (std::size_t f = 0; f < x_.size(); ++f) {
-    const Vec3 a = (imp.stiffness * (goal_[f] - x_[f]) - imp.damping * v_[f] + force_[f]) / imp.mass;
-    v_[f] += a * dt;  // semi-implicit Euler
-    x_[f] += v_[f] * dt;
+  for (std::size_t f = 0; f < x_.size(); ++f)
+    step_fingertip(params_.impedance, hold_[f], goal_[f], force_[f], dt, x_[f], v_[f]);
+}
+
+void SimulatedSpidar::take_holds() {
+  if (!source_->holds(hold_)) {
+    std::fill(hold_.begin(), hold_.end(), FingertipHold{});
+    return;
   }
+  for (auto& h : hold_) h = sanitized(h);
 }
 
 void SimulatedSpidar::advance(double dt_s) {
@@ -94,6 +100,7 @@ void SimulatedSpidar::advance(double dt_s) {
     const double h = std::min(dt_s, params_.max_substep);
     t_s_ += h;
     source_->goals(t_s_, goal_);
+    take_holds();
     step(h);
     dt_s -= h;
   }

@@ -6,7 +6,7 @@ namespace spidar::session {
 
 Result<std::unique_ptr<Scene>> Scene::load(const std::string& path,
                                            const std::array<hand::HandModel, 2>& user,
-                                           double deadline_s) {
+                                           const ScriptedUserOptions& user_options) {
   auto s = std::make_unique<Scene>();
   auto world_r = physics::World::Load(path, s->params);
   if (!world_r) return world_r.error();
@@ -14,7 +14,7 @@ Result<std::unique_ptr<Scene>> Scene::load(const std::string& path,
   if (auto cube_r = physics::RubiksCube::Attach(*s->world)) s->cube = std::move(cube_r).value();
   Pose X_cube0;
   s->task = make_scripted_task(*s->world, s->cube, s->params.proxy.radius, user, &X_cube0,
-                               deadline_s);
+                               user_options);
   s->monitor = std::make_unique<CubeMonitor>(&s->cube, X_cube0);
   if (s->cube) s->task->track(&s->monitor->pose());  // the user watches the cube
   return s;

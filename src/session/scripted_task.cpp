@@ -22,11 +22,12 @@ std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
                                                     const std::optional<physics::RubiksCube>& cube,
                                                     double proxy_radius,
                                                     const std::array<hand::HandModel, 2>& user,
-                                                    Pose* X_cube0, double deadline_s) {
+                                                    Pose* X_cube0, const ScriptedUserOptions& options) {
   sim::RubiksTaskParams tp;
   tp.proxy_radius = proxy_radius;
   tp.has_cube = cube.has_value();
-  if (deadline_s > 0) tp.deadline = deadline_s;
+  tp.shaped_fingers = options.shaped_fingers;
+  if (options.deadline_s > 0) tp.deadline = options.deadline_s;
   *X_cube0 = Pose{};
   if (cube) {
     *X_cube0 = cube->core_pose();

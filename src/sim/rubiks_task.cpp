@@ -133,6 +133,35 @@ void RubiksTask::goals(double t_run, std::span<Vec3> goal) {
     }
   }
   scheduled_goals(plan_, t_run, frames_, goal, true);
+  // No faster than a hand moves (max_goal_speed); from the start, or a clock that went back (a
+  // new run), wherever the script is.
+  const bool limit = p_.shaped_fingers && prev_goal_t_ >= 0 && t_run >= prev_goal_t_;
+  const double step = p_.max_goal_speed * (t_run - prev_goal_t_);
+  for (std::size_t f = 0; f < goal.size() && f < prev_goal_.size(); ++f) {
+    if (limit) {
+      const Vec3 d = goal[f] - prev_goal_[f];
+      if (d.norm() > step) goal[f] = prev_goal_[f] + d * (step / d.norm());
+    }
+    prev_goal_[f] = goal[f];
+  }
+  prev_goal_t_ = t_run;
+  // The holds at the present script time (during a cross-fade, those of where it is going).
+  for (int f = 0; f < 8; ++f) {
+    const int h = f >= 4 ? 1 : 0;
+    const auto& table = fitted_hold_[h];
+    if (table.empty()) continue;
+    const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
+    const device::FingertipHold& local = table[static_cast<std::size_t>(std::lround(x))][f % 4];
+    const Quat q_WG(frames_.q_WG[h][0], frames_.q_WG[h][1], frames_.q_WG[h][2], frames_.q_WG[h][3]);
+    const Mat3 R_WG = q_WG.toRotationMatrix() * rot_z(state(t, h == 0 ? hand::Side::kLeft : hand::Side::kRight, f).yaw);
+    holds_[static_cast<std::size_t>(f)] = {R_WG * local.R_WE, local.scale};
+  }
+}
+
+bool RubiksTask::holds(std::span<device::FingertipHold> hold) {
+  if (fitted_hold_[0].empty() || fitted_hold_[1].empty()) return false;
+  for (std::size_t f = 0; f < hold.size() && f < holds_.size(); ++f) hold[f] = holds_[f];
+  return true;
 }
 
 void RubiksTask::scheduled_goals(const Plan& plan, double t_run, const GraspFrames& fr,
@@ -182,14 +211,32 @@ Vec3 RubiksTask::script_path(double t, int f) const {
 }
 
 Vec3 RubiksTask::path(double t, int f) const {
-  const int h = f >= 4 ? 1 : 0;
-  const auto& table = fitted_[h];
-  if (table.empty()) return script_path(t, f);
-  // The fitted touching positions, pressed in by the script's squeeze.
+  if (fitted_[f >= 4 ? 1 : 0].empty()) return script_path(t, f);
+  return fitted_touch(t, f) + pressing(t, f);  // the fitted touching positions, pressed in
+}
+
+Vec3 RubiksTask::fitted_touch(double t, int f) const {
+  const auto& table = fitted_[f >= 4 ? 1 : 0];
   const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
   const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
   const double w = x - static_cast<double>(k);
-  return (1.0 - w) * table[k][f % 4] + w * table[k + 1][f % 4] + squeeze_path(t, f);
+  return (1.0 - w) * table[k][f % 4] + w * table[k + 1][f % 4];
+}
+
+Vec3 RubiksTask::pressing(double t, int f) const {
+  const Vec3 s = squeeze_path(t, f);
+  const auto& table = fitted_hold_[f >= 4 ? 1 : 0];
+  if (table.empty() || s.isZero()) return s;
+  // The finger's compliance relative to its softest direction, R·diag(1/scale)·Rᵀ, between the
+  // neighbouring fitted samples.
+  auto compliance = [&](std::size_t k) {
+    const device::FingertipHold& h = table[k][f % 4];
+    return Mat3(h.R_WE * h.scale.cwiseInverse().asDiagonal() * h.R_WE.transpose());
+  };
+  const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
+  const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
+  const double w = x - static_cast<double>(k);
+  return ((1.0 - w) * compliance(k) + w * compliance(k + 1)) * s;
 }
 
 void RubiksTask::touch_points(double t_run, std::span<Vec3> p_W) const {
@@ -204,7 +251,7 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal,
     const int h = right ? 1 : 0;
     const Quat q_WG(fr.q_WG[h][0], fr.q_WG[h][1], fr.q_WG[h][2], fr.q_WG[h][3]);
     const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
-    const Vec3 p = squeeze ? path(t, f) : Vec3(path(t, f) - squeeze_path(t, f));
+    const Vec3 p = squeeze ? path(t, f) : Vec3(path(t, f) - pressing(t, f));
     goal[f] = p_WG + q_WG * (rot_z(s.yaw) * p) + Vec3(0, 0, s.lift - fr.lift[h]);
   }
 }

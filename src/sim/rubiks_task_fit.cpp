@@ -6,6 +6,7 @@
 
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
+#include "spidar/sim/finger_hold.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 #include "spidar/sim/user_hands.hpp"
 
@@ -46,6 +47,17 @@ Vec3 keep_grip(const Vec3& fitted, const Vec3& n, double closed, bool left, cons
   return p;
 }
 
+/// A fitted touching position (grasp frame, cube centre at the origin) moved along the contact's
+/// outward normal n onto the plane where the fingertip's proxy sphere (radius r) touches the face,
+/// `closed` (0 open … 1 closed) of the way. The fit may leave a fingertip off its face where the
+/// hand cannot reach the script's contact point (fingers at their limits); along the face it may
+/// go wherever the hand can take it, but off it the finger would not touch: its squeeze would
+/// press on nothing, or the cap would be pressed where the finger cannot follow.
+Vec3 onto_face(const Vec3& fitted, const Vec3& n, double closed, const RubiksTaskParams& tp) {
+  const double off = fitted.dot(n) - (tp.half + tp.proxy_radius);
+  return fitted - closed * off * n;
+}
+
 }  // namespace
 
 void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, double dt_s,
@@ -66,8 +78,11 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
     // able to follow them there, not already be at a limit.
     const double margin = std::max(0.0, limit_margin_rad);
     const hand::HandModel model = with_inset_limits(hands[h], margin);
+    // Shaped fingers: two more passes toward the faces (and the hand's own layers).
+    const int passes = p_.shaped_fingers ? 3 : (margin > 0 ? 2 : 1);
     hand::HandParams q = script_nominal_local(0.0, side);
     std::vector<hand::HandParams> poses(n);
+    std::vector<std::array<device::FingertipHold, 4>> holds(p_.shaped_fingers ? n : 0);
     for (std::size_t k = 0; k < n; ++k) {
       const double t = static_cast<double>(k) * fit_dt_;
       registration::HandObservation obs;
@@ -78,19 +93,25 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
       }
       const hand::HandParams prior = script_nominal_local(t, side);
       // Warm start along the script; the first sample from the nominal pose, with more rounds.
-      // With a margin, then again toward the nearest positions that keep the grip (keep_grip), so
-      // that the hand takes them (moving its other fingers and wrist for it).
+      // Then again toward the nearest positions on the faces (onto_face) and, with a margin, that
+      // keep the grip (keep_grip), so that the hand takes them (moving its other fingers and wrist
+      // for it). The last pass keeps what the hand reaches.
       registration::HandObservation target = obs;
-      for (int pass = 0; pass < (margin > 0 ? 2 : 1); ++pass) {
+      for (int pass = 0; pass < passes; ++pass) {
         for (int r = 0; r < (k == 0 ? 8 : 2); ++r)
           solver.fit(model, target, registration::ImageEvidence{}, &prior, &q);
         const hand::HandPoints pts = hand::forward_kinematics(model, q);
-        for (int f = 0; f < hand::kFingertipCount; ++f)
-          target.p_W_fingertip[f] =
-              margin > 0 ? keep_grip(pts.p_W_fingertip[f], contact_normal(4 * h + f), closeness(t, side), h == 0, p_)
-                         : pts.p_W_fingertip[f];
+        const bool last = pass + 1 == passes;
+        for (int f = 0; f < hand::kFingertipCount; ++f) {
+          const Vec3 normal = contact_normal(4 * h + f);
+          Vec3 p = pts.p_W_fingertip[f];
+          if (p_.shaped_fingers && !last) p = onto_face(p, normal, closeness(t, side), p_);
+          if (p_.shaped_fingers || margin > 0) p = keep_grip(p, normal, closeness(t, side), h == 0, p_);
+          target.p_W_fingertip[f] = p;
+        }
       }
       poses[k] = q;
+      if (p_.shaped_fingers) holds[k] = finger_holds(hands[h], q);  // the user's own joint ranges
       for (int f = 0; f < hand::kFingertipCount; ++f) {
         table[k][f] = target.p_W_fingertip[f];
         fit_shift_max_[h] = std::max(fit_shift_max_[h], (table[k][f] - obs.p_W_fingertip[f]).norm());
@@ -98,6 +119,7 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
     }
     fitted_[h] = std::move(table);
     fitted_q_[h] = std::move(poses);
+    fitted_hold_[h] = std::move(holds);
   };
   std::exception_ptr right_failed;
   std::thread right([&] {

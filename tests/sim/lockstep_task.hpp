@@ -4,12 +4,14 @@
 // feel the coupling forces, one physics step at a time. Deterministic, so what depends on where
 // the fingertips end up (the cube's turns, the user's hands on the caps) is checked without the
 // timing of a busy machine.
+#include <algorithm>
 #include <functional>
 #include <span>
 #include <vector>
 
 #include "source_path.hpp"
 #include "spidar/core/pose.hpp"
+#include "spidar/device/fingertip_impedance.hpp"
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/physics/world.hpp"
@@ -25,12 +27,15 @@ using LockstepObserver =
 /// Plays the task (the script with the scene's cube and proxy sizes) to its end on the scene
 /// scenes/rubiks_cube.xml. `prepare` sees the task before it starts (e.g. to fit it to hands; the
 /// task lives until run_lockstep returns), `observe` every step after it.
-inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const LockstepObserver& observe) {
+/// `shaped_fingers`: RubiksTaskParams::shaped_fingers.
+inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const LockstepObserver& observe,
+                         bool shaped_fingers = false) {
   auto world = physics::World::Load(spidar::test::source("scenes/rubiks_cube.xml")).value();
   auto cube = physics::RubiksCube::Attach(*world).value();
   RubiksTaskParams tp;
   tp.proxy_radius = world->params().proxy.radius;
   tp.p_W_cube = cube.core_pose().p;
+  tp.shaped_fingers = shaped_fingers;
   RubiksTask task(tp);
   if (prepare) prepare(task);
   core::Latest<CubePoseSample> pose;
@@ -40,19 +45,17 @@ inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const 
   x = goal;
   world->place_proxies(x);
   const device::FingertipImpedance imp;  // the simulated device's human fingertip
+  std::vector<device::FingertipHold> hold(8);
   const double dt = world->timestep();
   for (int s = 0; s * dt < tp.duration; ++s) {
     const Pose X = cube.core_pose();
     pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
     task.goals(s * dt, goal);
+    if (!task.holds(hold)) std::fill(hold.begin(), hold.end(), device::FingertipHold{});
     const auto f_proxy = world->coupling_forces();  // the fingertip feels the opposite
-    for (int i = 0; i < 8; ++i) {
-      for (int k = 0; k < 4; ++k) {  // semi-implicit Euler at dt / 4
-        const Vec3 a = (imp.stiffness * (goal[i] - x[i]) - imp.damping * v[i] - f_proxy[i]) / imp.mass;
-        v[i] += a * dt / 4;
-        x[i] += v[i] * dt / 4;
-      }
-    }
+    for (std::size_t i = 0; i < 8; ++i)
+      for (int k = 0; k < 4; ++k)  // sub-steps of dt / 4, as the simulated device's
+        device::step_fingertip(imp, device::sanitized(hold[i]), goal[i], -f_proxy[i], dt / 4, x[i], v[i]);
     world->step(x, v);
     if (observe) observe(s * dt, x, cube);
   }

@@ -57,6 +57,35 @@ TEST(RubiksTask, GoalsAreContinuousAndTheRightHandTurnsTwice) {
   EXPECT_EQ(task.phase(13.0), "done");
 }
 
+// Fitted to the user's hands with shaped fingers, each fingertip's goal lies where its hold (the finger's stiffness)
+// pushes it straight into its face from the touching position: the finger presses the face
+// without sliding along it, however stiff it is in other directions.
+TEST(RubiksTask, FittedGoalsPressAlongTheFaceNormalsThroughTheFingersHolds) {
+  RubiksTaskParams tp;
+  tp.shaped_fingers = true;
+  RubiksTask task(tp);
+  task.fit_to_hands(user_models());
+  std::array<Vec3, 8> goal, touch;
+  std::array<device::FingertipHold, 8> hold;
+  task.goals(0.0, goal);
+  ASSERT_TRUE(task.holds(hold));
+  for (double t : {1.9, 2.5, 2.9}) {  // closing, lifting, lifted (the cube not turned: faces ⟂ x, y, z)
+    task.goals(t, goal);
+    ASSERT_TRUE(task.holds(hold));
+    task.touch_points(t, touch);
+    for (std::size_t f = 0; f < 8; ++f) {
+      const auto& h = hold[f];
+      const Mat3 K = h.R_WE * h.scale.asDiagonal() * h.R_WE.transpose();  // relative to the softest
+      const Vec3 F = K * (goal[f] - touch[f]);
+      Eigen::Index axis = 0;
+      F.cwiseAbs().maxCoeff(&axis);
+      EXPECT_GT(std::abs(F[axis]) / F.norm(), 0.999) << "t " << t << " finger " << f << ": " << F.transpose();
+      EXPECT_LT(F.dot(touch[f] - task.params().p_W_cube), 0.0) << "into the cube";
+      EXPECT_GT(h.scale.maxCoeff(), 1.5) << "a shaped hold";
+    }
+  }
+}
+
 /// Worst and mean cap residual over the script: the touching points stand in for the device's
 /// caps (a finger stops at the face; the goals' squeeze only sets the grip force).
 struct Residual {

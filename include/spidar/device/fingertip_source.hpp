@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "spidar/core/types.hpp"
+#include "spidar/device/fingertip_impedance.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::device {
@@ -18,6 +19,12 @@ class FingertipSource {
   /// Goal positions p_W [m], world, of every fingertip at time t [s] since the device opened.
   /// Called from the device's thread; must not allocate.
   virtual void goals(double t_s, std::span<Vec3> p_W_goal) = 0;
+  /// How stiffly each fingertip holds the goals of the last goals() call (the shape of its
+  /// stiffness, world frame), or false to keep the device's isotropic impedance. A source that
+  /// knows the user's hand gives the finger's own stiffness ellipsoid, so that the displayed
+  /// forces move the fingertip only where the finger's joints can take it. Called right after
+  /// goals(), from the same thread; must not allocate.
+  virtual bool holds(std::span<FingertipHold> /*hold*/) { return false; }
 };
 
 /// Goals from a function of time (scripted trajectories).

@@ -8,7 +8,8 @@
 ///   then a first-order lag. A string whose tension falls below `slack_tension` goes slack: it
 ///   pulls nothing and reads up to `slack_sag` long.
 /// - Fingertips: mass-spring-damper of a human fingertip between the FingertipSource's goal and
-///   the cap, pushed by the string forces, integrated in sub-steps.
+///   the cap, pushed by the string forces, integrated in sub-steps (fingertip_impedance.hpp): its
+///   stiffness isotropic, or shaped like the finger's own where the source gives holds().
 /// - Time: by default the simulation follows the host's monotonic clock (real time); with
 ///   `fixed_step_s` > 0 each read advances exactly that much (deterministic tests).
 /// - Faults to inject: disconnect after a time, a read that hangs past the timeout, an
@@ -19,17 +20,12 @@
 
 #include "spidar/core/seqlock.hpp"
 #include "spidar/device/device.hpp"
+#include "spidar/device/fingertip_impedance.hpp"
 #include "spidar/device/fingertip_source.hpp"
 #include "spidar/device/servo_types.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::device {
-
-struct FingertipImpedance {
-  double mass = 0.015;      ///< [kg] effective fingertip mass
-  double stiffness = 300;   ///< [N/m] finger held toward its goal
-  double damping = 4.0;     ///< [N·s/m]
-};
 
 struct SimulatedSpidarParams {
   double count_noise = 0.5;            ///< encoder noise [counts RMS]
@@ -94,6 +90,8 @@ class SimulatedSpidar final : public Device {
     double tension = 0;
   };
   void step(double dt_s);
+  /// The source's holds for the goals just read (sanitised), or isotropic ones.
+  void take_holds();
 
   strings::DeviceConfig config_;
   SimulatedSpidarParams params_;
@@ -101,6 +99,7 @@ class SimulatedSpidar final : public Device {
   DeviceInfo info_;
   std::vector<String> strings_;
   std::vector<Vec3> x_, v_, goal_, force_;
+  std::vector<FingertipHold> hold_;
   std::vector<std::int32_t> commands_, applied_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};

@@ -11,17 +11,18 @@
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/physics/world.hpp"
 #include "spidar/session/cube_monitor.hpp"
+#include "spidar/session/scripted_task.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 
 namespace spidar::session {
 
 struct Scene {
   /// Loads `path` (MJCF) and fits the scripted task to the user's hands `user` (left, right);
-  /// `deadline_s` > 0: the run time by which the scripted user must be done (make_scripted_task).
+  /// `user_options`: how the scripted user plays (make_scripted_task).
   /// The error says what in the scene is wrong (callers prefix the option or config key).
   static Result<std::unique_ptr<Scene>> load(const std::string& path,
                                              const std::array<hand::HandModel, 2>& user,
-                                             double deadline_s = 0);
+                                             const ScriptedUserOptions& user_options = {});
   Scene() = default;
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;

@@ -1,4 +1,10 @@
 #pragma once
+/// How the scripted user plays its task.
+struct ScriptedUserOptions {
+  double deadline_s = 0;        ///< > 0: the run time by which it must be done (retries must fit) [s]
+  bool shaped_fingers = false;  ///< sim::RubiksTaskParams::shaped_fingers
+};
+
 /// The scripted user's task in a scene: the Rubik's cube's turns, or a reach for the object
 /// nearest the frame centre when the scene has no cube.
 #include <array>
@@ -18,14 +24,19 @@ namespace spidar::session {
 /// frame centre (its centre and half size), else the centre itself.
 void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp);
 
+/// How the scripted user plays its task.
+struct ScriptedUserOptions {
+  double deadline_s = 0;        ///< > 0: the run time by which it must be done (retries must fit) [s]
+  bool shaped_fingers = false;  ///< sim::RubiksTaskParams::shaped_fingers
+};
+
 /// The scripted user's task in a scene: the cube's start pose (`X_cube0`) when it has one, else the
 /// object nearest the frame centre; the script fitted to the user's own hands (`user`), so their
 /// fingers can be where the device's caps are. (One place for the demo and the live session.)
-/// `deadline_s` > 0: the run time by which the user must be done (its retries must fit).
 std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
                                                     const std::optional<physics::RubiksCube>& cube,
                                                     double proxy_radius,
                                                     const std::array<hand::HandModel, 2>& user,
-                                                    Pose* X_cube0, double deadline_s = 0);
+                                                    Pose* X_cube0, const ScriptedUserOptions& options = {});
 
 }  // namespace spidar::session

@@ -64,6 +64,18 @@ struct RubiksTaskParams {
   int turns = 2;                 ///< layer turns to make (≥ 1)
   double deadline = 20.0;        ///< run time by which the user must be done: retries must fit [s]
   bool has_cube = true;          ///< a Rubik's cube (false: another object; no turns are counted)
+  /// The user's fingertips held with their own fingers' stiffness (sim/finger_hold.hpp) once
+  /// fit_to_hands is called: the caps then yield to the displayed forces only where the fingers
+  /// can follow them, so the user's hands reach the device's caps (cap residual ≤ 0.4 mm in the
+  /// demo, against 3.7–7 mm with isotropic fingertips). The fit puts the fingertips on the faces
+  /// (they press along their compliant directions), keeps each hand on its layers, and the goals
+  /// move no faster than max_goal_speed. Off by default: with it the grip is weaker for some
+  /// hands and seeds (docs/user-model.md), so the layer turns need retries more often.
+  bool shaped_fingers = false;
+  /// With shaped_fingers, how fast a fingertip goal may move [m/s]: a hand moves smoothly, so where
+  /// the plan changes at once (a grasp frame taken from where the cube now is) the goals follow at
+  /// this speed, and a stiff finger does not snap. The script's own motions stay below 0.15 m/s.
+  double max_goal_speed = 0.5;
 };
 
 /// The cube's pose as the physics thread publishes it (plain data for core::Latest).
@@ -90,7 +102,9 @@ class RubiksTask final : public device::FingertipSource {
   /// touching positions (goals less their squeeze into the faces), in its grasp frame, are
   /// replaced by the nearest fingertip positions the hand can take (inverse kinematics along the
   /// script, every `dt_s`; linear in between); the squeeze is added back, so the grip is the
-  /// script's.
+  /// script's. With shaped_fingers it also puts the touching positions on the faces, keeps each
+  /// hand on its layers and gives the fingers' holds (holds()): the caps then yield to the
+  /// displayed forces only where the fingers can follow them.
   /// Without it the goals are the script's contact layout, which a hand of another size may not
   /// reach (adjacent caps closer than fingers are wide): the user's fingers could then not be
   /// where the device's caps are. Call before the task is shared with other threads.
@@ -115,6 +129,9 @@ class RubiksTask final : public device::FingertipSource {
   /// Goals of the eight fingertips at run time t [s] (world, m). The user's clock: call from one
   /// thread (the simulated device's); it checks the task and publishes the schedule.
   void goals(double t_s, std::span<Vec3> p_W_goal) override;
+  /// With fit_to_hands: each fingertip's stiffness shaped like the user's finger at the fitted
+  /// pose of the last goals() call (sim/finger_hold.hpp), turned with its hand; else false.
+  bool holds(std::span<device::FingertipHold> hold) override;
   /// Where the eight fingertips touch at time t (world, m): the goals less their squeeze into the
   /// faces (a finger stops at the face), in the grasp frames last published by goals().
   void touch_points(double t_s, std::span<Vec3> p_W) const;
@@ -181,6 +198,15 @@ class RubiksTask final : public device::FingertipSource {
   /// impedance): zero while open, `squeeze` along the face's inward normal when closed. A finger
   /// stops at the face; its touching position is script_path − squeeze_path.
   Vec3 squeeze_path(double t_s, int f) const;
+  /// Where the squeeze puts finger f's goal relative to its touching position: squeeze_path as a
+  /// force, k·squeeze_path with k the fingertip's softest stiffness, taken up by the finger's
+  /// hold (fit_to_hands): C·squeeze_path with C its compliance relative to its softest direction.
+  /// The contact then stops the fingertip at the touching position, pressing with the script's
+  /// force, and the fingertip yields only where the finger can move (a goal straight into the
+  /// face along a stiff direction would slide it sideways instead). Without a fit, squeeze_path.
+  Vec3 pressing(double t_s, int f) const;
+  /// The fitted touching position of finger f at script time t (fit_to_hands), grasp frame.
+  Vec3 fitted_touch(double t_s, int f) const;
   /// Outward normal of the face finger f (0..7) grasps, in its hand's grasp frame.
   Vec3 contact_normal(int f) const;
   /// The nominal pose of one hand in its grasp frame (before yaw and lift): the pose fitted to
@@ -195,11 +221,16 @@ class RubiksTask final : public device::FingertipSource {
   Plan plan_;                               ///< servo thread's copy
   core::Latest<Plan> published_plan_;       ///< for the other threads
   double prev_s_ = 0;                       ///< script time at the previous goals() call
+  double prev_goal_t_ = -1;                 ///< run time of the previous goals() call (−1: none)
+  std::array<Vec3, 8> prev_goal_{};         ///< the goals it gave
   double drop_since_ = -1;                  ///< run time the cube was first seen dropped (−1: not)
   int turns_at_check_ = 0;                  ///< turns seen at the previous turn check
   /// Fitted fingertip paths (fit_to_hands): per hand, 4 fingertips every fit_dt_ seconds.
   std::array<std::vector<std::array<Vec3, 4>>, 2> fitted_;
   std::array<std::vector<hand::HandParams>, 2> fitted_q_;  ///< the poses that reach them
+  /// The fingers' holds at those poses, in the grasp frame (before the hand's yaw).
+  std::array<std::vector<std::array<device::FingertipHold, 4>>, 2> fitted_hold_;
+  std::array<device::FingertipHold, 8> holds_{};  ///< servo thread: for the last goals()
   double fit_dt_ = 0.0;
   std::array<double, 2> fit_shift_max_{0.0, 0.0};
 };
