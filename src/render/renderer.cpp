@@ -559,8 +559,12 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
                        params.background_rgb[2], 1.f};
   const float far_value[4] = {inf, inf, inf, inf};
   const GLuint no_hand[4] = {0, 0, 0, 0};
-  gl::ClearBufferfv(GL_COLOR, 0, bg);
-  gl::ClearBufferfv(GL_COLOR, 1, far_value);
+  // Colour and the depth target are cleared only when no static world is copied over them
+  // (software GL pays for a clear per pixel).
+  if (static_count == 0) {
+    gl::ClearBufferfv(GL_COLOR, 0, bg);
+    gl::ClearBufferfv(GL_COLOR, 1, far_value);
+  }
   gl::ClearBufferfv(GL_COLOR, 2, far_value);
   gl::ClearBufferuiv(GL_COLOR, 3, no_hand);
   gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
