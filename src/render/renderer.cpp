@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -138,6 +139,7 @@ struct Renderer::Impl {
   bool static_valid = false;
   std::vector<float> static_key, key_scratch;
   GLuint present_fbo = 0, present_tex = 0;
+  mutable cv::Mat colour_rgba;  ///< read(): the colour target as read back (reused)
   int present_w = 0, present_h = 0;
 
   ~Impl() {
@@ -612,7 +614,13 @@ Status Renderer::read(RenderTargets* out, unsigned targets) const {
     gl::ReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
     gl::ReadPixels(0, 0, r.width, r.height, format, type, m->data);
   };
-  if (targets & kColour) read_one(0, &out->colour, CV_8UC3, GL_BGR, GL_UNSIGNED_BYTE);
+  if (targets & kColour) {
+    // The colour target's own layout, RGBA8, is read as is (a plain copy in Mesa), then its
+    // alpha dropped and red and blue swapped (SIMD): about a fifth of the cost of asking GL for
+    // BGR, which Mesa converts pixel by pixel.
+    read_one(0, &r.colour_rgba, CV_8UC4, GL_RGBA, GL_UNSIGNED_BYTE);
+    cv::cvtColor(r.colour_rgba, out->colour, cv::COLOR_RGBA2BGR);
+  }
   if (targets & kDepth) read_one(1, &out->depth, CV_32FC1, GL_RED, GL_FLOAT);
   if (targets & kHandDepth) read_one(2, &out->hand_depth, CV_32FC1, GL_RED, GL_FLOAT);
   if (targets & kHandId) read_one(3, &out->hand_id, CV_8UC1, GL_RED_INTEGER, GL_UNSIGNED_BYTE);

@@ -153,6 +153,32 @@ TEST(Renderer, HandTargetsAndOcclusion) {
   }
 }
 
+TEST(Renderer, ColourIsReadAsBgrBytes) {
+  SPIDAR_REQUIRE_GL();
+  // Unlit colours (ambient 1): the box and the background must come back as the bytes
+  // round(255 · rgb) in B, G, R order, whatever buffer the read-back is given.
+  const vision::Camera cam = vision::default_rig_camera();
+  auto renderer = Renderer::create(*gl_context()).value();
+  SceneSnapshot scene;
+  scene.shapes.push_back(box_shape(Pose{}, Vec3(0.03, 0.03, 0.03), {0.2f, 0.6f, 0.8f, 1.f}));
+  RenderParams params;
+  params.ambient = 1.f;
+  params.background_rgb = {1.f, 0.4f, 0.f};
+  ASSERT_TRUE(renderer->render(scene, cam, params).ok());
+  const Vec2 centre = cam.project(Vec3::Zero());
+  const int u = static_cast<int>(std::lround(centre.x())), v = static_cast<int>(std::lround(centre.y()));
+  RenderTargets fresh, reused;
+  reused.colour = cv::Mat(7, 5, CV_8UC3, cv::Scalar(1, 2, 3));
+  for (RenderTargets* t : {&fresh, &reused}) {
+    ASSERT_TRUE(renderer->read(t, kColour).ok());
+    ASSERT_EQ(t->colour.type(), CV_8UC3);
+    ASSERT_EQ(t->colour.size(), cv::Size(cam.width(), cam.height()));
+    EXPECT_EQ(t->colour.at<cv::Vec3b>(v, u), cv::Vec3b(204, 153, 51));
+    EXPECT_EQ(t->colour.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 102, 255));
+    EXPECT_TRUE(t->depth.empty());  // only the colour was asked for
+  }
+}
+
 TEST(Renderer, MeshesPlanesSpheresAndBadShapes) {
   SPIDAR_REQUIRE_GL();
   const vision::Camera cam = vision::default_rig_camera();
