@@ -116,8 +116,13 @@ struct Renderer::Impl {
   int width = 0, height = 0;
   GLuint program = 0;
   GLint u_view = -1, u_projection = -1, u_light = -1, u_ambient = -1;
-  GLuint fbo = 0, depth_rb = 0;
-  GLuint tex[4] = {};  // colour RGBA8, depth R32F, hand depth R32F, hand id R8UI
+  /// A framebuffer with some of the four target formats (colour RGBA8, depth R32F, hand depth
+  /// R32F, hand id R8UI), format k as colour attachment k, and a 32-bit float depth buffer.
+  struct Framebuffer {
+    GLuint fbo = 0, depth_rb = 0;
+    GLuint tex[4] = {};
+  };
+  Framebuffer frame;  ///< all four targets: what render() draws and read() reads
   GLuint instance_vbo = 0;
   std::size_t instance_capacity = 0;
   GpuMesh primitives[kPrimitiveCount];
@@ -134,9 +139,12 @@ struct Renderer::Impl {
   std::vector<Instance> upload;
   // The static world (RenderParams::cache_static): its colour, depth target and depth buffer,
   // drawn once and copied in each frame while `static_key` (its instances and the view) holds.
-  GLuint static_fbo = 0, static_depth_rb = 0;
-  GLuint static_tex[2] = {};  // colour RGBA8, depth R32F
+  Framebuffer static_world;
   bool static_valid = false;
+  // Hand depth (+inf), hand id (0) and the depth buffer (1) at their cleared values, cleared once
+  // and copied into the frame's targets at the start of each render: llvmpipe copies a target
+  // faster than it clears one (it fills a cleared tile pixel by pixel).
+  Framebuffer blank;
   std::vector<float> static_key, key_scratch;
   GLuint present_fbo = 0, present_tex = 0;
   mutable cv::Mat colour_rgba;  ///< read(): the colour target as read back (reused)
@@ -162,53 +170,85 @@ struct Renderer::Impl {
     m = {};
   }
 
+  static void destroy(Framebuffer& f) {
+    if (f.fbo) gl::DeleteFramebuffers(1, &f.fbo);
+    if (f.depth_rb) gl::DeleteRenderbuffers(1, &f.depth_rb);
+    for (GLuint& t : f.tex)
+      if (t) gl::DeleteTextures(1, &t);
+    f = {};
+  }
+
   void destroy_targets() {
-    if (fbo) gl::DeleteFramebuffers(1, &fbo);
-    if (depth_rb) gl::DeleteRenderbuffers(1, &depth_rb);
-    gl::DeleteTextures(4, tex);
-    fbo = depth_rb = 0;
-    for (auto& t : tex) t = 0;
-    if (static_fbo) gl::DeleteFramebuffers(1, &static_fbo);
-    if (static_depth_rb) gl::DeleteRenderbuffers(1, &static_depth_rb);
-    gl::DeleteTextures(2, static_tex);
-    static_fbo = static_depth_rb = 0;
-    for (auto& t : static_tex) t = 0;
+    destroy(frame);
+    destroy(static_world);
+    destroy(blank);
     static_valid = false;
   }
 
-  /// The static world's targets: the main targets' first two formats (colour, depth) and a depth
-  /// buffer, made on first use.
-  Status create_static_targets() {
-    return make_targets(2, &static_fbo, static_tex, &static_depth_rb, "static-world targets");
-  }
-
-  /// A framebuffer of the current size with the first `count` of the target formats (colour RGBA8,
-  /// depth R32F, hand depth R32F, hand id R8UI) as colour attachments 0.. and a 32-bit float
-  /// depth buffer. Leaves it bound.
-  Status make_targets(int count, GLuint* fb, GLuint* textures, GLuint* depth_buffer, const char* what) {
+  /// Makes `f` at the current size with the target formats in `targets` (a Target mask: bit k,
+  /// format k) and a depth buffer. Leaves it bound.
+  Status make_targets(unsigned targets, Framebuffer* f, const char* what) {
     const GLint internal[4] = {GL_RGBA8, GL_R32F, GL_R32F, GL_R8UI};
     const GLenum format[4] = {GL_RGBA, GL_RED, GL_RED, GL_RED_INTEGER};
     const GLenum type[4] = {GL_UNSIGNED_BYTE, GL_FLOAT, GL_FLOAT, GL_UNSIGNED_BYTE};
-    gl::GenFramebuffers(1, fb);
-    gl::BindFramebuffer(GL_FRAMEBUFFER, *fb);
-    gl::GenTextures(count, textures);
-    for (int i = 0; i < count; ++i) {
-      gl::BindTexture(GL_TEXTURE_2D, textures[i]);
+    gl::GenFramebuffers(1, &f->fbo);
+    gl::BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    for (int i = 0; i < 4; ++i) {
+      if (!(targets & (1u << i))) continue;
+      gl::GenTextures(1, &f->tex[i]);
+      gl::BindTexture(GL_TEXTURE_2D, f->tex[i]);
       gl::TexImage2D(GL_TEXTURE_2D, 0, internal[i], width, height, 0, format[i], type[i], nullptr);
       gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
       gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
       gl::FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
-                               GL_TEXTURE_2D, textures[i], 0);
+                               GL_TEXTURE_2D, f->tex[i], 0);
     }
-    gl::GenRenderbuffers(1, depth_buffer);
-    gl::BindRenderbuffer(GL_RENDERBUFFER, *depth_buffer);
+    gl::GenRenderbuffers(1, &f->depth_rb);
+    gl::BindRenderbuffer(GL_RENDERBUFFER, f->depth_rb);
     gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
-    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth_buffer);
+    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f->depth_rb);
     const GLenum status = gl::CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE)
       return Error{std::string("renderer: ") + what + " " + std::to_string(width) + "x" +
                    std::to_string(height) + " incomplete (status 0x" + std::to_string(status) + ")"};
     return gl::check_gl((std::string("renderer: creating ") + what).c_str());
+  }
+
+  /// Copies the colour attachments in `targets` (a Target mask) and the depth buffer of `from`
+  /// into the same attachments of `to`: same sizes and formats, nearest, so a plain copy (Mesa
+  /// copies the resource's region). Leaves `to` bound for drawing, with its draw buffers changed.
+  void copy_targets(const Framebuffer& from, const Framebuffer& to, unsigned targets) const {
+    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, from.fbo);
+    gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, to.fbo);
+    for (GLenum i = 0; i < 4; ++i) {
+      if (!(targets & (1u << i))) continue;
+      gl::ReadBuffer(GL_COLOR_ATTACHMENT0 + i);
+      GLenum only[4] = {GL_NONE, GL_NONE, GL_NONE, GL_NONE};
+      only[i] = GL_COLOR_ATTACHMENT0 + i;
+      gl::DrawBuffers(4, only);
+      gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  }
+
+  /// The frame's hand depth, hand id and depth buffer reset to +inf, 0 and 1, copied from
+  /// `blank` (made and cleared on first use). Leaves the frame bound, its draw buffers changed.
+  Status reset_hand_targets() {
+    if (!blank.fbo) {
+      if (auto st = make_targets(kHandDepth | kHandId, &blank, "blank hand targets"); !st) return st;
+      const GLenum hand[4] = {GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+      gl::DrawBuffers(4, hand);
+      const float inf = std::numeric_limits<float>::infinity();
+      const float far_value[4] = {inf, inf, inf, inf};
+      const GLuint no_hand[4] = {0, 0, 0, 0};
+      gl::ClearBufferfv(GL_COLOR, 2, far_value);
+      gl::ClearBufferuiv(GL_COLOR, 3, no_hand);
+      gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
+    }
+    copy_targets(blank, frame, kHandDepth | kHandId);
+    gl::BindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
+    return gl::check_gl("renderer: resetting the hand targets");
   }
 
   Status create_program() {
@@ -242,7 +282,7 @@ struct Renderer::Impl {
     destroy_targets();
     width = w;
     height = h;
-    return make_targets(4, &fbo, tex, &depth_rb, "offscreen targets");
+    return make_targets(kAllTargets, &frame, "offscreen targets");
   }
 
   GpuMesh upload_mesh(const CpuMesh& cpu) {
@@ -419,11 +459,11 @@ struct Renderer::Impl {
     key_scratch.insert(key_scratch.end(), {light.x(), light.y(), light.z(), params.ambient,
                                            params.background_rgb[0], params.background_rgb[1],
                                            params.background_rgb[2]});
-    if (!static_fbo) {
-      if (auto st = create_static_targets(); !st) return st;
+    if (!static_world.fbo) {
+      if (auto st = make_targets(kColour | kDepth, &static_world, "static-world targets"); !st) return st;
     }
     if (!static_valid || key_scratch != static_key) {
-      gl::BindFramebuffer(GL_FRAMEBUFFER, static_fbo);
+      gl::BindFramebuffer(GL_FRAMEBUFFER, static_world.fbo);
       const GLenum targets[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
       gl::DrawBuffers(2, targets);
       const float inf = std::numeric_limits<float>::infinity();
@@ -437,18 +477,7 @@ struct Renderer::Impl {
       static_key.swap(key_scratch);
       static_valid = true;
     }
-    // Same sizes and formats, nearest: a plain copy (Mesa copies the resource's region).
-    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, static_fbo);
-    gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
-    for (GLenum i = 0; i < 2; ++i) {
-      gl::ReadBuffer(GL_COLOR_ATTACHMENT0 + i);
-      GLenum only[4] = {GL_NONE, GL_NONE, GL_NONE, GL_NONE};
-      only[i] = GL_COLOR_ATTACHMENT0 + i;
-      gl::DrawBuffers(4, only);
-      gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    }
-    gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
-    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    copy_targets(static_world, frame, kColour | kDepth);
     return gl::check_gl("renderer: static world");
   }
 
@@ -535,7 +564,7 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
     gl::BufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(r.upload.size() * sizeof(Instance)),
                       r.upload.data());
 
-  gl::BindFramebuffer(GL_FRAMEBUFFER, r.fbo);
+  gl::BindFramebuffer(GL_FRAMEBUFFER, r.frame.fbo);
   gl::Viewport(0, 0, r.width, r.height);
   gl::Enable(GL_DEPTH_TEST);
   gl::DepthFunc(GL_LESS);
@@ -553,23 +582,20 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
   gl::Uniform3f(r.u_light, light.x(), light.y(), light.z());
   gl::Uniform1f(r.u_ambient, params.ambient);
 
-  const GLenum all[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                         GL_COLOR_ATTACHMENT3};
-  gl::DrawBuffers(4, all);
-  const float inf = std::numeric_limits<float>::infinity();
-  const float bg[4] = {params.background_rgb[0], params.background_rgb[1],
-                       params.background_rgb[2], 1.f};
-  const float far_value[4] = {inf, inf, inf, inf};
-  const GLuint no_hand[4] = {0, 0, 0, 0};
   // Colour and the depth target are cleared only when no static world is copied over them
-  // (software GL pays for a clear per pixel).
+  // (software GL pays for a clear per pixel); the hand targets and the depth buffer are copied
+  // from their blank copies.
   if (static_count == 0) {
+    const GLenum scene_targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_NONE};
+    gl::DrawBuffers(4, scene_targets);
+    const float inf = std::numeric_limits<float>::infinity();
+    const float bg[4] = {params.background_rgb[0], params.background_rgb[1],
+                         params.background_rgb[2], 1.f};
+    const float far_value[4] = {inf, inf, inf, inf};
     gl::ClearBufferfv(GL_COLOR, 0, bg);
     gl::ClearBufferfv(GL_COLOR, 1, far_value);
   }
-  gl::ClearBufferfv(GL_COLOR, 2, far_value);
-  gl::ClearBufferuiv(GL_COLOR, 3, no_hand);
-  gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
+  if (auto st = r.reset_hand_targets(); !st) return st;
 
   // Pass 1: hands into hand depth and hand id. With visible hands and no scene objects, colour
   // too: nothing could occlude them, so the separate colour pass below is not needed.
@@ -588,7 +614,7 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
   if (static_count > 0) {
     if (auto st = r.draw_static(view, projection, light, params, meshes, object_count + hand_count); !st)
       return st;
-    gl::BindFramebuffer(GL_FRAMEBUFFER, r.fbo);
+    gl::BindFramebuffer(GL_FRAMEBUFFER, r.frame.fbo);
   } else {
     gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
   }
@@ -607,7 +633,7 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
 Status Renderer::read(RenderTargets* out, unsigned targets) const {
   const Impl& r = *impl_;
   if (out == nullptr) return Error{"renderer: read needs an output"};
-  gl::BindFramebuffer(GL_READ_FRAMEBUFFER, r.fbo);
+  gl::BindFramebuffer(GL_READ_FRAMEBUFFER, r.frame.fbo);
   gl::PixelStorei(GL_PACK_ALIGNMENT, 1);
   auto read_one = [&](int attachment, cv::Mat* m, int cv_type, GLenum format, GLenum type) {
     m->create(r.height, r.width, cv_type);

@@ -378,6 +378,66 @@ TEST(Renderer, CachedStaticWorldGivesTheSameTargetsAndFollowsChanges) {
   compare(moving_only, cam, {}, "no static shapes");
 }
 
+TEST(Renderer, EachFrameStartsFromClearedTargets) {
+  SPIDAR_REQUIRE_GL();
+  // A renderer that drew hands (with and without a static world, visible and hidden) must give a
+  // next frame with other hands, or none, the targets of a renderer that never drew anything:
+  // nothing of the earlier hands may remain in hand depth, hand id or the depth buffer.
+  auto hands_at = [](double x) {
+    SceneSnapshot s;
+    for (int f = 0; f < 3; ++f) {
+      Shape finger = capsule_shape(Vec3(x, -0.03 + 0.025 * f, 0.05), Vec3(x + 0.05, -0.02 + 0.025 * f, 0.06), 0.009);
+      finger.hand = f % 2;
+      finger.finger = f;
+      s.shapes.push_back(finger);
+    }
+    return s;
+  };
+  Shape table;
+  table.type = Shape::Type::kPlane;
+  table.size = Vec3(0.3, 0.3, 0);
+  table.body = 0;
+  Shape moving = box_shape(Pose{Quat::Identity(), Vec3(0.02, 0.0, 0.01)}, Vec3(0.03, 0.03, 0.03));
+  moving.body = 3;
+  const vision::Camera cam = vision::default_rig_camera();
+  auto used = Renderer::create(*gl_context()).value();
+  for (bool with_table : {true, false}) {
+    for (HandDrawMode mode : {HandDrawMode::kHidden, HandDrawMode::kVisible}) {
+      RenderParams params;
+      params.hands = mode;
+      SceneSnapshot before = hands_at(-0.06), after = hands_at(0.03), none;
+      for (SceneSnapshot* s : {&before, &after, &none}) {
+        if (with_table) s->shapes.push_back(table);
+        s->shapes.push_back(moving);
+      }
+      ASSERT_TRUE(used->render(before, cam, params).ok());
+      for (const SceneSnapshot* next : {&after, &none}) {
+        auto fresh = Renderer::create(*gl_context()).value();
+        RenderTargets a, b;
+        ASSERT_TRUE(used->render(*next, cam, params).ok());
+        ASSERT_TRUE(used->read(&a).ok());
+        ASSERT_TRUE(fresh->render(*next, cam, params).ok());
+        ASSERT_TRUE(fresh->read(&b).ok());
+        EXPECT_EQ(differing_pixels(a, b), 0) << "table " << with_table << " visible "
+                                             << (mode == HandDrawMode::kVisible) << " hands "
+                                             << (next == &after);
+        if (next == &after) {
+          EXPECT_GT(cv::countNonZero(a.hand_id), 1000);
+        }
+      }
+    }
+  }
+  // Hands only, no scene: the same through a change of image size.
+  ASSERT_TRUE(used->render(hands_at(-0.06), odd_camera()).ok());
+  ASSERT_TRUE(used->render(hands_at(0.03), cam).ok());
+  auto fresh = Renderer::create(*gl_context()).value();
+  ASSERT_TRUE(fresh->render(hands_at(0.03), cam).ok());
+  RenderTargets a, b;
+  ASSERT_TRUE(used->read(&a).ok());
+  ASSERT_TRUE(fresh->read(&b).ok());
+  EXPECT_EQ(differing_pixels(a, b), 0) << "after a resize";
+}
+
 TEST(Renderer, ResizesToTheCamera) {
   SPIDAR_REQUIRE_GL();
   auto renderer = Renderer::create(*gl_context(), 64, 48).value();
