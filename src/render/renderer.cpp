@@ -123,6 +123,14 @@ struct Renderer::Impl {
     GLuint tex[4] = {};
   };
   Framebuffer frame;  ///< all four targets: what render() draws and read() reads
+  /// The frame's depth buffer for the hand pass (frame.depth_rb serves the scene pass): the
+  /// scene's is overwritten by the static world each frame, this one only by hands, so only the
+  /// pixels the last hands covered need resetting.
+  GLuint hand_depth_rb = 0;
+  /// The pixels the last hand pass wrote (rows as in the image, which are GL's rows): the bounding
+  /// box of hand_id != 0, known when read() read the hand id after the last render().
+  mutable cv::Rect hands_written;
+  mutable bool hands_written_known = false;
   GLuint instance_vbo = 0;
   std::size_t instance_capacity = 0;
   GpuMesh primitives[kPrimitiveCount];
@@ -180,6 +188,9 @@ struct Renderer::Impl {
 
   void destroy_targets() {
     destroy(frame);
+    if (hand_depth_rb) gl::DeleteRenderbuffers(1, &hand_depth_rb);
+    hand_depth_rb = 0;
+    hands_written_known = false;
     destroy(static_world);
     destroy(blank);
     static_valid = false;
@@ -203,9 +214,7 @@ struct Renderer::Impl {
       gl::FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
                                GL_TEXTURE_2D, f->tex[i], 0);
     }
-    gl::GenRenderbuffers(1, &f->depth_rb);
-    gl::BindRenderbuffer(GL_RENDERBUFFER, f->depth_rb);
-    gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+    f->depth_rb = make_depth_buffer();
     gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f->depth_rb);
     const GLenum status = gl::CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE)
@@ -214,10 +223,30 @@ struct Renderer::Impl {
     return gl::check_gl((std::string("renderer: creating ") + what).c_str());
   }
 
+  /// A 32-bit float depth buffer of the current size.
+  GLuint make_depth_buffer() const {
+    GLuint rb = 0;
+    gl::GenRenderbuffers(1, &rb);
+    gl::BindRenderbuffer(GL_RENDERBUFFER, rb);
+    gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+    return rb;
+  }
+
+  /// Attaches `rb` as the frame's depth buffer (the frame stays bound).
+  void use_frame_depth_buffer(GLuint rb) const {
+    gl::BindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
+    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb);
+  }
+
   /// Copies the colour attachments in `targets` (a Target mask) and the depth buffer of `from`
-  /// into the same attachments of `to`: same sizes and formats, nearest, so a plain copy (Mesa
-  /// copies the resource's region). Leaves `to` bound for drawing, with its draw buffers changed.
-  void copy_targets(const Framebuffer& from, const Framebuffer& to, unsigned targets) const {
+  /// into the same attachments of `to` within `region` (pixels; the whole image by default): same
+  /// sizes and formats, nearest, so a plain copy (Mesa copies the resource's region). Leaves `to`
+  /// bound for drawing, with its draw buffers changed.
+  void copy_targets(const Framebuffer& from, const Framebuffer& to, unsigned targets,
+                    cv::Rect region = {}) const {
+    if (region.area() <= 0) region = cv::Rect(0, 0, width, height);
+    const GLint x0 = region.x, y0 = region.y, x1 = region.x + region.width,
+                y1 = region.y + region.height;
     gl::BindFramebuffer(GL_READ_FRAMEBUFFER, from.fbo);
     gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, to.fbo);
     for (GLenum i = 0; i < 4; ++i) {
@@ -226,14 +255,16 @@ struct Renderer::Impl {
       GLenum only[4] = {GL_NONE, GL_NONE, GL_NONE, GL_NONE};
       only[i] = GL_COLOR_ATTACHMENT0 + i;
       gl::DrawBuffers(4, only);
-      gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+      gl::BlitFramebuffer(x0, y0, x1, y1, x0, y0, x1, y1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     }
-    gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    gl::BlitFramebuffer(x0, y0, x1, y1, x0, y0, x1, y1, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
     gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
   }
 
-  /// The frame's hand depth, hand id and depth buffer reset to +inf, 0 and 1, copied from
-  /// `blank` (made and cleared on first use). Leaves the frame bound, its draw buffers changed.
+  /// Resets the frame's hand depth, hand id and hand depth buffer to +inf, 0 and 1 by copying
+  /// `blank` (made and cleared on first use): only where the last hand pass wrote when that is
+  /// known, everywhere else. Leaves the frame bound with the hand depth buffer attached, its draw
+  /// buffers changed.
   Status reset_hand_targets() {
     if (!blank.fbo) {
       if (auto st = make_targets(kHandDepth | kHandId, &blank, "blank hand targets"); !st) return st;
@@ -246,7 +277,10 @@ struct Renderer::Impl {
       gl::ClearBufferuiv(GL_COLOR, 3, no_hand);
       gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
     }
-    copy_targets(blank, frame, kHandDepth | kHandId);
+    use_frame_depth_buffer(hand_depth_rb);
+    const cv::Rect region = hands_written_known ? hands_written : cv::Rect(0, 0, width, height);
+    if (region.area() > 0) copy_targets(blank, frame, kHandDepth | kHandId, region);
+    hands_written_known = false;  // until read() sees this frame's hand id
     gl::BindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
     return gl::check_gl("renderer: resetting the hand targets");
   }
@@ -282,7 +316,9 @@ struct Renderer::Impl {
     destroy_targets();
     width = w;
     height = h;
-    return make_targets(kAllTargets, &frame, "offscreen targets");
+    if (auto st = make_targets(kAllTargets, &frame, "offscreen targets"); !st) return st;
+    hand_depth_rb = make_depth_buffer();
+    return gl::check_gl("renderer: creating the hand depth buffer");
   }
 
   GpuMesh upload_mesh(const CpuMesh& cpu) {
@@ -608,9 +644,11 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
     gl::BindVertexArray(0);
     return gl::check_gl("renderer: render");
   }
-  // Pass 2: the scene into colour and depth, with a fresh depth buffer: the static world's
-  // (colour, depth target and depth buffer copied from its cache), then the moving objects.
+  // Pass 2: the scene into colour and depth, with its own depth buffer, fresh: the static
+  // world's (colour, depth target and depth buffer copied from its cache), then the moving
+  // objects.
   const GLenum scene_targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_NONE};
+  r.use_frame_depth_buffer(r.frame.depth_rb);
   if (static_count > 0) {
     if (auto st = r.draw_static(view, projection, light, params, meshes, object_count + hand_count); !st)
       return st;
@@ -649,7 +687,12 @@ Status Renderer::read(RenderTargets* out, unsigned targets) const {
   }
   if (targets & kDepth) read_one(1, &out->depth, CV_32FC1, GL_RED, GL_FLOAT);
   if (targets & kHandDepth) read_one(2, &out->hand_depth, CV_32FC1, GL_RED, GL_FLOAT);
-  if (targets & kHandId) read_one(3, &out->hand_id, CV_8UC1, GL_RED_INTEGER, GL_UNSIGNED_BYTE);
+  if (targets & kHandId) {
+    read_one(3, &out->hand_id, CV_8UC1, GL_RED_INTEGER, GL_UNSIGNED_BYTE);
+    // Every hand fragment drawn wrote an id ≥ 1: where the next render must reset.
+    r.hands_written = cv::boundingRect(out->hand_id);
+    r.hands_written_known = true;
+  }
   gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
   return gl::check_gl("renderer: read-back");
 }

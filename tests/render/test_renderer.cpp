@@ -380,13 +380,17 @@ TEST(Renderer, CachedStaticWorldGivesTheSameTargetsAndFollowsChanges) {
 
 TEST(Renderer, EachFrameStartsFromClearedTargets) {
   SPIDAR_REQUIRE_GL();
-  // A renderer that drew hands (with and without a static world, visible and hidden) must give a
+  // A renderer that drew hands (with and without a static world, visible and hidden, its targets
+  // read back or not: the renderer resets only where it saw hands when it knows) must give a
   // next frame with other hands, or none, the targets of a renderer that never drew anything:
   // nothing of the earlier hands may remain in hand depth, hand id or the depth buffer.
+  // Three fingers at x .. x + 5 cm; the first 2 cm under the table, whose depth buffer must not
+  // hide it from the hand targets.
   auto hands_at = [](double x) {
     SceneSnapshot s;
     for (int f = 0; f < 3; ++f) {
-      Shape finger = capsule_shape(Vec3(x, -0.03 + 0.025 * f, 0.05), Vec3(x + 0.05, -0.02 + 0.025 * f, 0.06), 0.009);
+      const double z = f == 0 ? -0.02 : 0.05;
+      Shape finger = capsule_shape(Vec3(x, -0.03 + 0.025 * f, z), Vec3(x + 0.05, -0.02 + 0.025 * f, z + 0.01), 0.009);
       finger.hand = f % 2;
       finger.finger = f;
       s.shapes.push_back(finger);
@@ -403,6 +407,7 @@ TEST(Renderer, EachFrameStartsFromClearedTargets) {
   auto used = Renderer::create(*gl_context()).value();
   for (bool with_table : {true, false}) {
     for (HandDrawMode mode : {HandDrawMode::kHidden, HandDrawMode::kVisible}) {
+     for (unsigned read_before : {0u, unsigned{kHandId}, unsigned{kAllTargets}}) {
       RenderParams params;
       params.hands = mode;
       SceneSnapshot before = hands_at(-0.06), after = hands_at(0.03), none;
@@ -411,6 +416,10 @@ TEST(Renderer, EachFrameStartsFromClearedTargets) {
         s->shapes.push_back(moving);
       }
       ASSERT_TRUE(used->render(before, cam, params).ok());
+      if (read_before != 0) {
+        RenderTargets seen;
+        ASSERT_TRUE(used->read(&seen, read_before).ok());
+      }
       for (const SceneSnapshot* next : {&after, &none}) {
         auto fresh = Renderer::create(*gl_context()).value();
         RenderTargets a, b;
@@ -419,12 +428,13 @@ TEST(Renderer, EachFrameStartsFromClearedTargets) {
         ASSERT_TRUE(fresh->render(*next, cam, params).ok());
         ASSERT_TRUE(fresh->read(&b).ok());
         EXPECT_EQ(differing_pixels(a, b), 0) << "table " << with_table << " visible "
-                                             << (mode == HandDrawMode::kVisible) << " hands "
-                                             << (next == &after);
+                                             << (mode == HandDrawMode::kVisible) << " read "
+                                             << read_before << " hands " << (next == &after);
         if (next == &after) {
           EXPECT_GT(cv::countNonZero(a.hand_id), 1000);
         }
       }
+     }
     }
   }
   // Hands only, no scene: the same through a change of image size.
