@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -80,7 +81,19 @@ struct GpuMesh {
   GLsizei index_count = 0;
   std::size_t vertex_bytes = 0, index_bytes = 0;  // sizes of the buffers' stores
   std::uint64_t version = 0;                      // MeshData::version uploaded
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();  // vertex bounds
 };
+
+/// The bounding box of a mesh's vertex positions (zero for no vertices).
+void set_bounds(const CpuMesh& cpu, GpuMesh* m) {
+  m->lo.setZero();
+  m->hi.setZero();
+  for (std::size_t i = 0; i + 6 <= cpu.vertices.size(); i += 6) {
+    const Eigen::Vector3d p(cpu.vertices[i], cpu.vertices[i + 1], cpu.vertices[i + 2]);
+    m->lo = i == 0 ? p : m->lo.cwiseMin(p);
+    m->hi = i == 0 ? p : m->hi.cwiseMax(p);
+  }
+}
 
 enum Primitive : int {
   kBoxMesh = 0,
@@ -131,6 +144,11 @@ struct Renderer::Impl {
   /// box of hand_id != 0, known when read() read the hand id after the last render().
   mutable cv::Rect hands_written;
   mutable bool hands_written_known = false;
+  /// The pixels the last frame's moving objects may have covered in colour, depth and the scene's
+  /// depth buffer (a bound from their bounding boxes), known when that frame started from the
+  /// static world's copy and drew nothing else there.
+  cv::Rect scene_written;
+  bool scene_written_known = false;
   GLuint instance_vbo = 0;
   std::size_t instance_capacity = 0;
   GpuMesh primitives[kPrimitiveCount];
@@ -191,6 +209,7 @@ struct Renderer::Impl {
     if (hand_depth_rb) gl::DeleteRenderbuffers(1, &hand_depth_rb);
     hand_depth_rb = 0;
     hands_written_known = false;
+    scene_written_known = false;
     destroy(static_world);
     destroy(blank);
     static_valid = false;
@@ -238,13 +257,17 @@ struct Renderer::Impl {
     gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb);
   }
 
+  /// The whole image, in pixels.
+  cv::Rect whole() const { return {0, 0, width, height}; }
+
   /// Copies the colour attachments in `targets` (a Target mask) and the depth buffer of `from`
-  /// into the same attachments of `to` within `region` (pixels; the whole image by default): same
-  /// sizes and formats, nearest, so a plain copy (Mesa copies the resource's region). Leaves `to`
-  /// bound for drawing, with its draw buffers changed.
+  /// into the same attachments of `to` within `region` (pixels, image rows = GL rows; nothing if
+  /// empty): same sizes and formats, nearest, so a plain copy (Mesa copies the resource's region).
+  /// Leaves `to` bound for drawing, with its draw buffers changed.
   void copy_targets(const Framebuffer& from, const Framebuffer& to, unsigned targets,
-                    cv::Rect region = {}) const {
-    if (region.area() <= 0) region = cv::Rect(0, 0, width, height);
+                    const cv::Rect& region) const {
+    gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, to.fbo);
+    if (region.area() <= 0) return;
     const GLint x0 = region.x, y0 = region.y, x1 = region.x + region.width,
                 y1 = region.y + region.height;
     gl::BindFramebuffer(GL_READ_FRAMEBUFFER, from.fbo);
@@ -278,8 +301,7 @@ struct Renderer::Impl {
       gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
     }
     use_frame_depth_buffer(hand_depth_rb);
-    const cv::Rect region = hands_written_known ? hands_written : cv::Rect(0, 0, width, height);
-    if (region.area() > 0) copy_targets(blank, frame, kHandDepth | kHandId, region);
+    copy_targets(blank, frame, kHandDepth | kHandId, hands_written_known ? hands_written : whole());
     hands_written_known = false;  // until read() sees this frame's hand id
     gl::BindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
     return gl::check_gl("renderer: resetting the hand targets");
@@ -340,6 +362,7 @@ struct Renderer::Impl {
                    static_cast<GLsizeiptr>(cpu.indices.size() * sizeof(std::uint32_t)),
                    cpu.indices.data(), GL_STATIC_DRAW);
     m.index_count = static_cast<GLsizei>(cpu.indices.size());
+    set_bounds(cpu, &m);
     m.vertex_bytes = cpu.vertices.size() * sizeof(float);
     m.index_bytes = cpu.indices.size() * sizeof(std::uint32_t);
     // Per-instance attributes 2..7 come from the shared instance buffer; their offsets are set
@@ -377,6 +400,7 @@ struct Renderer::Impl {
       m.index_bytes = ibytes;
     }
     m.index_count = static_cast<GLsizei>(staging.indices.size());
+    set_bounds(staging, &m);
     m.version = md.version;
     gl::BindVertexArray(0);
   }
@@ -476,11 +500,13 @@ struct Renderer::Impl {
 
   /// Pass 2's start when there are static shapes: brings the static world's cache up to date
   /// (drawn again only when its instances or the view changed) and copies its colour, depth
-  /// target and depth buffer into the frame's targets. Static instances sit in the instance
-  /// buffer from `first` on. Leaves the main targets bound for drawing.
+  /// target and depth buffer into the frame's targets: where the last frame's objects may have
+  /// drawn (`written`) when the cache holds and that is known, else everywhere. Static instances
+  /// sit in the instance buffer from `first` on. Leaves the main targets bound for drawing.
   Status draw_static(const Eigen::Matrix4f& view, const Eigen::Matrix4f& projection,
                      const Eigen::Vector3f& light, const RenderParams& params,
-                     const std::vector<GpuMesh>* meshes, std::size_t first) {
+                     const std::vector<GpuMesh>* meshes, std::size_t first,
+                     std::optional<cv::Rect> written) {
     key_scratch.clear();
     for (std::size_t k = 0; k < static_batches.size(); ++k) {
       if (static_batches[k].empty()) continue;
@@ -512,13 +538,47 @@ struct Renderer::Impl {
       draw(static_batches, first, meshes);
       static_key.swap(key_scratch);
       static_valid = true;
+      written.reset();
     }
-    copy_targets(static_world, frame, kColour | kDepth);
+    copy_targets(static_world, frame, kColour | kDepth, written ? *written : whole());
     return gl::check_gl("renderer: static world");
   }
 
   const GpuMesh& mesh_of(std::size_t key, const std::vector<GpuMesh>* meshes) const {
     return key < kPrimitiveCount ? primitives[key] : (*meshes)[key - kPrimitiveCount];
+  }
+
+  /// Pixels (image rows) that hold every fragment the instances of `batches` can draw seen by
+  /// `camera`: the projections of the corners of their bounding boxes (the capsule template's
+  /// stretched by its half length), grown by a pixel each side. Fragments lie inside the convex
+  /// hull of those projections when every corner is in front of the camera; when one is not,
+  /// the whole image.
+  cv::Rect screen_bounds(const std::vector<std::vector<Instance>>& batches,
+                         const std::vector<GpuMesh>* meshes, const vision::Camera& camera) const {
+    const vision::Intrinsics& K = camera.intrinsics();
+    const Mat4 X_CW = camera.X_CW().matrix();
+    double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+    for (std::size_t key = 0; key < batches.size(); ++key) {
+      if (batches[key].empty()) continue;
+      const GpuMesh& m = mesh_of(key, meshes);
+      for (const Instance& inst : batches[key]) {
+        const Mat4 X_CS = X_CW * Eigen::Map<const Eigen::Matrix4f>(inst.model).cast<double>();
+        const double stretch = key == kCapsuleMesh ? inst.extra[0] : 0.0;
+        for (int c = 0; c < 8; ++c) {
+          Vec3 p_S((c & 1) ? m.hi.x() : m.lo.x(), (c & 2) ? m.hi.y() : m.lo.y(),
+                   (c & 4) ? m.hi.z() + stretch : m.lo.z() - stretch);
+          const Vec3 p_C = (X_CS * p_S.homogeneous()).head<3>();
+          if (!(p_C.z() > 1e-6)) return whole();
+          const double u = K.fx * p_C.x() / p_C.z() + K.cx, v = K.fy * p_C.y() / p_C.z() + K.cy;
+          u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+        }
+      }
+    }
+    if (u0 > u1) return {};  // nothing drawn
+    // Pixel i holds the image points u in [i - 1/2, i + 1/2]; one more pixel each side.
+    auto first = [](double a) { return static_cast<int>(std::floor(std::max(a, -1e9))) - 1; };
+    auto last = [](double a) { return static_cast<int>(std::ceil(std::min(a, 1e9))) + 1; };
+    return cv::Rect(cv::Point(first(u0), first(v0)), cv::Point(last(u1) + 1, last(v1) + 1)) & whole();
   }
 
   /// Draws batches whose instances sit in the instance buffer from `first` on.
@@ -649,8 +709,11 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
   // objects.
   const GLenum scene_targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_NONE};
   r.use_frame_depth_buffer(r.frame.depth_rb);
+  const std::optional<cv::Rect> written =
+      r.scene_written_known ? std::optional<cv::Rect>(r.scene_written) : std::nullopt;
+  r.scene_written_known = false;
   if (static_count > 0) {
-    if (auto st = r.draw_static(view, projection, light, params, meshes, object_count + hand_count); !st)
+    if (auto st = r.draw_static(view, projection, light, params, meshes, object_count + hand_count, written); !st)
       return st;
     gl::BindFramebuffer(GL_FRAMEBUFFER, r.frame.fbo);
   } else {
@@ -658,6 +721,11 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
   }
   gl::DrawBuffers(4, scene_targets);
   r.draw(r.object_batches, 0, meshes);
+  // Where the next frame must restore the static world (when only objects drew over it).
+  if (static_count > 0 && params.hands != HandDrawMode::kVisible) {
+    r.scene_written = r.screen_bounds(r.object_batches, meshes, camera);
+    r.scene_written_known = true;
+  }
   // Debugging: visible hands occlude the scene's colour (not its depth target).
   if (params.hands == HandDrawMode::kVisible) {
     const GLenum colour_only[4] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_NONE};

@@ -360,10 +360,48 @@ TEST(Renderer, CachedStaticWorldGivesTheSameTargetsAndFollowsChanges) {
     EXPECT_EQ(differing_pixels(a, b), 0) << what;
   };
   const vision::Camera cam = vision::default_rig_camera();
+  // A moving mesh (a tetrahedron) and a moving capsule too: the cache is copied back only where
+  // the last frame's objects may have drawn (their bounding boxes' projections).
+  auto meshes = std::make_shared<std::vector<MeshData>>();
+  MeshData tetra;
+  tetra.vertices = {0, 0, 0.03f, 0.03f, 0, -0.01f, -0.015f, 0.026f, -0.01f, -0.015f, -0.026f, -0.01f};
+  tetra.faces = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2};
+  meshes->push_back(tetra);
+  scene.meshes = meshes;
+  Shape tet;
+  tet.type = Shape::Type::kMesh;
+  tet.mesh = 0;
+  tet.body = 4;
+  tet.X_WS.p = Vec3(-0.08, -0.05, 0.01);
+  scene.shapes.push_back(tet);
+  Shape rod = capsule_shape(Vec3(0.06, -0.06, 0.01), Vec3(0.1, -0.02, 0.02), 0.006);
+  rod.body = 5;
+  scene.shapes.push_back(rod);
   compare(scene, cam, {}, "first frame (cache drawn)");
   compare(scene, cam, {}, "second frame (cache copied)");
   scene.shapes[2].X_WS.p.x() += 0.02;  // the moving box moves: the cache still holds
   compare(scene, cam, {}, "moved object");
+  scene.shapes[4].X_WS.p += Vec3(0.12, 0.07, 0.0);  // the mesh and the capsule move far
+  scene.shapes[4].X_WS.R = Eigen::AngleAxisd(1.0, Vec3::UnitZ());
+  scene.shapes[5].X_WS.p.x() -= 0.15;
+  compare(scene, cam, {}, "moved mesh and capsule");
+  SceneSnapshot static_and_hands = scene;  // no moving object: nothing to copy back next frame
+  static_and_hands.shapes.erase(static_and_hands.shapes.begin() + 2);
+  static_and_hands.shapes.resize(3);
+  compare(static_and_hands, cam, {}, "no moving objects");
+  compare(scene, cam, {}, "objects back");
+  // A rod from behind the camera to 30 cm in front of it, beside the optical axis: a bound
+  // through the camera plane is the whole image.
+  SceneSnapshot at_camera = scene;
+  const Pose X_WR{Quat(cam.X_WC().R), cam.X_WC() * Vec3(0.04, 0.03, 0.1)};
+  at_camera.shapes.push_back(box_shape(X_WR, Vec3(0.01, 0.01, 0.2)));
+  at_camera.shapes.back().body = 6;
+  compare(at_camera, cam, {}, "object through the camera plane");
+  compare(scene, cam, {}, "after the object around the camera");
+  RenderParams visible_same_light;
+  visible_same_light.hands = HandDrawMode::kVisible;
+  compare(scene, cam, visible_same_light, "visible hands (drawn over the copied world)");
+  compare(scene, cam, {}, "hidden again");
   scene.shapes[1].X_WS.p.y() -= 0.03;  // the static block moves: the cache must be redrawn
   compare(scene, cam, {}, "moved static block");
   compare(scene, odd_camera(), {}, "another camera and image size");
