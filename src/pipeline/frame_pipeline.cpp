@@ -329,9 +329,7 @@ Status FramePipeline::picture(const cv::Mat& bgr, const SceneSnapshot& world, Fr
     const bool depth = c.params().mode == render::CompositeMode::kDepth;
     in.real_bgr = depth && !out->key.foreground.empty() ? out->key.foreground : bgr;
     in.real_alpha = out->key.alpha;
-    if (auto st = c.compose(in, img); !st) return st;
-    c.last_alpha().copyTo(*alpha);
-    return Ok{};
+    return c.compose(in, img, alpha);
   };
   if (auto st = compose(s.main, &out->composite, &out->composite_alpha); !st) return st;
   if (p.other_composite) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -54,38 +55,93 @@ Status check_inputs(const CompositeInputs& in, bool need_alpha) {
   return Ok{};
 }
 
-}  // namespace
-
-Status Compositor::compose(const CompositeInputs& in, cv::Mat* out) {
-  if (out == nullptr) return Error{"compositor: no output given"};
-  if (auto s = validate(params_); !s) return s;
-  return params_.mode == CompositeMode::kPaper ? compose_paper(in, out) : compose_depth(in, out);
+/// One row of a composite: out = a · real + (1 − a) · virt per pixel of n (BGR, 8 bit), rounded;
+/// a ≤ 0 gives virt and a = 1 real, exactly as the formula would. Runs of either are copied
+/// whole (most of a row is one or the other; only the soft edges are blended).
+void compose_row(const float* a, const std::uint8_t* real, const std::uint8_t* virt,
+                 std::uint8_t* out, int n) {
+  auto copy_run = [&](int x, int end, const std::uint8_t* from) {
+    std::memcpy(out + 3 * x, from + 3 * x, 3 * static_cast<std::size_t>(end - x));
+    return end;
+  };
+  int x = 0;
+  while (x < n) {
+    const float w = a[x];
+    int end = x + 1;
+    if (w <= 0.f) {
+      while (end < n && a[end] <= 0.f) ++end;
+      x = copy_run(x, end, virt);
+    } else if (w == 1.f) {
+      while (end < n && a[end] == 1.f) ++end;
+      x = copy_run(x, end, real);
+    } else {
+      for (int c = 3 * x; c < 3 * x + 3; ++c) {
+        const float value = w * real[c] + (1.f - w) * virt[c];
+        out[c] = static_cast<std::uint8_t>(std::clamp(value + 0.5f, 0.f, 255.f));
+      }
+      ++x;
+    }
+  }
 }
 
-Status Compositor::compose_paper(const CompositeInputs& in, cv::Mat* out) {
+/// The whole composite, row by row: outside `roi` the rendering's colour with alpha 0; inside,
+/// `alpha_row(y, a)` writes the alpha of image row y's roi columns to a[0 .. roi.width) and the
+/// row is composed with it. One pass over each image: nothing is copied first.
+template <class AlphaRow>
+void compose_rows(const cv::Mat& virt, const cv::Mat& real, const cv::Rect& roi,
+                  AlphaRow&& alpha_row, cv::Mat& out, cv::Mat& alpha) {
+  out.create(virt.size(), CV_8UC3);
+  alpha.create(virt.size(), CV_32FC1);
+  const std::size_t row_bytes = 3 * static_cast<std::size_t>(virt.cols);
+  for (int y = 0; y < virt.rows; ++y) {
+    const std::uint8_t* v = virt.ptr<std::uint8_t>(y);
+    std::uint8_t* o = out.ptr<std::uint8_t>(y);
+    float* a = alpha.ptr<float>(y);
+    if (y < roi.y || y >= roi.y + roi.height || roi.width <= 0) {
+      std::memcpy(o, v, row_bytes);
+      std::fill(a, a + virt.cols, 0.f);
+      continue;
+    }
+    const int x0 = roi.x, x1 = roi.x + roi.width;
+    std::memcpy(o, v, 3 * static_cast<std::size_t>(x0));
+    std::memcpy(o + 3 * x1, v + 3 * x1, 3 * static_cast<std::size_t>(virt.cols - x1));
+    std::fill(a, a + x0, 0.f);
+    std::fill(a + x1, a + virt.cols, 0.f);
+    alpha_row(y, a + x0);
+    compose_row(a + x0, real.ptr<std::uint8_t>(y) + 3 * x0, v + 3 * x0, o + 3 * x0, roi.width);
+  }
+}
+
+}  // namespace
+
+Status Compositor::compose(const CompositeInputs& in, cv::Mat* out, cv::Mat* alpha) {
+  if (out == nullptr) return Error{"compositor: no output given"};
+  if (auto s = validate(params_); !s) return s;
+  // The alpha goes to the caller's buffer, or to our own (not to one a caller lent last time).
+  if (alpha == nullptr && alpha_shared_) alpha_ = cv::Mat();
+  alpha_shared_ = alpha != nullptr;
+  cv::Mat& a = alpha != nullptr ? *alpha : alpha_;
+  auto st = params_.mode == CompositeMode::kPaper ? compose_paper(in, out, &a)
+                                                  : compose_depth(in, out, &a);
+  if (alpha != nullptr) alpha_ = *alpha;
+  return st;
+}
+
+Status Compositor::compose_paper(const CompositeInputs& in, cv::Mat* out, cv::Mat* alpha) {
   if (auto s = check_inputs(in, false); !s) return s;
   const RenderTargets& v = *in.virt;
-  cv::compare(v.hand_depth, v.depth, front_, cv::CMP_LT);  // virtual hand front-most
-  v.colour.copyTo(*out);
-  in.real_bgr.copyTo(*out, front_);
-  front_.convertTo(alpha_, CV_32F, 1.0 / 255.0);
+  // The real image wherever the virtual hand is front-most.
+  compose_rows(v.colour, in.real_bgr, cv::Rect(0, 0, v.colour.cols, v.colour.rows),
+               [&](int y, float* a) {
+                 const float* hand = v.hand_depth.ptr<float>(y);
+                 const float* depth = v.depth.ptr<float>(y);
+                 for (int x = 0; x < v.colour.cols; ++x) a[x] = hand[x] < depth[x] ? 1.f : 0.f;
+               },
+               *out, *alpha);
   return Ok{};
 }
 
-Status Compositor::compose_depth(const CompositeInputs& in, cv::Mat* out) {
-  if (auto s = check_inputs(in, true); !s) return s;
-  const RenderTargets& v = *in.virt;
-  v.colour.copyTo(*out);
-  alpha_.create(v.colour.size(), CV_32FC1);
-  alpha_.setTo(0);
-  // Only where the matte is non-zero can anything change.
-  cv::compare(in.real_alpha, 0.f, hand_mask_, cv::CMP_GT);
-  const int r = params_.edge_blur_px;
-  cv::Rect roi = cv::boundingRect(hand_mask_);
-  if (roi.area() == 0) return Ok{};
-  const cv::Rect image(0, 0, v.colour.cols, v.colour.rows);
-  roi = cv::Rect(roi.x - r, roi.y - r, roi.width + 2 * r, roi.height + 2 * r) & image;
-
+Status Compositor::carry_hand_depth(const RenderTargets& v, const cv::Rect& roi) {
   // Virtual-hand pixels, and for every pixel near them the nearest one (or the nearest 2×2 block
   // holding one: its blocks start at the distance transform's roi corner).
   cv::compare(v.hand_depth, FLT_MAX, hand_mask_, cv::CMP_LT);
@@ -93,22 +149,35 @@ Status Compositor::compose_depth(const CompositeInputs& in, cv::Mat* out) {
   dt_options.max_distance_px = params_.max_carry_px;  // only pixels the carry can reach
   dt_options.downsample = params_.carry_downsample;
   if (auto s = vision::silhouette_distance(hand_mask_, &distance_, dt_options); !s) return s;
-  const float unmatched = params_.show_unmatched ? 1.f : 0.f;
+  const auto unmatched = static_cast<std::uint8_t>(params_.show_unmatched ? 1 : 0);
   const auto margin = static_cast<float>(params_.depth_margin_m);
   const int sc = distance_.scale;
   const auto max_d = static_cast<float>(params_.max_carry_px) / static_cast<float>(sc);  // map units
   const cv::Rect& dt = distance_.roi;
   const int rows = v.hand_depth.rows, cols = v.hand_depth.cols;
   const float none = std::numeric_limits<float>::quiet_NaN();
-  // Per map cell (a pixel, or a 2×2 block from the roi's corner): the depth carried there, the
-  // front-most hand depth of the nearest cell holding a virtual-hand pixel; NaN: none in reach.
-  carried_.create(distance_.empty ? cv::Size(1, 1) : distance_.labels.size(), CV_32FC1);
-  carried_.setTo(none);
-  for (int ly = 0; !distance_.empty && ly < carried_.rows; ++ly) {
+  front_.create(roi.size(), CV_8UC1);
+  if (distance_.empty) {
+    front_.setTo(unmatched);
+    return Ok{};
+  }
+  // Per map cell (a pixel, or a 2×2 block from the dt roi's corner) that a roi pixel falls in:
+  // the depth carried there, the front-most hand depth of the nearest cell holding a
+  // virtual-hand pixel; NaN: none in reach. Cells no roi pixel falls in are not computed.
+  carried_.create(distance_.labels.size(), CV_32FC1);
+  auto cell_range = [&](int from, int to, int origin, int cells) {  // image [from, to) → cells
+    const int first = std::max(from, origin);
+    if (first >= to) return cv::Range(0, 0);
+    return cv::Range((first - origin) / sc, std::min((to - 1 - origin) / sc + 1, cells));
+  };
+  const cv::Range cell_rows = cell_range(roi.y, roi.y + roi.height, dt.y, carried_.rows);
+  const cv::Range cell_cols = cell_range(roi.x, roi.x + roi.width, dt.x, carried_.cols);
+  for (int ly = cell_rows.start; ly < cell_rows.end; ++ly) {
     const int* lab = distance_.labels.ptr<int>(ly);
     const float* dist = distance_.distance.ptr<float>(ly);
     float* c = carried_.ptr<float>(ly);
-    for (int lx = 0; lx < carried_.cols; ++lx) {
+    for (int lx = cell_cols.start; lx < cell_cols.end; ++lx) {
+      c[lx] = none;
       const int l = lab[lx];
       if (dist[lx] > max_d || l <= 0 || l >= static_cast<int>(distance_.label_pixel.size())) continue;
       const cv::Point q = distance_.label_pixel[static_cast<std::size_t>(l)];
@@ -126,15 +195,14 @@ Status Compositor::compose_depth(const CompositeInputs& in, cv::Mat* out) {
   for (int x = 0; x < roi.width; ++x) {
     const int ix = x + roi.x;
     const int lx = ix >= dt.x ? (ix - dt.x) / sc : -1;
-    map_column_[static_cast<std::size_t>(x)] = distance_.empty || lx >= carried_.cols ? -1 : lx;
+    map_column_[static_cast<std::size_t>(x)] = lx >= carried_.cols ? -1 : lx;
   }
-  front_.create(roi.size(), CV_32FC1);
   for (int y = 0; y < roi.height; ++y) {
     const int iy = y + roi.y;
     const float* depth = v.depth.ptr<float>(iy) + roi.x;
-    float* f = front_.ptr<float>(y);
+    std::uint8_t* f = front_.ptr<std::uint8_t>(y);
     const int ly = iy >= dt.y ? (iy - dt.y) / sc : -1;
-    if (distance_.empty || ly < 0 || ly >= carried_.rows) {
+    if (ly < 0 || ly >= carried_.rows) {
       std::fill(f, f + roi.width, unmatched);
       continue;
     }
@@ -142,27 +210,41 @@ Status Compositor::compose_depth(const CompositeInputs& in, cv::Mat* out) {
     for (int x = 0; x < roi.width; ++x) {
       const int lx = map_column_[static_cast<std::size_t>(x)];
       const float carried = lx >= 0 ? c[lx] : none;
-      f[x] = std::isnan(carried) ? unmatched : (carried < depth[x] + margin ? 1.f : 0.f);
+      f[x] = std::isnan(carried) ? unmatched : (carried < depth[x] + margin ? 1 : 0);
     }
   }
-  if (r > 0) cv::blur(front_, front_, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1),
-                      cv::BORDER_REPLICATE);
-  cv::Mat a = alpha_(roi);
-  cv::multiply(front_, in.real_alpha(roi), a);
-  // out = a · real + (1 − a) · virtual over the roi.
-  for (int y = 0; y < roi.height; ++y) {
-    const float* ap = a.ptr<float>(y);
-    const std::uint8_t* rp = in.real_bgr.ptr<std::uint8_t>(y + roi.y) + 3 * roi.x;
-    std::uint8_t* op = out->ptr<std::uint8_t>(y + roi.y) + 3 * roi.x;
-    for (int x = 0; x < roi.width; ++x) {
-      const float w = ap[x];
-      if (w <= 0.f) continue;
-      for (int c = 0; c < 3; ++c) {
-        const float value = w * rp[3 * x + c] + (1.f - w) * op[3 * x + c];
-        op[3 * x + c] = static_cast<std::uint8_t>(std::clamp(value + 0.5f, 0.f, 255.f));
-      }
-    }
+  return Ok{};
+}
+
+Status Compositor::compose_depth(const CompositeInputs& in, cv::Mat* out, cv::Mat* alpha) {
+  if (auto s = check_inputs(in, true); !s) return s;
+  const RenderTargets& v = *in.virt;
+  // Only where the matte is non-zero (and within the blur's reach of it) can anything change.
+  const int r = params_.edge_blur_px;
+  cv::compare(in.real_alpha, 0.f, hand_mask_, cv::CMP_GT);  // SIMD; faster than a scan of ours
+  cv::Rect roi = cv::boundingRect(hand_mask_);
+  if (roi.area() > 0) {
+    const cv::Rect image(0, 0, v.colour.cols, v.colour.rows);
+    roi = cv::Rect(roi.x - r, roi.y - r, roi.width + 2 * r, roi.height + 2 * r) & image;
+    if (auto s = carry_hand_depth(v, roi); !s) return s;
+    // The blurred occlusion mask, box of (2r + 1)² pixels with the roi's edges replicated: the
+    // count of front pixels in each box (exact, in integers) and its share of the box, computed
+    // as cv::blur computes it on the 0/1 floats (count · (1 / area) in double, then float).
+    const int side = 2 * r + 1, area = side * side;
+    cv::boxFilter(front_, front_count_, CV_16U, cv::Size(side, side), cv::Point(-1, -1), false,
+                  cv::BORDER_REPLICATE);
+    box_share_.resize(static_cast<std::size_t>(area) + 1);
+    for (int k = 0; k <= area; ++k)
+      box_share_[static_cast<std::size_t>(k)] = static_cast<float>(k * (1.0 / area));
   }
+  // a = matte · blur(in_front); out = a · real + (1 − a) · virtual.
+  compose_rows(v.colour, in.real_bgr, roi,
+               [&](int y, float* a) {
+                 const std::uint16_t* count = front_count_.ptr<std::uint16_t>(y - roi.y);
+                 const float* matte = in.real_alpha.ptr<float>(y) + roi.x;
+                 for (int x = 0; x < roi.width; ++x) a[x] = box_share_[count[x]] * matte[x];
+               },
+               *out, *alpha);
   return Ok{};
 }
 

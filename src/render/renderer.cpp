@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -79,7 +81,19 @@ struct GpuMesh {
   GLsizei index_count = 0;
   std::size_t vertex_bytes = 0, index_bytes = 0;  // sizes of the buffers' stores
   std::uint64_t version = 0;                      // MeshData::version uploaded
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();  // vertex bounds
 };
+
+/// The bounding box of a mesh's vertex positions (zero for no vertices).
+void set_bounds(const CpuMesh& cpu, GpuMesh* m) {
+  m->lo.setZero();
+  m->hi.setZero();
+  for (std::size_t i = 0; i + 6 <= cpu.vertices.size(); i += 6) {
+    const Eigen::Vector3d p(cpu.vertices[i], cpu.vertices[i + 1], cpu.vertices[i + 2]);
+    m->lo = i == 0 ? p : m->lo.cwiseMin(p);
+    m->hi = i == 0 ? p : m->hi.cwiseMax(p);
+  }
+}
 
 enum Primitive : int {
   kBoxMesh = 0,
@@ -115,8 +129,26 @@ struct Renderer::Impl {
   int width = 0, height = 0;
   GLuint program = 0;
   GLint u_view = -1, u_projection = -1, u_light = -1, u_ambient = -1;
-  GLuint fbo = 0, depth_rb = 0;
-  GLuint tex[4] = {};  // colour RGBA8, depth R32F, hand depth R32F, hand id R8UI
+  /// A framebuffer with some of the four target formats (colour RGBA8, depth R32F, hand depth
+  /// R32F, hand id R8UI), format k as colour attachment k, and a 32-bit float depth buffer.
+  struct Framebuffer {
+    GLuint fbo = 0, depth_rb = 0;
+    GLuint tex[4] = {};
+  };
+  Framebuffer frame;  ///< all four targets: what render() draws and read() reads
+  /// The frame's depth buffer for the hand pass (frame.depth_rb serves the scene pass): the
+  /// scene's is overwritten by the static world each frame, this one only by hands, so only the
+  /// pixels the last hands covered need resetting.
+  GLuint hand_depth_rb = 0;
+  /// The pixels the last hand pass wrote (rows as in the image, which are GL's rows): the bounding
+  /// box of hand_id != 0, known when read() read the hand id after the last render().
+  mutable cv::Rect hands_written;
+  mutable bool hands_written_known = false;
+  /// The pixels the last frame's moving objects may have covered in colour, depth and the scene's
+  /// depth buffer (a bound from their bounding boxes), known when that frame started from the
+  /// static world's copy and drew nothing else there.
+  cv::Rect scene_written;
+  bool scene_written_known = false;
   GLuint instance_vbo = 0;
   std::size_t instance_capacity = 0;
   GpuMesh primitives[kPrimitiveCount];
@@ -133,11 +165,15 @@ struct Renderer::Impl {
   std::vector<Instance> upload;
   // The static world (RenderParams::cache_static): its colour, depth target and depth buffer,
   // drawn once and copied in each frame while `static_key` (its instances and the view) holds.
-  GLuint static_fbo = 0, static_depth_rb = 0;
-  GLuint static_tex[2] = {};  // colour RGBA8, depth R32F
+  Framebuffer static_world;
   bool static_valid = false;
+  // Hand depth (+inf), hand id (0) and the depth buffer (1) at their cleared values, cleared once
+  // and copied into the frame's targets at the start of each render: llvmpipe copies a target
+  // faster than it clears one (it fills a cleared tile pixel by pixel).
+  Framebuffer blank;
   std::vector<float> static_key, key_scratch;
   GLuint present_fbo = 0, present_tex = 0;
+  mutable cv::Mat colour_rgba;  ///< read(): the colour target as read back (reused)
   int present_w = 0, present_h = 0;
 
   ~Impl() {
@@ -160,53 +196,115 @@ struct Renderer::Impl {
     m = {};
   }
 
+  static void destroy(Framebuffer& f) {
+    if (f.fbo) gl::DeleteFramebuffers(1, &f.fbo);
+    if (f.depth_rb) gl::DeleteRenderbuffers(1, &f.depth_rb);
+    for (GLuint& t : f.tex)
+      if (t) gl::DeleteTextures(1, &t);
+    f = {};
+  }
+
   void destroy_targets() {
-    if (fbo) gl::DeleteFramebuffers(1, &fbo);
-    if (depth_rb) gl::DeleteRenderbuffers(1, &depth_rb);
-    gl::DeleteTextures(4, tex);
-    fbo = depth_rb = 0;
-    for (auto& t : tex) t = 0;
-    if (static_fbo) gl::DeleteFramebuffers(1, &static_fbo);
-    if (static_depth_rb) gl::DeleteRenderbuffers(1, &static_depth_rb);
-    gl::DeleteTextures(2, static_tex);
-    static_fbo = static_depth_rb = 0;
-    for (auto& t : static_tex) t = 0;
+    destroy(frame);
+    if (hand_depth_rb) gl::DeleteRenderbuffers(1, &hand_depth_rb);
+    hand_depth_rb = 0;
+    hands_written_known = false;
+    scene_written_known = false;
+    destroy(static_world);
+    destroy(blank);
     static_valid = false;
   }
 
-  /// The static world's targets: the main targets' first two formats (colour, depth) and a depth
-  /// buffer, made on first use.
-  Status create_static_targets() {
-    return make_targets(2, &static_fbo, static_tex, &static_depth_rb, "static-world targets");
-  }
-
-  /// A framebuffer of the current size with the first `count` of the target formats (colour RGBA8,
-  /// depth R32F, hand depth R32F, hand id R8UI) as colour attachments 0.. and a 32-bit float
-  /// depth buffer. Leaves it bound.
-  Status make_targets(int count, GLuint* fb, GLuint* textures, GLuint* depth_buffer, const char* what) {
+  /// Makes `f` at the current size with the target formats in `targets` (a Target mask: bit k,
+  /// format k) and a depth buffer. Leaves it bound.
+  Status make_targets(unsigned targets, Framebuffer* f, const char* what) {
     const GLint internal[4] = {GL_RGBA8, GL_R32F, GL_R32F, GL_R8UI};
     const GLenum format[4] = {GL_RGBA, GL_RED, GL_RED, GL_RED_INTEGER};
     const GLenum type[4] = {GL_UNSIGNED_BYTE, GL_FLOAT, GL_FLOAT, GL_UNSIGNED_BYTE};
-    gl::GenFramebuffers(1, fb);
-    gl::BindFramebuffer(GL_FRAMEBUFFER, *fb);
-    gl::GenTextures(count, textures);
-    for (int i = 0; i < count; ++i) {
-      gl::BindTexture(GL_TEXTURE_2D, textures[i]);
+    gl::GenFramebuffers(1, &f->fbo);
+    gl::BindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    for (int i = 0; i < 4; ++i) {
+      if (!(targets & (1u << i))) continue;
+      gl::GenTextures(1, &f->tex[i]);
+      gl::BindTexture(GL_TEXTURE_2D, f->tex[i]);
       gl::TexImage2D(GL_TEXTURE_2D, 0, internal[i], width, height, 0, format[i], type[i], nullptr);
       gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
       gl::TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
       gl::FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i),
-                               GL_TEXTURE_2D, textures[i], 0);
+                               GL_TEXTURE_2D, f->tex[i], 0);
     }
-    gl::GenRenderbuffers(1, depth_buffer);
-    gl::BindRenderbuffer(GL_RENDERBUFFER, *depth_buffer);
-    gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
-    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth_buffer);
+    f->depth_rb = make_depth_buffer();
+    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f->depth_rb);
     const GLenum status = gl::CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE)
       return Error{std::string("renderer: ") + what + " " + std::to_string(width) + "x" +
                    std::to_string(height) + " incomplete (status 0x" + std::to_string(status) + ")"};
     return gl::check_gl((std::string("renderer: creating ") + what).c_str());
+  }
+
+  /// A 32-bit float depth buffer of the current size.
+  GLuint make_depth_buffer() const {
+    GLuint rb = 0;
+    gl::GenRenderbuffers(1, &rb);
+    gl::BindRenderbuffer(GL_RENDERBUFFER, rb);
+    gl::RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+    return rb;
+  }
+
+  /// Attaches `rb` as the frame's depth buffer (the frame stays bound).
+  void use_frame_depth_buffer(GLuint rb) const {
+    gl::BindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
+    gl::FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb);
+  }
+
+  /// The whole image, in pixels.
+  cv::Rect whole() const { return {0, 0, width, height}; }
+
+  /// Copies the colour attachments in `targets` (a Target mask) and the depth buffer of `from`
+  /// into the same attachments of `to` within `region` (pixels, image rows = GL rows; nothing if
+  /// empty): same sizes and formats, nearest, so a plain copy (Mesa copies the resource's region).
+  /// Leaves `to` bound for drawing, with its draw buffers changed.
+  void copy_targets(const Framebuffer& from, const Framebuffer& to, unsigned targets,
+                    const cv::Rect& region) const {
+    gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, to.fbo);
+    if (region.area() <= 0) return;
+    const GLint x0 = region.x, y0 = region.y, x1 = region.x + region.width,
+                y1 = region.y + region.height;
+    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, from.fbo);
+    gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, to.fbo);
+    for (GLenum i = 0; i < 4; ++i) {
+      if (!(targets & (1u << i))) continue;
+      gl::ReadBuffer(GL_COLOR_ATTACHMENT0 + i);
+      GLenum only[4] = {GL_NONE, GL_NONE, GL_NONE, GL_NONE};
+      only[i] = GL_COLOR_ATTACHMENT0 + i;
+      gl::DrawBuffers(4, only);
+      gl::BlitFramebuffer(x0, y0, x1, y1, x0, y0, x1, y1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    gl::BlitFramebuffer(x0, y0, x1, y1, x0, y0, x1, y1, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  }
+
+  /// Resets the frame's hand depth, hand id and hand depth buffer to +inf, 0 and 1 by copying
+  /// `blank` (made and cleared on first use): only where the last hand pass wrote when that is
+  /// known, everywhere else. Leaves the frame bound with the hand depth buffer attached, its draw
+  /// buffers changed.
+  Status reset_hand_targets() {
+    if (!blank.fbo) {
+      if (auto st = make_targets(kHandDepth | kHandId, &blank, "blank hand targets"); !st) return st;
+      const GLenum hand[4] = {GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+      gl::DrawBuffers(4, hand);
+      const float inf = std::numeric_limits<float>::infinity();
+      const float far_value[4] = {inf, inf, inf, inf};
+      const GLuint no_hand[4] = {0, 0, 0, 0};
+      gl::ClearBufferfv(GL_COLOR, 2, far_value);
+      gl::ClearBufferuiv(GL_COLOR, 3, no_hand);
+      gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
+    }
+    use_frame_depth_buffer(hand_depth_rb);
+    copy_targets(blank, frame, kHandDepth | kHandId, hands_written_known ? hands_written : whole());
+    hands_written_known = false;  // until read() sees this frame's hand id
+    gl::BindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
+    return gl::check_gl("renderer: resetting the hand targets");
   }
 
   Status create_program() {
@@ -240,7 +338,9 @@ struct Renderer::Impl {
     destroy_targets();
     width = w;
     height = h;
-    return make_targets(4, &fbo, tex, &depth_rb, "offscreen targets");
+    if (auto st = make_targets(kAllTargets, &frame, "offscreen targets"); !st) return st;
+    hand_depth_rb = make_depth_buffer();
+    return gl::check_gl("renderer: creating the hand depth buffer");
   }
 
   GpuMesh upload_mesh(const CpuMesh& cpu) {
@@ -262,6 +362,7 @@ struct Renderer::Impl {
                    static_cast<GLsizeiptr>(cpu.indices.size() * sizeof(std::uint32_t)),
                    cpu.indices.data(), GL_STATIC_DRAW);
     m.index_count = static_cast<GLsizei>(cpu.indices.size());
+    set_bounds(cpu, &m);
     m.vertex_bytes = cpu.vertices.size() * sizeof(float);
     m.index_bytes = cpu.indices.size() * sizeof(std::uint32_t);
     // Per-instance attributes 2..7 come from the shared instance buffer; their offsets are set
@@ -299,6 +400,7 @@ struct Renderer::Impl {
       m.index_bytes = ibytes;
     }
     m.index_count = static_cast<GLsizei>(staging.indices.size());
+    set_bounds(staging, &m);
     m.version = md.version;
     gl::BindVertexArray(0);
   }
@@ -398,11 +500,13 @@ struct Renderer::Impl {
 
   /// Pass 2's start when there are static shapes: brings the static world's cache up to date
   /// (drawn again only when its instances or the view changed) and copies its colour, depth
-  /// target and depth buffer into the frame's targets. Static instances sit in the instance
-  /// buffer from `first` on. Leaves the main targets bound for drawing.
+  /// target and depth buffer into the frame's targets: where the last frame's objects may have
+  /// drawn (`written`) when the cache holds and that is known, else everywhere. Static instances
+  /// sit in the instance buffer from `first` on. Leaves the main targets bound for drawing.
   Status draw_static(const Eigen::Matrix4f& view, const Eigen::Matrix4f& projection,
                      const Eigen::Vector3f& light, const RenderParams& params,
-                     const std::vector<GpuMesh>* meshes, std::size_t first) {
+                     const std::vector<GpuMesh>* meshes, std::size_t first,
+                     std::optional<cv::Rect> written) {
     key_scratch.clear();
     for (std::size_t k = 0; k < static_batches.size(); ++k) {
       if (static_batches[k].empty()) continue;
@@ -417,11 +521,11 @@ struct Renderer::Impl {
     key_scratch.insert(key_scratch.end(), {light.x(), light.y(), light.z(), params.ambient,
                                            params.background_rgb[0], params.background_rgb[1],
                                            params.background_rgb[2]});
-    if (!static_fbo) {
-      if (auto st = create_static_targets(); !st) return st;
+    if (!static_world.fbo) {
+      if (auto st = make_targets(kColour | kDepth, &static_world, "static-world targets"); !st) return st;
     }
     if (!static_valid || key_scratch != static_key) {
-      gl::BindFramebuffer(GL_FRAMEBUFFER, static_fbo);
+      gl::BindFramebuffer(GL_FRAMEBUFFER, static_world.fbo);
       const GLenum targets[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
       gl::DrawBuffers(2, targets);
       const float inf = std::numeric_limits<float>::infinity();
@@ -434,24 +538,47 @@ struct Renderer::Impl {
       draw(static_batches, first, meshes);
       static_key.swap(key_scratch);
       static_valid = true;
+      written.reset();
     }
-    // Same sizes and formats, nearest: a plain copy (Mesa copies the resource's region).
-    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, static_fbo);
-    gl::BindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
-    for (GLenum i = 0; i < 2; ++i) {
-      gl::ReadBuffer(GL_COLOR_ATTACHMENT0 + i);
-      GLenum only[4] = {GL_NONE, GL_NONE, GL_NONE, GL_NONE};
-      only[i] = GL_COLOR_ATTACHMENT0 + i;
-      gl::DrawBuffers(4, only);
-      gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    }
-    gl::BlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
-    gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    copy_targets(static_world, frame, kColour | kDepth, written ? *written : whole());
     return gl::check_gl("renderer: static world");
   }
 
   const GpuMesh& mesh_of(std::size_t key, const std::vector<GpuMesh>* meshes) const {
     return key < kPrimitiveCount ? primitives[key] : (*meshes)[key - kPrimitiveCount];
+  }
+
+  /// Pixels (image rows) that hold every fragment the instances of `batches` can draw seen by
+  /// `camera`: the projections of the corners of their bounding boxes (the capsule template's
+  /// stretched by its half length), grown by a pixel each side. Fragments lie inside the convex
+  /// hull of those projections when every corner is in front of the camera; when one is not,
+  /// the whole image.
+  cv::Rect screen_bounds(const std::vector<std::vector<Instance>>& batches,
+                         const std::vector<GpuMesh>* meshes, const vision::Camera& camera) const {
+    const vision::Intrinsics& K = camera.intrinsics();
+    const Mat4 X_CW = camera.X_CW().matrix();
+    double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+    for (std::size_t key = 0; key < batches.size(); ++key) {
+      if (batches[key].empty()) continue;
+      const GpuMesh& m = mesh_of(key, meshes);
+      for (const Instance& inst : batches[key]) {
+        const Mat4 X_CS = X_CW * Eigen::Map<const Eigen::Matrix4f>(inst.model).cast<double>();
+        const double stretch = key == kCapsuleMesh ? inst.extra[0] : 0.0;
+        for (int c = 0; c < 8; ++c) {
+          Vec3 p_S((c & 1) ? m.hi.x() : m.lo.x(), (c & 2) ? m.hi.y() : m.lo.y(),
+                   (c & 4) ? m.hi.z() + stretch : m.lo.z() - stretch);
+          const Vec3 p_C = (X_CS * p_S.homogeneous()).head<3>();
+          if (!(p_C.z() > 1e-6)) return whole();
+          const double u = K.fx * p_C.x() / p_C.z() + K.cx, v = K.fy * p_C.y() / p_C.z() + K.cy;
+          u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+        }
+      }
+    }
+    if (u0 > u1) return {};  // nothing drawn
+    // Pixel i holds the image points u in [i - 1/2, i + 1/2]; one more pixel each side.
+    auto first = [](double a) { return static_cast<int>(std::floor(std::max(a, -1e9))) - 1; };
+    auto last = [](double a) { return static_cast<int>(std::ceil(std::min(a, 1e9))) + 1; };
+    return cv::Rect(cv::Point(first(u0), first(v0)), cv::Point(last(u1) + 1, last(v1) + 1)) & whole();
   }
 
   /// Draws batches whose instances sit in the instance buffer from `first` on.
@@ -533,7 +660,7 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
     gl::BufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(r.upload.size() * sizeof(Instance)),
                       r.upload.data());
 
-  gl::BindFramebuffer(GL_FRAMEBUFFER, r.fbo);
+  gl::BindFramebuffer(GL_FRAMEBUFFER, r.frame.fbo);
   gl::Viewport(0, 0, r.width, r.height);
   gl::Enable(GL_DEPTH_TEST);
   gl::DepthFunc(GL_LESS);
@@ -551,19 +678,20 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
   gl::Uniform3f(r.u_light, light.x(), light.y(), light.z());
   gl::Uniform1f(r.u_ambient, params.ambient);
 
-  const GLenum all[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                         GL_COLOR_ATTACHMENT3};
-  gl::DrawBuffers(4, all);
-  const float inf = std::numeric_limits<float>::infinity();
-  const float bg[4] = {params.background_rgb[0], params.background_rgb[1],
-                       params.background_rgb[2], 1.f};
-  const float far_value[4] = {inf, inf, inf, inf};
-  const GLuint no_hand[4] = {0, 0, 0, 0};
-  gl::ClearBufferfv(GL_COLOR, 0, bg);
-  gl::ClearBufferfv(GL_COLOR, 1, far_value);
-  gl::ClearBufferfv(GL_COLOR, 2, far_value);
-  gl::ClearBufferuiv(GL_COLOR, 3, no_hand);
-  gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
+  // Colour and the depth target are cleared only when no static world is copied over them
+  // (software GL pays for a clear per pixel); the hand targets and the depth buffer are copied
+  // from their blank copies.
+  if (static_count == 0) {
+    const GLenum scene_targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_NONE};
+    gl::DrawBuffers(4, scene_targets);
+    const float inf = std::numeric_limits<float>::infinity();
+    const float bg[4] = {params.background_rgb[0], params.background_rgb[1],
+                         params.background_rgb[2], 1.f};
+    const float far_value[4] = {inf, inf, inf, inf};
+    gl::ClearBufferfv(GL_COLOR, 0, bg);
+    gl::ClearBufferfv(GL_COLOR, 1, far_value);
+  }
+  if (auto st = r.reset_hand_targets(); !st) return st;
 
   // Pass 1: hands into hand depth and hand id. With visible hands and no scene objects, colour
   // too: nothing could occlude them, so the separate colour pass below is not needed.
@@ -576,18 +704,28 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
     gl::BindVertexArray(0);
     return gl::check_gl("renderer: render");
   }
-  // Pass 2: the scene into colour and depth, with a fresh depth buffer: the static world's
-  // (colour, depth target and depth buffer copied from its cache), then the moving objects.
+  // Pass 2: the scene into colour and depth, with its own depth buffer, fresh: the static
+  // world's (colour, depth target and depth buffer copied from its cache), then the moving
+  // objects.
   const GLenum scene_targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_NONE};
+  r.use_frame_depth_buffer(r.frame.depth_rb);
+  const std::optional<cv::Rect> written =
+      r.scene_written_known ? std::optional<cv::Rect>(r.scene_written) : std::nullopt;
+  r.scene_written_known = false;
   if (static_count > 0) {
-    if (auto st = r.draw_static(view, projection, light, params, meshes, object_count + hand_count); !st)
+    if (auto st = r.draw_static(view, projection, light, params, meshes, object_count + hand_count, written); !st)
       return st;
-    gl::BindFramebuffer(GL_FRAMEBUFFER, r.fbo);
+    gl::BindFramebuffer(GL_FRAMEBUFFER, r.frame.fbo);
   } else {
     gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
   }
   gl::DrawBuffers(4, scene_targets);
   r.draw(r.object_batches, 0, meshes);
+  // Where the next frame must restore the static world (when only objects drew over it).
+  if (static_count > 0 && params.hands != HandDrawMode::kVisible) {
+    r.scene_written = r.screen_bounds(r.object_batches, meshes, camera);
+    r.scene_written_known = true;
+  }
   // Debugging: visible hands occlude the scene's colour (not its depth target).
   if (params.hands == HandDrawMode::kVisible) {
     const GLenum colour_only[4] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_NONE};
@@ -601,17 +739,28 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
 Status Renderer::read(RenderTargets* out, unsigned targets) const {
   const Impl& r = *impl_;
   if (out == nullptr) return Error{"renderer: read needs an output"};
-  gl::BindFramebuffer(GL_READ_FRAMEBUFFER, r.fbo);
+  gl::BindFramebuffer(GL_READ_FRAMEBUFFER, r.frame.fbo);
   gl::PixelStorei(GL_PACK_ALIGNMENT, 1);
   auto read_one = [&](int attachment, cv::Mat* m, int cv_type, GLenum format, GLenum type) {
     m->create(r.height, r.width, cv_type);
     gl::ReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(attachment));
     gl::ReadPixels(0, 0, r.width, r.height, format, type, m->data);
   };
-  if (targets & kColour) read_one(0, &out->colour, CV_8UC3, GL_BGR, GL_UNSIGNED_BYTE);
+  if (targets & kColour) {
+    // The colour target's own layout, RGBA8, is read as is (a plain copy in Mesa), then its
+    // alpha dropped and red and blue swapped (SIMD): about a fifth of the cost of asking GL for
+    // BGR, which Mesa converts pixel by pixel.
+    read_one(0, &r.colour_rgba, CV_8UC4, GL_RGBA, GL_UNSIGNED_BYTE);
+    cv::cvtColor(r.colour_rgba, out->colour, cv::COLOR_RGBA2BGR);
+  }
   if (targets & kDepth) read_one(1, &out->depth, CV_32FC1, GL_RED, GL_FLOAT);
   if (targets & kHandDepth) read_one(2, &out->hand_depth, CV_32FC1, GL_RED, GL_FLOAT);
-  if (targets & kHandId) read_one(3, &out->hand_id, CV_8UC1, GL_RED_INTEGER, GL_UNSIGNED_BYTE);
+  if (targets & kHandId) {
+    read_one(3, &out->hand_id, CV_8UC1, GL_RED_INTEGER, GL_UNSIGNED_BYTE);
+    // Every hand fragment drawn wrote an id ≥ 1: where the next render must reset.
+    r.hands_written = cv::boundingRect(out->hand_id);
+    r.hands_written_known = true;
+  }
   gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
   return gl::check_gl("renderer: read-back");
 }

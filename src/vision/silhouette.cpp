@@ -57,9 +57,9 @@ Status silhouette_distance(const cv::Mat& silhouette, SilhouetteDistance* out,
   cv::compare(sil, 0, inverted, cv::CMP_EQ);
   cv::distanceTransform(inverted, out->distance, out->labels, cv::DIST_L2, cv::DIST_MASK_5,
                         cv::DIST_LABEL_PIXEL);
-  // Each silhouette pixel carries its own label: read the table back from the image.
-  out->label_pixel.clear();
-  out->label_pixel.push_back(cv::Point(-1, -1));
+  // Each silhouette pixel carries its own label (1, 2, ... in OpenCV's order): read the table
+  // back from the image, sized for one label per pixel up front (grown if ever needed).
+  out->label_pixel.assign(static_cast<std::size_t>(cv::countNonZero(sil)) + 1, cv::Point(-1, -1));
   for (int y = 0; y < sil.rows; ++y) {
     const std::uint8_t* s = sil.ptr<std::uint8_t>(y);
     const int* lab = out->labels.ptr<int>(y);

@@ -153,6 +153,32 @@ TEST(Renderer, HandTargetsAndOcclusion) {
   }
 }
 
+TEST(Renderer, ColourIsReadAsBgrBytes) {
+  SPIDAR_REQUIRE_GL();
+  // Unlit colours (ambient 1): the box and the background must come back as the bytes
+  // round(255 · rgb) in B, G, R order, whatever buffer the read-back is given.
+  const vision::Camera cam = vision::default_rig_camera();
+  auto renderer = Renderer::create(*gl_context()).value();
+  SceneSnapshot scene;
+  scene.shapes.push_back(box_shape(Pose{}, Vec3(0.03, 0.03, 0.03), {0.2f, 0.6f, 0.8f, 1.f}));
+  RenderParams params;
+  params.ambient = 1.f;
+  params.background_rgb = {1.f, 0.4f, 0.f};
+  ASSERT_TRUE(renderer->render(scene, cam, params).ok());
+  const Vec2 centre = cam.project(Vec3::Zero());
+  const int u = static_cast<int>(std::lround(centre.x())), v = static_cast<int>(std::lround(centre.y()));
+  RenderTargets fresh, reused;
+  reused.colour = cv::Mat(7, 5, CV_8UC3, cv::Scalar(1, 2, 3));
+  for (RenderTargets* t : {&fresh, &reused}) {
+    ASSERT_TRUE(renderer->read(t, kColour).ok());
+    ASSERT_EQ(t->colour.type(), CV_8UC3);
+    ASSERT_EQ(t->colour.size(), cv::Size(cam.width(), cam.height()));
+    EXPECT_EQ(t->colour.at<cv::Vec3b>(v, u), cv::Vec3b(204, 153, 51));
+    EXPECT_EQ(t->colour.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 102, 255));
+    EXPECT_TRUE(t->depth.empty());  // only the colour was asked for
+  }
+}
+
 TEST(Renderer, MeshesPlanesSpheresAndBadShapes) {
   SPIDAR_REQUIRE_GL();
   const vision::Camera cam = vision::default_rig_camera();
@@ -334,10 +360,48 @@ TEST(Renderer, CachedStaticWorldGivesTheSameTargetsAndFollowsChanges) {
     EXPECT_EQ(differing_pixels(a, b), 0) << what;
   };
   const vision::Camera cam = vision::default_rig_camera();
+  // A moving mesh (a tetrahedron) and a moving capsule too: the cache is copied back only where
+  // the last frame's objects may have drawn (their bounding boxes' projections).
+  auto meshes = std::make_shared<std::vector<MeshData>>();
+  MeshData tetra;
+  tetra.vertices = {0, 0, 0.03f, 0.03f, 0, -0.01f, -0.015f, 0.026f, -0.01f, -0.015f, -0.026f, -0.01f};
+  tetra.faces = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2};
+  meshes->push_back(tetra);
+  scene.meshes = meshes;
+  Shape tet;
+  tet.type = Shape::Type::kMesh;
+  tet.mesh = 0;
+  tet.body = 4;
+  tet.X_WS.p = Vec3(-0.08, -0.05, 0.01);
+  scene.shapes.push_back(tet);
+  Shape rod = capsule_shape(Vec3(0.06, -0.06, 0.01), Vec3(0.1, -0.02, 0.02), 0.006);
+  rod.body = 5;
+  scene.shapes.push_back(rod);
   compare(scene, cam, {}, "first frame (cache drawn)");
   compare(scene, cam, {}, "second frame (cache copied)");
   scene.shapes[2].X_WS.p.x() += 0.02;  // the moving box moves: the cache still holds
   compare(scene, cam, {}, "moved object");
+  scene.shapes[4].X_WS.p += Vec3(0.12, 0.07, 0.0);  // the mesh and the capsule move far
+  scene.shapes[4].X_WS.R = Eigen::AngleAxisd(1.0, Vec3::UnitZ());
+  scene.shapes[5].X_WS.p.x() -= 0.15;
+  compare(scene, cam, {}, "moved mesh and capsule");
+  SceneSnapshot static_and_hands = scene;  // no moving object: nothing to copy back next frame
+  static_and_hands.shapes.erase(static_and_hands.shapes.begin() + 2);
+  static_and_hands.shapes.resize(3);
+  compare(static_and_hands, cam, {}, "no moving objects");
+  compare(scene, cam, {}, "objects back");
+  // A rod from behind the camera to 30 cm in front of it, beside the optical axis: a bound
+  // through the camera plane is the whole image.
+  SceneSnapshot at_camera = scene;
+  const Pose X_WR{Quat(cam.X_WC().R), cam.X_WC() * Vec3(0.04, 0.03, 0.1)};
+  at_camera.shapes.push_back(box_shape(X_WR, Vec3(0.01, 0.01, 0.2)));
+  at_camera.shapes.back().body = 6;
+  compare(at_camera, cam, {}, "object through the camera plane");
+  compare(scene, cam, {}, "after the object around the camera");
+  RenderParams visible_same_light;
+  visible_same_light.hands = HandDrawMode::kVisible;
+  compare(scene, cam, visible_same_light, "visible hands (drawn over the copied world)");
+  compare(scene, cam, {}, "hidden again");
   scene.shapes[1].X_WS.p.y() -= 0.03;  // the static block moves: the cache must be redrawn
   compare(scene, cam, {}, "moved static block");
   compare(scene, odd_camera(), {}, "another camera and image size");
@@ -350,6 +414,76 @@ TEST(Renderer, CachedStaticWorldGivesTheSameTargetsAndFollowsChanges) {
   SceneSnapshot moving_only = scene;
   moving_only.shapes.erase(moving_only.shapes.begin(), moving_only.shapes.begin() + 2);
   compare(moving_only, cam, {}, "no static shapes");
+}
+
+TEST(Renderer, EachFrameStartsFromClearedTargets) {
+  SPIDAR_REQUIRE_GL();
+  // A renderer that drew hands (with and without a static world, visible and hidden, its targets
+  // read back or not: the renderer resets only where it saw hands when it knows) must give a
+  // next frame with other hands, or none, the targets of a renderer that never drew anything:
+  // nothing of the earlier hands may remain in hand depth, hand id or the depth buffer.
+  // Three fingers at x .. x + 5 cm; the first 2 cm under the table, whose depth buffer must not
+  // hide it from the hand targets.
+  auto hands_at = [](double x) {
+    SceneSnapshot s;
+    for (int f = 0; f < 3; ++f) {
+      const double z = f == 0 ? -0.02 : 0.05;
+      Shape finger = capsule_shape(Vec3(x, -0.03 + 0.025 * f, z), Vec3(x + 0.05, -0.02 + 0.025 * f, z + 0.01), 0.009);
+      finger.hand = f % 2;
+      finger.finger = f;
+      s.shapes.push_back(finger);
+    }
+    return s;
+  };
+  Shape table;
+  table.type = Shape::Type::kPlane;
+  table.size = Vec3(0.3, 0.3, 0);
+  table.body = 0;
+  Shape moving = box_shape(Pose{Quat::Identity(), Vec3(0.02, 0.0, 0.01)}, Vec3(0.03, 0.03, 0.03));
+  moving.body = 3;
+  const vision::Camera cam = vision::default_rig_camera();
+  auto used = Renderer::create(*gl_context()).value();
+  for (bool with_table : {true, false}) {
+    for (HandDrawMode mode : {HandDrawMode::kHidden, HandDrawMode::kVisible}) {
+     for (unsigned read_before : {0u, unsigned{kHandId}, unsigned{kAllTargets}}) {
+      RenderParams params;
+      params.hands = mode;
+      SceneSnapshot before = hands_at(-0.06), after = hands_at(0.03), none;
+      for (SceneSnapshot* s : {&before, &after, &none}) {
+        if (with_table) s->shapes.push_back(table);
+        s->shapes.push_back(moving);
+      }
+      ASSERT_TRUE(used->render(before, cam, params).ok());
+      if (read_before != 0) {
+        RenderTargets seen;
+        ASSERT_TRUE(used->read(&seen, read_before).ok());
+      }
+      for (const SceneSnapshot* next : {&after, &none}) {
+        auto fresh = Renderer::create(*gl_context()).value();
+        RenderTargets a, b;
+        ASSERT_TRUE(used->render(*next, cam, params).ok());
+        ASSERT_TRUE(used->read(&a).ok());
+        ASSERT_TRUE(fresh->render(*next, cam, params).ok());
+        ASSERT_TRUE(fresh->read(&b).ok());
+        EXPECT_EQ(differing_pixels(a, b), 0) << "table " << with_table << " visible "
+                                             << (mode == HandDrawMode::kVisible) << " read "
+                                             << read_before << " hands " << (next == &after);
+        if (next == &after) {
+          EXPECT_GT(cv::countNonZero(a.hand_id), 1000);
+        }
+      }
+     }
+    }
+  }
+  // Hands only, no scene: the same through a change of image size.
+  ASSERT_TRUE(used->render(hands_at(-0.06), odd_camera()).ok());
+  ASSERT_TRUE(used->render(hands_at(0.03), cam).ok());
+  auto fresh = Renderer::create(*gl_context()).value();
+  ASSERT_TRUE(fresh->render(hands_at(0.03), cam).ok());
+  RenderTargets a, b;
+  ASSERT_TRUE(used->read(&a).ok());
+  ASSERT_TRUE(fresh->read(&b).ok());
+  EXPECT_EQ(differing_pixels(a, b), 0) << "after a resize";
 }
 
 TEST(Renderer, ResizesToTheCamera) {

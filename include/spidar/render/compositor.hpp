@@ -11,6 +11,8 @@
 ///        that carried depth is in front of the scene (hand_depth < depth + depth_margin), with
 ///        the occlusion edge softened by a small box blur and multiplied by the matte's own soft
 ///        alpha:  out = a · real + (1 − a) · virtual,  a = matte · blur(in_front).
+///        Only the real hand's bounding box (grown by the blur radius) is composed; the rest of
+///        the image is the rendering with a = 0.
 ///        The nearest pixel is found on 2×2 blocks by default (carry_downsample).
 ///        Real-hand pixels farther than max_carry_px from any virtual-hand pixel (e.g. the
 ///        forearm, or no model at all) are shown or hidden by show_unmatched.
@@ -59,18 +61,30 @@ class Compositor {
   const CompositorParams& params() const { return params_; }
   void set_params(const CompositorParams& params) { params_ = params; }
 
-  /// Writes the composite (CV_8UC3) to `out`, reusing buffers between frames. Error on missing
-  /// or mismatched inputs, naming which.
-  Status compose(const CompositeInputs& in, cv::Mat* out);
-  /// The alpha of the real image in the last composite (CV_32FC1, 0..1), for tests and debugging.
+  /// Writes the composite (CV_8UC3) to `out` and, if `alpha` is given, the share of the real
+  /// image in it (CV_32FC1, 0..1) to `alpha`, reusing their buffers between frames (each pixel
+  /// of both is written: no copy of the rendering is needed first). Error on missing or
+  /// mismatched inputs, naming which.
+  Status compose(const CompositeInputs& in, cv::Mat* out, cv::Mat* alpha = nullptr);
+  /// The alpha of the real image in the last composite (CV_32FC1, 0..1), for tests and debugging:
+  /// the compositor's own buffer, or the caller's `alpha` when one was given (shared, not copied).
   const cv::Mat& last_alpha() const { return alpha_; }
 
  private:
-  Status compose_paper(const CompositeInputs& in, cv::Mat* out);
-  Status compose_depth(const CompositeInputs& in, cv::Mat* out);
+  Status compose_paper(const CompositeInputs& in, cv::Mat* out, cv::Mat* alpha);
+  Status compose_depth(const CompositeInputs& in, cv::Mat* out, cv::Mat* alpha);
+  /// In depth mode: fills front_ (roi-sized, 1 where the carried hand depth is in front of the
+  /// scene, show_unmatched where no hand depth reaches) from the distance map of the virtual
+  /// hand pixels. `roi` in image pixels.
+  Status carry_hand_depth(const RenderTargets& virt, const cv::Rect& roi);
 
   CompositorParams params_;
-  cv::Mat hand_mask_, front_, alpha_;
+  cv::Mat hand_mask_;
+  cv::Mat front_;                  ///< CV_8UC1 over the roi: 1 = real hand in front, 0 = behind
+  cv::Mat front_count_;            ///< CV_16UC1 over the roi: front_ pixels in the blur's box
+  std::vector<float> box_share_;   ///< count → blurred value, count / box area (as cv::blur)
+  cv::Mat alpha_;                  ///< see last_alpha()
+  bool alpha_shared_ = false;      ///< alpha_ is the caller's buffer (last compose had `alpha`)
   cv::Mat carried_;                ///< depth carried to each distance-map cell (NaN: none)
   std::vector<int> map_column_;    ///< roi column → distance-map column
   vision::SilhouetteDistance distance_;
