@@ -31,7 +31,7 @@ hand::HandParams mid_range(const hand::HandModel& m) {
 }
 
 /// Fingertip f's motion per radian of parameter `param` (forward difference of the kinematics).
-Vec3 motion(const hand::HandModel& m, const hand::HandParams& q, int f, int param) {
+Vec3 tip_motion(const hand::HandModel& m, const hand::HandParams& q, int f, int param) {
   constexpr double kStep = 1e-7;
   hand::HandParams moved = q;
   moved[param] += kStep;
@@ -52,7 +52,7 @@ TEST(FingerHold, AwayFromTheLimitsTheFingertipYieldsAsItsJointsMoveIt) {
   for (int f : {hand::kIndex, hand::kRing}) {
     const hand::DigitParams d = hand::digit_params(f);
     Mat3 ref = Mat3::Zero();
-    for (int p : {d.flexion, d.abduction, d.distal}) ref += motion(m, q, f, p) * motion(m, q, f, p).transpose();
+    for (int p : {d.flexion, d.abduction, d.distal}) ref += tip_motion(m, q, f, p) * tip_motion(m, q, f, p).transpose();
     ref /= Eigen::SelfAdjointEigenSolver<Mat3>(ref).eigenvalues().maxCoeff();
     const auto& h = holds[static_cast<std::size_t>(f)];
     ASSERT_LT(h.scale.maxCoeff(), device::kMaxHoldScale) << "finger " << f << ": none clamped";
@@ -68,8 +68,8 @@ TEST(FingerHold, TheMiddleFingerCannotYieldSideways) {
   const auto& h = finger_holds(m, q)[hand::kMiddle];
   // Its two joints move the fingertip in a plane; across it (their cross product) the hold is
   // as stiff as it gets, in the plane it yields.
-  const Vec3 a = motion(m, q, hand::kMiddle, hand::kMiddleMcpFlexion);
-  const Vec3 b = motion(m, q, hand::kMiddle, hand::kMiddleDip);
+  const Vec3 a = tip_motion(m, q, hand::kMiddle, hand::kMiddleMcpFlexion);
+  const Vec3 b = tip_motion(m, q, hand::kMiddle, hand::kMiddleDip);
   const Vec3 across = a.cross(b).normalized();
   int stiff = 0;
   for (int i = 0; i < 3; ++i) {
@@ -85,10 +85,10 @@ TEST(FingerHold, TheMiddleFingerCannotYieldSideways) {
 TEST(FingerHold, AJointAtItsLimitStiffensTheFingertipAlongItsMotion) {
   const hand::HandModel m = user_right();
   hand::HandParams q = mid_range(m);
-  const Vec3 abduct = motion(m, q, hand::kIndex, hand::kIndexMcpAbduction).normalized();
+  const Vec3 abduct = tip_motion(m, q, hand::kIndex, hand::kIndexMcpAbduction).normalized();
   const double free = abduct.dot(compliance(finger_holds(m, q)[hand::kIndex]) * abduct);
   q[hand::kIndexMcpAbduction] = m.limits.lower[hand::kIndexMcpAbduction];
-  const Vec3 at_limit = motion(m, q, hand::kIndex, hand::kIndexMcpAbduction).normalized();
+  const Vec3 at_limit = tip_motion(m, q, hand::kIndex, hand::kIndexMcpAbduction).normalized();
   const double held = at_limit.dot(compliance(finger_holds(m, q)[hand::kIndex]) * at_limit);
   EXPECT_LT(held, 0.1 * free) << free << " → " << held;
   // The other fingers do not care.
