@@ -17,9 +17,9 @@
 namespace spidar::render {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNoDepth = std::numeric_limits<float>::infinity();
 
-struct Scene {
+struct LayeredScene {
   RenderTargets virt;
   cv::Mat real_bgr, alpha;
 };
@@ -31,13 +31,13 @@ struct Composite {
 /// A scene of `size`: an object with a depth ramp, a virtual hand of a few blobs at depths
 /// around the object's, and a real hand (the blobs shifted, with a soft-edged matte whose values
 /// are multiples of 1/255 as the chroma key's). `seed` varies the layout.
-Scene make_scene(cv::Size size, int seed, bool at_border) {
+LayeredScene make_layered_scene(cv::Size size, int seed, bool at_border) {
   cv::RNG rng(static_cast<std::uint64_t>(seed) + 1);
-  Scene s;
+  LayeredScene s;
   s.virt.colour.create(size, CV_8UC3);
   rng.fill(s.virt.colour, cv::RNG::UNIFORM, 0, 256);
-  s.virt.depth = cv::Mat(size, CV_32FC1, kInf);
-  s.virt.hand_depth = cv::Mat(size, CV_32FC1, kInf);
+  s.virt.depth = cv::Mat(size, CV_32FC1, kNoDepth);
+  s.virt.hand_depth = cv::Mat(size, CV_32FC1, kNoDepth);
   s.virt.hand_id = cv::Mat(size, CV_8UC1, cv::Scalar(0));
   // The object: a rectangle whose depth rises to the right (0.45 .. 0.55 m).
   const cv::Rect object(size.width / 5, size.height / 4, size.width / 2, size.height / 2);
@@ -78,7 +78,7 @@ Scene make_scene(cv::Size size, int seed, bool at_border) {
 }
 
 /// The depth mode, pass by pass, as the compositor's doc comment states it.
-Composite reference_depth(const Scene& s, const CompositorParams& p) {
+Composite reference_depth(const LayeredScene& s, const CompositorParams& p) {
   const RenderTargets& v = s.virt;
   Composite c{v.colour.clone(), cv::Mat(v.colour.size(), CV_32FC1, 0.f)};
   cv::Rect roi = cv::boundingRect(s.alpha > 0.f);
@@ -132,7 +132,7 @@ Composite reference_depth(const Scene& s, const CompositorParams& p) {
 }
 
 /// The paper mode: the real image where the virtual hand is front-most.
-Composite reference_paper(const Scene& s) {
+Composite reference_paper(const LayeredScene& s) {
   const RenderTargets& v = s.virt;
   const cv::Mat front = v.hand_depth < v.depth;
   Composite c{v.colour.clone(), cv::Mat()};
@@ -157,7 +157,7 @@ TEST(CompositorReference, DepthModeIsTheReferenceBitForBit) {
   int cases = 0;
   for (const cv::Size size : {cv::Size(160, 120), cv::Size(131, 97)}) {
     for (int seed = 0; seed < 3; ++seed) {
-      const Scene s = make_scene(size, seed, seed == 1);
+      const LayeredScene s = make_layered_scene(size, seed, seed == 1);
       for (int blur : {0, 1, 3, 16}) {
         for (int downsample : {1, 2}) {
           for (int carry : {1, 7, 48}) {
@@ -196,7 +196,7 @@ TEST(CompositorReference, DepthModeIsTheReferenceBitForBit) {
 TEST(CompositorReference, DepthModeScenesShowBothOutcomes) {
   // The scenes above are not trivial: the real hand is partly in front of the object, partly
   // behind it, with soft edges, so a wrong carry or blur would change pixels.
-  const Scene s = make_scene(cv::Size(160, 120), 0, false);
+  const LayeredScene s = make_layered_scene(cv::Size(160, 120), 0, false);
   const Composite c = reference_depth(s, CompositorParams{});
   const cv::Mat in_matte = s.alpha > 0.f;
   EXPECT_GT(cv::countNonZero(c.alpha >= 1.f), 100);
@@ -209,7 +209,7 @@ TEST(CompositorReference, PaperModeIsTheReferenceBitForBit) {
   cv::Mat out, alpha;
   for (const cv::Size size : {cv::Size(160, 120), cv::Size(131, 97)}) {
     for (int seed = 0; seed < 3; ++seed) {
-      const Scene s = make_scene(size, seed, seed == 1);
+      const LayeredScene s = make_layered_scene(size, seed, seed == 1);
       ASSERT_TRUE(compositor.compose({&s.virt, s.real_bgr, s.alpha}, &out, &alpha).ok());
       const Composite want = reference_paper(s);
       ASSERT_GT(cv::countNonZero(want.alpha), 100);
@@ -221,12 +221,12 @@ TEST(CompositorReference, PaperModeIsTheReferenceBitForBit) {
 
 TEST(CompositorReference, OwnAlphaBufferIsNotTheOneLentBefore) {
   // After a composite into the caller's alpha, one without it must not write into that buffer.
-  const Scene s = make_scene(cv::Size(160, 120), 2, false);
+  const LayeredScene s = make_layered_scene(cv::Size(160, 120), 2, false);
   Compositor compositor;
   cv::Mat out, lent;
   ASSERT_TRUE(compositor.compose({&s.virt, s.real_bgr, s.alpha}, &out, &lent).ok());
   const cv::Mat kept = lent.clone();
-  Scene other = s;
+  LayeredScene other = s;
   other.alpha = cv::Mat(s.alpha.size(), CV_32FC1, 0.f);
   ASSERT_TRUE(compositor.compose({&other.virt, other.real_bgr, other.alpha}, &out).ok());
   EXPECT_EQ(differing(lent, kept), 0);
