@@ -65,7 +65,8 @@ TEST(FingerHold, AwayFromTheLimitsTheFingertipYieldsAsItsJointsMoveIt) {
 TEST(FingerHold, TheMiddleFingerCannotYieldSideways) {
   const hand::HandModel m = user_right();
   const hand::HandParams q = mid_range(m);
-  const auto& h = finger_holds(m, q)[hand::kMiddle];
+  const auto holds = finger_holds(m, q);
+  const auto& h = holds[hand::kMiddle];
   // Its two joints move the fingertip in a plane; across it (their cross product) the hold is
   // as stiff as it gets, in the plane it yields.
   const Vec3 a = tip_motion(m, q, hand::kMiddle, hand::kMiddleMcpFlexion);
