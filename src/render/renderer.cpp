@@ -122,6 +122,16 @@ Status compile(GLenum type, const char* source, GLuint* out) {
   return Ok{};
 }
 
+/// Clears the bound framebuffer's colour target (draw buffer 0) to the background and its depth
+/// target (draw buffer 1) to +inf (nothing there).
+void clear_colour_and_depth_targets(const RenderParams& params) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const float bg[4] = {params.background_rgb[0], params.background_rgb[1], params.background_rgb[2], 1.f};
+  const float far_value[4] = {inf, inf, inf, inf};
+  gl::ClearBufferfv(GL_COLOR, 0, bg);
+  gl::ClearBufferfv(GL_COLOR, 1, far_value);
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -528,12 +538,7 @@ struct Renderer::Impl {
       gl::BindFramebuffer(GL_FRAMEBUFFER, static_world.fbo);
       const GLenum targets[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
       gl::DrawBuffers(2, targets);
-      const float inf = std::numeric_limits<float>::infinity();
-      const float bg[4] = {params.background_rgb[0], params.background_rgb[1],
-                           params.background_rgb[2], 1.f};
-      const float far_value[4] = {inf, inf, inf, inf};
-      gl::ClearBufferfv(GL_COLOR, 0, bg);
-      gl::ClearBufferfv(GL_COLOR, 1, far_value);
+      clear_colour_and_depth_targets(params);
       gl::ClearBufferfi(GL_DEPTH_STENCIL, 0, 1.f, 0);
       draw(static_batches, first, meshes);
       static_key.swap(key_scratch);
@@ -684,12 +689,7 @@ Status Renderer::render(const SceneSnapshot& scene, const vision::Camera& camera
   if (static_count == 0) {
     const GLenum scene_targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_NONE};
     gl::DrawBuffers(4, scene_targets);
-    const float inf = std::numeric_limits<float>::infinity();
-    const float bg[4] = {params.background_rgb[0], params.background_rgb[1],
-                         params.background_rgb[2], 1.f};
-    const float far_value[4] = {inf, inf, inf, inf};
-    gl::ClearBufferfv(GL_COLOR, 0, bg);
-    gl::ClearBufferfv(GL_COLOR, 1, far_value);
+    clear_colour_and_depth_targets(params);
   }
   if (auto st = r.reset_hand_targets(); !st) return st;
 

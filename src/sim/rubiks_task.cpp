@@ -145,16 +145,18 @@ void RubiksTask::goals(double t_run, std::span<Vec3> goal) {
     prev_goal_[f] = goal[f];
   }
   prev_goal_t_ = t_run;
-  // The holds at the present script time (during a cross-fade, those of where it is going).
-  for (int f = 0; f < 8; ++f) {
-    const int h = f >= 4 ? 1 : 0;
+  // The holds at the present script time (during a cross-fade, those of where it is going): the
+  // nearest fitted sample, turned with its hand's grasp frame and yaw.
+  for (int h = 0; h < 2; ++h) {
     const auto& table = fitted_hold_[h];
     if (table.empty()) continue;
-    const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
-    const device::FingertipHold& local = table[static_cast<std::size_t>(std::lround(x))][f % 4];
+    const auto [k, w] = fit_sample(t, table.size());
+    const auto& local = table[w < 0.5 ? k : k + 1];
     const Quat q_WG(frames_.q_WG[h][0], frames_.q_WG[h][1], frames_.q_WG[h][2], frames_.q_WG[h][3]);
-    const Mat3 R_WG = q_WG.toRotationMatrix() * rot_z(state(t, h == 0 ? hand::Side::kLeft : hand::Side::kRight, f).yaw);
-    holds_[static_cast<std::size_t>(f)] = {R_WG * local.R_WE, local.scale};
+    const Mat3 R_WG =
+        q_WG.toRotationMatrix() * rot_z(state(t, h == 0 ? hand::Side::kLeft : hand::Side::kRight, 0).yaw);
+    for (int f = 0; f < 4; ++f)
+      holds_[static_cast<std::size_t>(4 * h + f)] = {R_WG * local[f].R_WE, local[f].scale};
   }
 }
 
@@ -215,11 +217,15 @@ Vec3 RubiksTask::path(double t, int f) const {
   return fitted_touch(t, f) + pressing(t, f);  // the fitted touching positions, pressed in
 }
 
+RubiksTask::FitSample RubiksTask::fit_sample(double t, std::size_t n) const {
+  const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(n - 1));
+  const auto k = std::min(static_cast<std::size_t>(x), n - 2);
+  return {k, x - static_cast<double>(k)};
+}
+
 Vec3 RubiksTask::fitted_touch(double t, int f) const {
   const auto& table = fitted_[f >= 4 ? 1 : 0];
-  const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
-  const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
-  const double w = x - static_cast<double>(k);
+  const auto [k, w] = fit_sample(t, table.size());
   return (1.0 - w) * table[k][f % 4] + w * table[k + 1][f % 4];
 }
 
@@ -233,9 +239,7 @@ Vec3 RubiksTask::pressing(double t, int f) const {
     const device::FingertipHold& h = table[k][f % 4];
     return Mat3(h.R_WE * h.scale.cwiseInverse().asDiagonal() * h.R_WE.transpose());
   };
-  const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
-  const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
-  const double w = x - static_cast<double>(k);
+  const auto [k, w] = fit_sample(t, table.size());
   return ((1.0 - w) * compliance(k) + w * compliance(k + 1)) * s;
 }
 
@@ -259,9 +263,7 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal,
 hand::HandParams RubiksTask::nominal_local(double t, hand::Side side) const {
   const auto& table = fitted_q_[side == hand::Side::kRight ? 1 : 0];
   if (table.empty()) return script_nominal_local(t, side);
-  const double x = std::clamp(t / fit_dt_, 0.0, static_cast<double>(table.size() - 1));
-  const auto k = std::min(static_cast<std::size_t>(x), table.size() - 2);
-  const double w = x - static_cast<double>(k);
+  const auto [k, w] = fit_sample(t, table.size());
   hand::HandParams q = table[k];
   q.q = (1.0 - w) * table[k].q + w * table[k + 1].q;  // neighbours 10 ms apart: small steps
   return q;

@@ -205,6 +205,13 @@ class RubiksTask final : public device::FingertipSource {
   /// force, and the fingertip yields only where the finger can move (a goal straight into the
   /// face along a stiff direction would slide it sideways instead). Without a fit, squeeze_path.
   Vec3 pressing(double t_s, int f) const;
+  /// Where script time t falls between the fitted samples (a table of n ≥ 2, every fit_dt_):
+  /// sample k and the weight of sample k + 1.
+  struct FitSample {
+    std::size_t k;
+    double w;
+  };
+  FitSample fit_sample(double t_s, std::size_t n) const;
   /// The fitted touching position of finger f at script time t (fit_to_hands), grasp frame.
   Vec3 fitted_touch(double t_s, int f) const;
   /// Outward normal of the face finger f (0..7) grasps, in its hand's grasp frame.
