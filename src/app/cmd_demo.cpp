@@ -61,8 +61,9 @@ Action add_demo(CLI::App& app) {
   cmd->add_flag("--shaped-fingers", o->shaped_fingers,
                 "the simulated user's fingertips yield only where their fingers can move (stiffness "
                 "ellipsoids from their hands): their hands then reach the device's caps");
-  cmd->add_flag("--silhouette", o->silhouette,
-                "register with the silhouette term too (default: the paper's joint-balls)");
+  cmd->add_flag("!--paper-registration", o->silhouette,
+                "register the main fit with the paper's joint-balls alone (default: joint-balls and "
+                "the hand-aware silhouette term; the other method always runs as the comparison)");
   cmd->add_flag("!--no-video", o->video, "do not write mixed_reality.mp4");
   cmd->add_option("--out", o->out, "output directory")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "length [s] (0: the scenario's own)");

@@ -22,7 +22,7 @@ struct DemoOptions {
   double fps = 30.0;               ///< camera rate [Hz]
   bool window = false;
   std::string compositor = "depth";
-  bool silhouette = false;         ///< the silhouette term in the main registration
+  bool silhouette = true;          ///< the silhouette term in the main registration
   bool fixed_hand_size = false;    ///< no online hand-size personalisation (on in the demo)
   bool shaped_fingers = false;     ///< the user's fingertips held with their fingers' stiffness
   bool video = true;

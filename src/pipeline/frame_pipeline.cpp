@@ -8,6 +8,7 @@
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/render/hand_shapes.hpp"
+#include "spidar/registration/coverage.hpp"
 #include "spidar/vision/silhouette.hpp"
 
 namespace spidar::pipeline {
@@ -68,6 +69,10 @@ struct FramePipeline::Impl {
   std::array<render::HandSkin, 2> skins;
   std::array<hand::HandParams, 2> previous;
   bool have_previous = false;
+  /// The silhouette term's coverage direction: both hands' outlines at the previous fits and the
+  /// silhouette pixels each owns (registration/coverage.hpp).
+  std::array<registration::ProjectedHand, 2> outlines;
+  std::array<std::vector<registration::OwnedPixel>, 2> owned;
   /// Online size estimates (personalise_shape), and the sizes the skins were last built with.
   std::array<registration::ShapeEstimator, 2> shape;
   std::array<hand::HandDimensions, 2> skin_dims;
@@ -99,6 +104,9 @@ Result<std::unique_ptr<FramePipeline>> FramePipeline::create(
   if (params.skinned_hands) {
     if (auto s = render::validate(params.model_skin); !s) return Error{"frame pipeline: model_skin: " + s.error().message};
   }
+  if (params.silhouette_downsample != 1 && params.silhouette_downsample != 2)
+    return Error{"frame pipeline: silhouette_downsample: expected 1 or 2, got " +
+                 std::to_string(params.silhouette_downsample)};
   for (const auto& hand_fingers : params.fingers) {
     for (int f : hand_fingers) {
       if (f < 0 || f >= device::kMaxFingers)
@@ -186,11 +194,26 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   registration::ImageEvidence image;
   image.camera = &s.camera;
   image.alpha = out->key.alpha;
-  if (p.registration.silhouette_term) {
+  if (p.registration.silhouette_term && p.registration.silhouette_inward) {
     vision::SilhouetteDistanceOptions o;
     o.max_distance_px = p.silhouette_margin_px;
+    o.downsample = p.silhouette_downsample;
     if (auto st = vision::silhouette_distance(out->key.silhouette, &s.distance, o); !st) return st;
     image.distance = &s.distance;
+  }
+  if (p.registration.silhouette_term) {
+    if (s.have_previous) {
+      for (int h = 0; h < 2; ++h) {
+        const double forearm_radius =
+            p.registration.bracelet_radius_per_width * s.models[h].shape.dimensions.width +
+            p.registration.bracelet_standoff_m;
+        registration::project_hand(s.models[h], s.previous[h], s.camera, forearm_radius, &s.outlines[h]);
+      }
+      registration::coverage_evidence(out->key.silhouette, {&s.outlines[0], &s.outlines[1]},
+                                      p.registration, &s.owned);
+    } else {
+      for (auto& pixels : s.owned) pixels.clear();
+    }
   }
   tm.distance_ms = ms_since(t0);
 
@@ -214,10 +237,12 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       obs.wrist_confidence = out->bracelets[h].confidence;
     }
     const bool cold = !s.have_previous;
+    registration::ImageEvidence hand_image = image;
+    if (p.registration.silhouette_term && s.have_previous) hand_image.coverage = &s.owned[h];
     auto fit_from = [&](hand::HandParams q, const hand::HandParams* prior, int rounds,
                         registration::FitReport* report) {
       for (int r = 0; r < rounds; ++r) {
-        const registration::FitReport rr = s.solver.fit(s.models[h], obs, image, prior, &q);
+        const registration::FitReport rr = s.solver.fit(s.models[h], obs, hand_image, prior, &q);
         if (r == 0) report->cost_initial = rr.cost_initial;
         report->iterations += rr.iterations;
         report->cost_final = rr.cost_final;

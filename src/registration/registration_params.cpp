@@ -35,6 +35,9 @@ constexpr Field kFields[] = {
      "px"},
     {"silhouette_samples_per_bone", nullptr, &RegistrationParams::silhouette_samples_per_bone, 1.0,
      kMaxSilhouetteSamplesPerBone, false, ""},
+    {"coverage_sigma_px", &RegistrationParams::coverage_sigma_px, nullptr, 0.0, 1000.0, true, "px"},
+    {"coverage_stride_px", nullptr, &RegistrationParams::coverage_stride_px, 1.0, 64.0, false, "px"},
+    {"coverage_max_px", &RegistrationParams::coverage_max_px, nullptr, 0.0, 1000.0, true, "px"},
     {"prior_sigma_wrist_m", &RegistrationParams::prior_sigma_wrist_m, nullptr, 0.0, 100.0, true,
      "m"},
     {"prior_sigma_rotation_rad", &RegistrationParams::prior_sigma_rotation_rad, nullptr, 0.0,
@@ -84,8 +87,9 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
   node.expect_keys({"fingertip_sigma_m", "wrist_sigma_px", "bracelet_offset_m",
                     "bracelet_surface_shift", "bracelet_radius_per_width", "bracelet_standoff_m",
                     "joint_ball_sigma_px", "joint_ball_alpha", "ball_radius_scale",
-                    "matte_threshold", "silhouette_term", "silhouette_sigma_px",
-                    "silhouette_samples_per_bone", "prior_sigma_wrist_m",
+                    "matte_threshold", "silhouette_term", "silhouette_inward", "silhouette_sigma_px",
+                    "silhouette_samples_per_bone", "coverage_sigma_px", "coverage_stride_px",
+                    "coverage_max_px", "prior_sigma_wrist_m",
                     "prior_sigma_rotation_rad", "prior_sigma_joint_rad", "lambda_initial",
                     "max_iterations", "cost_epsilon", "step_epsilon", "relative_epsilon"});
   RegistrationParams p;
@@ -104,6 +108,7 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
     if (!in_range(f, v)) child->fail(expectation(f, v));
   }
   if (auto b = node.find("silhouette_term")) p.silhouette_term = b->as_bool();
+  if (auto b = node.find("silhouette_inward")) p.silhouette_inward = b->as_bool();
   // Every field was range-checked at its key; this only guards against the table and the
   // struct drifting apart.
   if (auto s = validate(p); !s.ok()) node.fail(s.error().message);

@@ -171,6 +171,14 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
       const Vec3 p = bone_point(*pr.model, s, silhouette_bone(sp.bone), sp.t, J3p);
       add_projected(Term::kSilhouette, p, sp.offset_px, sp.target_px, w_sil);
     }
+    // Owned silhouette pixels left uncovered, pulling the nearest part's edge.
+    const double w_cov = 1.0 / rp.coverage_sigma_px;
+    for (int k = 0; k < tg.coverage_count; ++k) {
+      const SilhouettePoint& sp = tg.coverage[k];
+      const Vec3 p = sp.bone >= 0 ? bone_point(*pr.model, s, silhouette_bone(sp.bone), sp.t, J3p)
+                                  : rigid_point(s, sp.palm_H, J3p);
+      add_projected(Term::kSilhouette, p, sp.offset_px, sp.target_px, w_cov);
+    }
   }
 
   // The temporal prior, per parameter.

@@ -1,6 +1,9 @@
 #include "spidar/registration/residuals.hpp"
 
+#include <limits>
 #include <vector>
+
+#include "spidar/registration/coverage.hpp"
 
 #include "residual_terms.hpp"
 
@@ -55,6 +58,37 @@ void freeze_silhouette(const ResidualProblem& pr, const detail::PoseState& s,
   }
 }
 
+/// Owned silhouette pixels (ImageEvidence::coverage) that the pose leaves uncovered, each with the
+/// nearest part's edge point.
+void freeze_coverage(const ResidualProblem& pr, const hand::HandParams& q,
+                     const vision::Camera& camera, const std::vector<OwnedPixel>& owned,
+                     FrozenTargets* tg) {
+  if (owned.empty()) return;
+  ProjectedHand outline;
+  project_hand(*pr.model, q, camera, 0.0, &outline);
+  const auto n = static_cast<int>(owned.size());
+  const int step = (n + kMaxCoveragePoints - 1) / kMaxCoveragePoints;
+  for (int i = 0; i < n && tg->coverage_count < kMaxCoveragePoints; i += step) {
+    const Vec2& px = owned[static_cast<std::size_t>(i)].px;
+    // Most owned pixels stay covered by the part that covered them when the owner was decided.
+    if (part_distance(outline, owned[static_cast<std::size_t>(i)].part, px) <= detail::kSilhouetteTolerancePx)
+      continue;
+    const OutlineNearest near = nearest_part(outline, px);
+    if (!(near.distance_px > detail::kSilhouetteTolerancePx) || near.distance_px == std::numeric_limits<double>::infinity()) continue;
+    SilhouettePoint sp;
+    sp.bone = near.bone;
+    sp.target_px = px;
+    if (near.bone >= 0) {
+      const ImageCapsule& c = outline.bones[near.bone];
+      sp.t = near.t;
+      sp.offset_px = near.edge_px - (c.a + near.t * (c.c - c.a));
+    } else {
+      sp.palm_H = near.palm_H;
+    }
+    tg->coverage[tg->coverage_count++] = sp;
+  }
+}
+
 /// Collects the rows (tests only).
 struct StackSink {
   std::vector<double> r;
@@ -96,6 +130,7 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   tg->wrist_active = false;
   for (JointBall& b : tg->balls) b = JointBall{};
   tg->silhouette_count = 0;
+  tg->coverage_count = 0;
   const ImageEvidence* image = pr.image;
   if (!image || !image->camera) return;
   const vision::Camera& camera = *image->camera;
@@ -110,9 +145,11 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   if (!image->alpha.empty() && image->alpha.type() == CV_32FC1) {
     joint_ball_targets(*pr.model, s.points, camera, image->alpha, *pr.params, &tg->balls);
   }
-  if (pr.params->silhouette_term && image->distance && !image->distance->empty) {
+  if (pr.params->silhouette_term && pr.params->silhouette_inward && image->distance &&
+      !image->distance->empty) {
     freeze_silhouette(pr, s, camera, *image->distance, tg);
   }
+  if (pr.params->silhouette_term && image->coverage) freeze_coverage(pr, q, camera, *image->coverage, tg);
 }
 
 TermCosts term_costs(const ResidualProblem& pr, const FrozenTargets& tg, const hand::HandParams& q) {

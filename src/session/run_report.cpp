@@ -318,7 +318,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"stage_ms_median",
          {{"chroma_key", quantile(column(t, [](const MrFrame& m) { return m.stages.key_ms; }), 0.5)},
           {"bracelets", quantile(column(t, [](const MrFrame& m) { return m.stages.bracelet_ms; }), 0.5)},
-          {"distance_transform", quantile(column(t, [](const MrFrame& m) { return m.stages.distance_ms; }), 0.5)},
+          {"silhouette_evidence", quantile(column(t, [](const MrFrame& m) { return m.stages.distance_ms; }), 0.5)},
           {"registration", quantile(column(t, [](const MrFrame& m) { return m.stages.registration_ms; }), 0.5)},
           {"render", quantile(column(t, [](const MrFrame& m) { return m.stages.render_ms; }), 0.5)},
           {"composite", quantile(column(t, [](const MrFrame& m) { return m.stages.composite_ms; }), 0.5)}}},

@@ -14,6 +14,8 @@
 #include <cstring>
 #include <string>
 #include <vector>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "source_path.hpp"
 #include "spidar/hand/hand_config.hpp"
@@ -38,6 +40,8 @@ struct Args {
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
+  std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
+  std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below 0.5
   double shape_w = 0, shape_dq = 0;
 };
 
@@ -74,6 +78,8 @@ int main(int argc, char** argv) {
     else if (k == "--t1") a.t1 = std::atof(next().c_str());
     else if (k == "--fps") a.fps = std::atof(next().c_str());
     else if (k == "--verbose") a.verbose = true;
+    else if (k == "--dump") a.dump_dir = next();
+    else if (k == "--set") a.sets.push_back(next());
     else {
       std::fprintf(stderr, "registration_study: unknown argument %s\n", k.c_str());
       return 2;
@@ -114,6 +120,22 @@ int main(int argc, char** argv) {
   if (a.no_balls) p.registration.joint_ball_sigma_px = 1000;
   if (a.no_wrist) p.registration.wrist_sigma_px = 1000;
   p.personalise_shape = a.personalise;
+  for (const std::string& kv : a.sets) {
+    const auto eq = kv.find('=');
+    const std::string key = kv.substr(0, eq);
+    const double v = std::atof(kv.substr(eq + 1).c_str());
+    if (key == "coverage_sigma_px") p.registration.coverage_sigma_px = v;
+    else if (key == "coverage_stride_px") p.registration.coverage_stride_px = static_cast<int>(v);
+    else if (key == "coverage_max_px") p.registration.coverage_max_px = v;
+    else if (key == "silhouette_sigma_px") p.registration.silhouette_sigma_px = v;
+    else if (key == "joint_ball_sigma_px") p.registration.joint_ball_sigma_px = v;
+    else if (key == "silhouette_downsample") p.silhouette_downsample = static_cast<int>(v);
+    else if (key == "max_iterations") p.registration.max_iterations = static_cast<int>(v);
+    else {
+      std::fprintf(stderr, "registration_study: --set: unknown key %s\n", key.c_str());
+      return 2;
+    }
+  }
   if (a.shape_w > 0) p.shape_estimator.solve_every = static_cast<int>(a.shape_w);
   if (a.shape_dq > 0) p.shape_estimator.min_pose_change = a.shape_dq;
   sim::RubiksTask task({});
@@ -198,6 +220,20 @@ int main(int argc, char** argv) {
       for (int k = 0; k < 6; ++k)
         brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
       ++brace_n;
+    }
+    if (!a.dump_dir.empty() && m.iou < 0.5) {
+      // Green: the real hands only; red: the fitted model's hand pixels; the frame beside.
+      cv::Mat overlay(frame.hand_only.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+      overlay.setTo(cv::Scalar(0, 200, 0), frame.hand_only);
+      cv::Mat both;
+      cv::bitwise_and(frame.hand_only, ws.model_mask, both);
+      overlay.setTo(cv::Scalar(0, 0, 220), ws.model_mask);
+      overlay.setTo(cv::Scalar(0, 220, 220), both);
+      cv::Mat row;
+      cv::hconcat(frame.bgr, overlay, row);
+      char name[64];
+      std::snprintf(name, sizeof name, "/t%05.2f.png", t);
+      cv::imwrite(a.dump_dir + name, row);
     }
     obs.push_back(1e3 * obs_res);
     caps.push_back(1e3 * cap_res);

@@ -21,6 +21,7 @@
 #include "spidar/vision/bracelet.hpp"
 #include "spidar/vision/camera.hpp"
 #include "spidar/vision/chroma_key.hpp"
+#include "spidar/registration/coverage.hpp"
 #include "spidar/vision/silhouette.hpp"
 
 namespace spidar::registration::test {
@@ -102,6 +103,23 @@ inline void draw_capsule_mask(const hand::HandModel& model, const hand::HandPara
     cv::convexHull(pts, hull);
     cv::fillConvexPoly(*mask, hull, 255);
   }
+}
+
+/// The silhouette pixels each hand owns with both hands drawn at `poses` (coverage.hpp).
+inline std::array<std::vector<OwnedPixel>, 2> owned_pixels(const cv::Mat& silhouette,
+                                                     const std::array<hand::HandModel, 2>& models,
+                                                     const std::array<hand::HandParams, 2>& poses,
+                                                     const vision::Camera& camera,
+                                                     const RegistrationParams& params) {
+  std::array<ProjectedHand, 2> outline;
+  for (int h = 0; h < 2; ++h) {
+    const double forearm = params.bracelet_radius_per_width * models[h].shape.dimensions.width +
+                           params.bracelet_standoff_m;
+    project_hand(models[h], poses[h], camera, forearm, &outline[h]);
+  }
+  std::array<std::vector<OwnedPixel>, 2> owned;
+  coverage_evidence(silhouette, {&outline[0], &outline[1]}, params, &owned);
+  return owned;
 }
 
 /// Image evidence built from a mask: alpha (mask / 255) and its distance transform.

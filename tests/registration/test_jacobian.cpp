@@ -15,6 +15,7 @@ struct Case {
   vision::Camera camera = vision::default_rig_camera();
   test::MaskEvidence mask;
   RegistrationParams params;
+  std::vector<OwnedPixel> owned;  ///< silhouette pixels of this hand (coverage.hpp)
 };
 
 // The true hand draws the silhouette; the evaluation pose q is a perturbation of it, so that
@@ -35,15 +36,24 @@ void make_case(int side, std::uint32_t seed, Case* c) {
   b.confidence = 0.8;
   c->obs = test::observe(c->model, c->truth, b, rng, 0.001);
   c->params.silhouette_term = true;
+  c->params.silhouette_inward = true;
   c->params.silhouette_samples_per_bone = 4;
+  // No other hand: this one owns its silhouette, decided at the truth.
+  ProjectedHand outline;
+  project_hand(c->model, c->truth, c->camera, 0.03, &outline);
+  std::array<std::vector<OwnedPixel>, 2> owned;
+  coverage_evidence(m, {&outline, nullptr}, c->params, &owned);
+  c->owned = owned[0];
 }
 
 TEST(ResidualJacobian, MatchesCentralDifferences) {
+  int palm_points = 0;  // coverage points held by the palm box, over all cases
   for (int side = 0; side < 2; ++side) {
     for (std::uint32_t seed : {1u, 2u, 3u}) {
       Case c;
       make_case(side, seed, &c);
-      const ImageEvidence image = c.mask.evidence(&c.camera, true);
+      ImageEvidence image = c.mask.evidence(&c.camera, true);
+      image.coverage = &c.owned;
       const ResidualProblem pr{&c.model, &c.obs, &image, &c.prior, &c.params};
       FrozenTargets tg;
       freeze_targets(pr, c.q, &tg);
@@ -55,6 +65,8 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
       EXPECT_GT(costs.silhouette, 0.0);
       EXPECT_GT(costs.prior, 0.0);
       EXPECT_GT(tg.silhouette_count, 5);
+      EXPECT_GT(tg.coverage_count, 5) << "side " << side << " seed " << seed;
+      for (int k = 0; k < tg.coverage_count; ++k) palm_points += tg.coverage[k].bone < 0 ? 1 : 0;
 
       VecX r;
       MatX J;
@@ -83,6 +95,7 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
       }
     }
   }
+  EXPECT_GT(palm_points, 0);
 }
 
 TEST(ResidualJacobian, NonFiniteObservationsAreIgnored) {

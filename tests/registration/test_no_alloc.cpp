@@ -17,9 +17,10 @@ TEST(NoAllocation, FitWithEveryTerm) {
   for (int h = 0; h < 2; ++h) test::draw_capsule_mask(models[h], truth[h], camera, &mask);
   test::MaskEvidence ev;
   test::evidence_from_mask(mask, &ev);
-  const ImageEvidence image = ev.evidence(&camera, true);
   RegistrationParams params;
   params.silhouette_term = true;
+  params.silhouette_inward = true;
+  const auto owned = test::owned_pixels(mask, models, truth, camera, params);
   const SuccessiveAdjustment solver(params);
   std::mt19937 rng(5);
   std::array<HandObservation, 2> obs;
@@ -37,6 +38,8 @@ TEST(NoAllocation, FitWithEveryTerm) {
   int iterations = 0;
   for (int h = 0; h < 2; ++h) {
     hand::HandParams q = start[h];
+    ImageEvidence image = ev.evidence(&camera, true);
+    image.coverage = &owned[h];
     iterations += solver.fit(models[h], obs[h], image, &start[h], &q).iterations;
   }
   alloc::stop();

@@ -36,7 +36,10 @@ struct FramePipelineParams {
   registration::RegistrationParams registration;
   render::CompositorParams compositor;  ///< its mode makes `composite`
   bool other_composite = true;          ///< also compose in the other mode (for comparison)
-  int silhouette_margin_px = 40;        ///< distance-transform margin (silhouette term only)
+  int silhouette_margin_px = 40;        ///< distance-transform margin (inward silhouette only)
+  /// The distance transform at full (1) or half (2) resolution (vision/silhouette.hpp): half costs
+  /// about a quarter and moves a pulled point's target by at most ~2 px.
+  int silhouette_downsample = 1;
   int first_frame_rounds = 6;           ///< registration rounds on the first frame (cold start)
   /// A bracelet farther than this share of the image width from where the previous fit predicts
   /// it is ignored for that frame (e.g. 0.06 = 38 px at 640 px); 0 = off (default: tried on the
@@ -66,6 +69,8 @@ struct FramePipelineParams {
 
 /// Wall-clock cost of each stage [ms].
 struct FrameTimings {
+  /// distance_ms: the silhouette term's evidence (which hand owns which silhouette pixel, and
+  /// the distance transform when the inward direction is on); 0 without the term.
   double key_ms = 0, bracelet_ms = 0, distance_ms = 0, registration_ms = 0, render_ms = 0,
          composite_ms = 0, total_ms = 0;
 };

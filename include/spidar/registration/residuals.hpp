@@ -12,6 +12,8 @@
 ///   joint-ball (uv(joint j)(θ) − P̃_j) / σ_ball (2 rows per ball with on_count ≥ 1)       [px / px]
 ///   silhouette (uv(axis point)(θ) + offset − nearest) / σ_sil (2 rows per point found outside
 ///              the real silhouette by more than 0.5 px when frozen)                      [px / px]
+///   coverage   (uv(edge point)(θ) − owned pixel) / σ_cov (2 rows per silhouette pixel this hand
+///              owns and leaves uncovered by more than 0.5 px when frozen; coverage.hpp)  [px / px]
 ///   prior      (θ_i − θ_prior,i) / σ_group (1 row per parameter with a finite prior)
 /// Frozen with the targets: the joint-ball targets P̃, each silhouette point's nearest silhouette
 /// pixel and its offset from the projected axis point (± the projected radius across the bone),
@@ -32,6 +34,9 @@ namespace spidar::registration {
 inline constexpr int kSilhouetteBoneCount = 3 + 4 * 4;  // 19
 inline constexpr int kMaxSilhouettePoints =
     kSilhouetteBoneCount * kMaxSilhouetteSamplesPerBone * 3;
+/// At most this many uncovered silhouette pixels per linearisation (coverage.hpp); more owned
+/// pixels are thinned evenly.
+inline constexpr int kMaxCoveragePoints = 768;
 
 /// Finger and segment (0 = metacarpal, hand_shape.hpp) of silhouette bone `bone` (0..18).
 struct BoneRef {
@@ -42,10 +47,11 @@ BoneRef silhouette_bone(int bone);
 
 /// One silhouette sample that lies outside the real silhouette (frozen at the linearisation).
 struct SilhouettePoint {
-  int bone = 0;                  ///< 0..18 (silhouette_bone)
+  int bone = 0;                  ///< 0..18 (silhouette_bone); −1: the palm box's point palm_H
   double t = 0;                  ///< along the bone axis: 0 proximal joint, 1 distal joint
   Vec2 offset_px = Vec2::Zero(); ///< from the projected axis point to this point [px]
   Vec2 target_px = Vec2::Zero(); ///< the nearest silhouette pixel [px]
+  Vec3 palm_H = Vec3::Zero();    ///< bone −1: the point on the palm box, right-hand H [m]
 };
 
 /// Everything one linearisation holds fixed. Plain fixed-size storage (about 30 KiB).
@@ -57,6 +63,11 @@ struct FrozenTargets {
   JointBalls balls{};
   std::array<SilhouettePoint, kMaxSilhouettePoints> silhouette{};
   int silhouette_count = 0;  ///< entries of `silhouette` in use
+  /// Owned silhouette pixels the pose leaves uncovered, each with the nearest part's edge point
+  /// (coverage.hpp): target_px is the pixel, offset_px the edge point's offset from the axis
+  /// point (bones) or zero (palm).
+  std::array<SilhouettePoint, kMaxCoveragePoints> coverage{};
+  int coverage_count = 0;
 };
 
 /// What the residuals are about besides the parameters. Pointers are borrowed; `prior` may be

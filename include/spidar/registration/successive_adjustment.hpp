@@ -27,6 +27,7 @@
 #include <array>
 #include <opencv2/core/mat.hpp>
 #include <optional>
+#include <vector>
 
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/hand/kinematics.hpp"
@@ -36,6 +37,8 @@
 #include "spidar/vision/silhouette.hpp"
 
 namespace spidar::registration {
+
+struct OwnedPixel;  // coverage.hpp
 
 /// What is measured of one hand in one frame.
 struct HandObservation {
@@ -50,6 +53,9 @@ struct ImageEvidence {
   const vision::Camera* camera = nullptr;
   cv::Mat alpha;  ///< CV_32FC1 chroma-key matte, 1 = hand (joint-balls); empty = no joint-balls
   const vision::SilhouetteDistance* distance = nullptr;  ///< silhouette term; null = off
+  /// The silhouette pixels this hand owns (coverage.hpp's coverage_evidence) for the silhouette
+  /// term's coverage direction; null = that direction is off. Per hand.
+  const std::vector<OwnedPixel>* coverage = nullptr;
 };
 
 /// Cost of each term at the final pose (dimensionless, see registration_params.hpp).

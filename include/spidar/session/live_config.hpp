@@ -39,7 +39,7 @@ struct LiveConfig {
 
   // compositor
   std::string compositor = "depth";  ///< paper | depth
-  bool silhouette = false;           ///< the silhouette term in the registration
+  bool silhouette = true;            ///< the silhouette term in the registration
 
   // window
   int window_width = 1280, window_height = 800;
