@@ -105,6 +105,60 @@ TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) 
               tip_sum / n, iou_sum / n, occ / n, occ_paper / n, bracelets, 2 * n);
 }
 
+// The hand-aware silhouette term against the paper's joint-balls alone, on the same frames of the
+// simulated user's hands: the approach (hands coming in from the sides, the worst frames of the
+// paper's fit) through the grasp and the lift.
+TEST_F(FramePipelineTest, TheSilhouetteTermBeatsJointBallsOnTheSameFrames) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  sim::RubiksTask task({});
+  task.fit_to_hands(truth_models_);
+  std::array<std::unique_ptr<FramePipeline>, 2> pipes;  // 0: paper, 1: with the silhouette term
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  const double t0 = 0.3;
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(t0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  for (int k = 0; k < 2; ++k) {
+    p.registration.silhouette_term = k == 1;
+    pipes[k] = FramePipeline::create(*context_, camera_, models_, p).value();
+  }
+  sim::UserHands user(truth_models_, task);
+  sim::SyntheticFrame frame;
+  FrameResult r;
+  sim::FrameTruthWorkspace ws;
+  std::array<double, 2> iou{}, joints{}, tips{}, worst{1.0, 1.0};
+  int n = 0;
+  for (double t = t0; t < 3.3; t += 1.0 / 30) {
+    const auto sample = pose_user(user, task, t);
+    const auto& truth = user.params();
+    ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_TRUE(pipes[k]->process(frame.bgr, sample, scene_, &r).ok());
+      const auto m = sim::measure_frame(frame, r, p.compositor.mode, models_, truth_models_, truth,
+                                        camera_, &ws).value();
+      iou[k] += m.iou;
+      worst[k] = std::min(worst[k], m.iou);
+      joints[k] += 0.5 * (m.joint_px[0] + m.joint_px[1]);
+      tips[k] += 0.5 * (m.fingertip_mm[0] + m.fingertip_mm[1]);
+    }
+    ++n;
+  }
+  for (int k = 0; k < 2; ++k) {
+    std::printf("%-22s IoU %.3f (worst %.3f), joints %.2f px, fingertips %.2f mm over %d frames\n",
+                k ? "joint-balls+silhouette" : "joint-balls", iou[k] / n, worst[k], joints[k] / n,
+                tips[k] / n, n);
+  }
+  // Measured (2026-11-24): IoU 0.741 → 0.756, worst frame 0.480 → 0.602, fingertips 0.68 → 0.65
+  // mm, joints 6.14 → 6.41 px. On these noise-free frames without size estimation the joints
+  // move a little to cover the silhouette with a model of the wrong size; in the demo's runs
+  // (sizes estimated) the same-run joint error is lower with the term in 7 of 9 seeds.
+  EXPECT_GT(iou[1] / n, iou[0] / n + 0.01);
+  EXPECT_GT(worst[1], worst[0]);  // the hard frames do not collapse
+  EXPECT_LT(joints[1] / n, joints[0] / n + 0.5);
+  EXPECT_LT(tips[1] / n, tips[0] / n + 0.2);
+}
+
 // A fit made with registration_only from another pipeline's matte, and pictured later by a third
 // pipeline (on another context, as AsyncSinks does on its thread), is the fit and the picture
 // process() makes in one go.
