@@ -186,6 +186,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.video_format = video ? render::video_format_name(video->format()) : "";
   summary.main_silhouette = o.silhouette;
   summary.personalised = !o.fixed_hand_size;
+  summary.shaped_fingers = o.shaped_fingers;
   summary.compositor = o.compositor;
   summary.width = o.width;
   summary.height = o.height;

@@ -177,7 +177,7 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
       const SilhouettePoint& sp = tg.coverage[k];
       const Vec3 p = sp.bone >= 0 ? bone_point(*pr.model, s, silhouette_bone(sp.bone), sp.t, J3p)
                                   : rigid_point(s, sp.palm_H, J3p);
-      add_projected(Term::kSilhouette, p, sp.offset_px, sp.target_px, w_cov);
+      add_projected(Term::kSilhouette, p, sp.offset_px, sp.target_px, w_cov * sp.weight);
     }
   }
 

@@ -78,6 +78,8 @@ void freeze_coverage(const ResidualProblem& pr, const hand::HandParams& q,
     SilhouettePoint sp;
     sp.bone = near.bone;
     sp.target_px = px;
+    const double huber = pr.params->coverage_huber_px;
+    sp.weight = near.distance_px > huber ? std::sqrt(huber / near.distance_px) : 1.0;
     if (near.bone >= 0) {
       const ImageCapsule& c = outline.bones[near.bone];
       sp.t = near.t;

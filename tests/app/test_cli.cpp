@@ -259,6 +259,10 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_LT(reg["joint_px_mean"].get<double>(), 12.0);
   EXPECT_GT(reg["iterations_mean"].get<double>(), 0.0);
   EXPECT_TRUE(reg["comparison"].is_object());
+  // The default: joint-balls with the hand-aware silhouette term, the paper's as the comparison.
+  EXPECT_EQ(reg["method"], "joint-balls + silhouette");
+  EXPECT_EQ(reg["comparison"]["method"], "joint-balls (paper)");
+  EXPECT_EQ(j["shaped_fingers"], false);
   const auto& c = j["composite"];
   // Measured: 0.16 % (depth) vs 15 % (paper) on a quiet machine, 6.6 % under load.
   EXPECT_LT(c["occlusion_error_pct"].get<double>(), 10.0);

@@ -127,6 +127,7 @@ int main(int argc, char** argv) {
     if (key == "coverage_sigma_px") p.registration.coverage_sigma_px = v;
     else if (key == "coverage_stride_px") p.registration.coverage_stride_px = static_cast<int>(v);
     else if (key == "coverage_max_px") p.registration.coverage_max_px = v;
+    else if (key == "coverage_huber_px") p.registration.coverage_huber_px = v;
     else if (key == "silhouette_sigma_px") p.registration.silhouette_sigma_px = v;
     else if (key == "joint_ball_sigma_px") p.registration.joint_ball_sigma_px = v;
     else if (key == "silhouette_downsample") p.silhouette_downsample = static_cast<int>(v);

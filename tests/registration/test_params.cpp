@@ -28,6 +28,15 @@ TEST(RegistrationParams, ValidateNamesTheField) {
   p = {};
   p.max_iterations = 0;
   EXPECT_NE(validate(p).error().message.find("max_iterations"), std::string::npos);
+  p = {};
+  p.coverage_stride_px = 0;
+  EXPECT_NE(validate(p).error().message.find("coverage_stride_px"), std::string::npos);
+  p = {};
+  p.coverage_sigma_px = -1;
+  EXPECT_NE(validate(p).error().message.find("coverage_sigma_px"), std::string::npos);
+  p = {};
+  p.coverage_huber_px = std::numeric_limits<double>::infinity();
+  EXPECT_NE(validate(p).error().message.find("coverage_huber_px"), std::string::npos);
 }
 
 TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
@@ -44,6 +53,11 @@ TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
   EXPECT_EQ(p.silhouette_term, d.silhouette_term);
   EXPECT_EQ(p.silhouette_sigma_px, d.silhouette_sigma_px);
   EXPECT_EQ(p.silhouette_samples_per_bone, d.silhouette_samples_per_bone);
+  EXPECT_EQ(p.silhouette_inward, d.silhouette_inward);
+  EXPECT_EQ(p.coverage_sigma_px, d.coverage_sigma_px);
+  EXPECT_EQ(p.coverage_stride_px, d.coverage_stride_px);
+  EXPECT_EQ(p.coverage_max_px, d.coverage_max_px);
+  EXPECT_EQ(p.coverage_huber_px, d.coverage_huber_px);
   EXPECT_EQ(p.prior_sigma_wrist_m, d.prior_sigma_wrist_m);
   EXPECT_EQ(p.prior_sigma_rotation_rad, d.prior_sigma_rotation_rad);
   EXPECT_EQ(p.prior_sigma_joint_rad, d.prior_sigma_joint_rad);

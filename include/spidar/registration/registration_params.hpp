@@ -54,6 +54,9 @@ struct RegistrationParams {
   /// A pixel farther than this from every part of its owning hand is not this hand's evidence
   /// (a forearm, a bracelet, the other hand's fingers at a wrong prediction) [px].
   double coverage_max_px = 30.0;
+  /// Uncovered pixels farther than this from the model count with a Huber weight (huber / d):
+  /// far pixels are as likely a shape the model lacks as a pose error [px].
+  double coverage_huber_px = 10.0;
   // --- temporal prior (toward the previous frame's parameters) ---
   double prior_sigma_wrist_m = 0.02;     ///< [m]
   double prior_sigma_rotation_rad = 0.2; ///< [rad]

@@ -52,6 +52,7 @@ struct SilhouettePoint {
   Vec2 offset_px = Vec2::Zero(); ///< from the projected axis point to this point [px]
   Vec2 target_px = Vec2::Zero(); ///< the nearest silhouette pixel [px]
   Vec3 palm_H = Vec3::Zero();    ///< bone −1: the point on the palm box, right-hand H [m]
+  double weight = 1.0;           ///< robust weight (coverage: Huber at coverage_huber_px), 0..1
 };
 
 /// Everything one linearisation holds fixed. Plain fixed-size storage (about 30 KiB).
