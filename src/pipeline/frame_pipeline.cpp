@@ -6,9 +6,9 @@
 
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/render_geometry.hpp"
+#include "spidar/registration/coverage.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/render/hand_shapes.hpp"
-#include "spidar/registration/coverage.hpp"
 #include "spidar/vision/silhouette.hpp"
 
 namespace spidar::pipeline {

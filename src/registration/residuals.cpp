@@ -1,6 +1,6 @@
 #include "spidar/registration/residuals.hpp"
 
-#include <limits>
+#include <cmath>
 #include <vector>
 
 #include "spidar/registration/coverage.hpp"
@@ -74,7 +74,7 @@ void freeze_coverage(const ResidualProblem& pr, const hand::HandParams& q,
     if (part_distance(outline, owned[static_cast<std::size_t>(i)].part, px) <= detail::kSilhouetteTolerancePx)
       continue;
     const OutlineNearest near = nearest_part(outline, px);
-    if (!(near.distance_px > detail::kSilhouetteTolerancePx) || near.distance_px == std::numeric_limits<double>::infinity()) continue;
+    if (!(near.distance_px > detail::kSilhouetteTolerancePx) || std::isinf(near.distance_px)) continue;
     SilhouettePoint sp;
     sp.bone = near.bone;
     sp.target_px = px;

@@ -21,8 +21,10 @@
 ///    CMC, MCP and IP; not at the wrist nor the tips (joint_balls.cpp says why). A ball enters the
 ///    cost only where eq. 21 moves its joint (P̃ ≠ P): one wholly inside the silhouette would add
 ///    only a spring holding the joint at the current iterate, slowing convergence several-fold;
-///  - the silhouette term pulls points of the model's bones that lie outside the real silhouette
-///    (> 0.5 px) onto their nearest silhouette pixel, never the other way.
+///  - the silhouette term (coverage.hpp) pulls the nearest part of the model toward each silhouette
+///    pixel this hand owns and leaves uncovered (> 0.5 px; ImageEvidence::coverage, the owners
+///    decided per frame among both hands and forearms); with silhouette_inward also model points
+///    lying outside the real silhouette onto their nearest silhouette pixel (a distance transform).
 /// Nothing here allocates per frame.
 #include <array>
 #include <opencv2/core/mat.hpp>
