@@ -198,5 +198,56 @@ TEST(Coverage, UncoveredPixelsPlaceThePalmTheStringsLeaveFree) {
   EXPECT_LT(sum[1], 0.6 * sum[0]);
 }
 
+TEST(Coverage, DegenerateInputsOwnNothingAndFitsStayFinite) {
+  const auto models = test::model_hands();
+  const auto poses = test::reaching_hands();
+  const vision::Camera camera = vision::default_rig_camera();
+  RegistrationParams params;
+  params.silhouette_term = true;
+  ProjectedHand outline;
+  project_hand(models[1], poses[1], camera, 0.03, &outline);
+  std::array<std::vector<OwnedPixel>, 2> owned;
+  // No silhouette, the wrong image type, nobody drawn: nothing is owned.
+  coverage_evidence(cv::Mat(), {&outline, &outline}, params, &owned);
+  EXPECT_TRUE(owned[0].empty() && owned[1].empty());
+  coverage_evidence(cv::Mat(camera.height(), camera.width(), CV_32FC1, cv::Scalar(1.0f)),
+                    {&outline, &outline}, params, &owned);
+  EXPECT_TRUE(owned[0].empty() && owned[1].empty());
+  const cv::Mat full(camera.height(), camera.width(), CV_8UC1, cv::Scalar(255));
+  coverage_evidence(full, {nullptr, nullptr}, params, &owned);
+  EXPECT_TRUE(owned[0].empty() && owned[1].empty());
+  // A hand behind the camera draws nothing and owns nothing.
+  hand::HandParams behind = poses[1];
+  behind.set_wrist(camera.X_WC().p - 0.2 * camera.ray_direction_W(Vec2(320, 240)), behind.r_W_hand());
+  ProjectedHand hidden;
+  project_hand(models[1], behind, camera, 0.03, &hidden);
+  EXPECT_EQ(hidden.hull_count, 0);
+  for (const ImageCapsule& c : hidden.bones) EXPECT_FALSE(c.valid);
+  EXPECT_TRUE(std::isinf(nearest_part(hidden, Vec2(320, 240)).distance_px));
+  coverage_evidence(full, {nullptr, &hidden}, params, &owned);
+  EXPECT_TRUE(owned[1].empty());
+  // A NaN pose draws nothing either.
+  hand::HandParams nan_pose = poses[1];
+  nan_pose[0] = std::nan("");
+  project_hand(models[1], nan_pose, camera, 0.03, &hidden);
+  for (const ImageCapsule& c : hidden.bones) EXPECT_FALSE(c.valid);
+  // A silhouette that is everything: the fit's pull is bounded (Huber, the kMaxCoveragePoints
+  // cap) and the result finite.
+  coverage_evidence(full, {nullptr, &outline}, params, &owned);
+  ASSERT_FALSE(owned[1].empty());
+  ImageEvidence image;
+  image.camera = &camera;
+  image.coverage = &owned[1];
+  std::mt19937 rng(2);
+  vision::BraceletObservation none;
+  const HandObservation obs = test::observe(models[1], poses[1], none, rng);
+  hand::HandParams q = poses[1];
+  const SuccessiveAdjustment solver(params);
+  const FitReport rep = solver.fit(models[1], obs, image, &poses[1], &q);
+  EXPECT_TRUE(q.q.allFinite());
+  EXPECT_TRUE(std::isfinite(rep.cost_final));
+  EXPECT_TRUE(hand::within_limits(q, models[1].limits));
+}
+
 }  // namespace
 }  // namespace spidar::registration
