@@ -94,6 +94,34 @@ void project_hand(const hand::HandModel& model, const hand::HandParams& q,
                                  forearm_radius_m, focal);
 }
 
+namespace {
+
+/// Signed distance from `px` to the palm hull's boundary [px] (≤ 0 inside: left of every
+/// counter-clockwise edge), with the nearest boundary point in the image and on the box (right-hand
+/// H) when asked for. +∞ if the palm is not drawn.
+double palm_distance(const ProjectedHand& hand, const Vec2& px, Vec2* edge_px = nullptr,
+                     Vec3* edge_H = nullptr) {
+  if (hand.hull_count < 3) return kInf;
+  bool inside = true;
+  double edge = kInf;
+  for (int k = 0; k < hand.hull_count; ++k) {
+    const int i = hand.hull[k], j = hand.hull[(k + 1) % hand.hull_count];
+    const Vec2 a = hand.palm_px[i], d = hand.palm_px[j] - a;
+    if (cross2(d, px - a) < 0) inside = false;
+    const double len2 = d.squaredNorm();
+    const double s = len2 > 1e-12 ? std::clamp((px - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+    const double dist = (px - (a + s * d)).norm();
+    if (dist < edge) {
+      edge = dist;
+      if (edge_px) *edge_px = a + s * d;
+      if (edge_H) *edge_H = (1.0 - s) * hand.palm_H[i] + s * hand.palm_H[j];
+    }
+  }
+  return inside ? -edge : edge;
+}
+
+}  // namespace
+
 OutlineNearest nearest_part(const ProjectedHand& hand, const Vec2& px) {
   OutlineNearest best;
   best.distance_px = kInf;
@@ -113,51 +141,22 @@ OutlineNearest nearest_part(const ProjectedHand& hand, const Vec2& px) {
     const double r = c.ra + best.t * (c.rc - c.ra);
     best.edge_px = n.norm() > 1e-9 ? Vec2(axis + r * n.normalized()) : axis;
   }
-  if (hand.hull_count >= 3) {
-    // Inside the (counter-clockwise) hull: left of every edge. Otherwise the nearest edge point.
-    bool inside = true;
-    double edge_best = kInf;
-    Vec2 edge_px = Vec2::Zero();
-    Vec3 edge_H = Vec3::Zero();
-    for (int k = 0; k < hand.hull_count; ++k) {
-      const int i = hand.hull[k], j = hand.hull[(k + 1) % hand.hull_count];
-      const Vec2 a = hand.palm_px[i], d = hand.palm_px[j] - a;
-      if (cross2(d, px - a) < 0) inside = false;
-      const double len2 = d.squaredNorm();
-      const double s = len2 > 1e-12 ? std::clamp((px - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-      const double dist = (px - (a + s * d)).norm();
-      if (dist < edge_best) {
-        edge_best = dist;
-        edge_px = a + s * d;
-        edge_H = (1.0 - s) * hand.palm_H[i] + s * hand.palm_H[j];
-      }
-    }
-    const double palm_d = inside ? -edge_best : edge_best;
-    if (palm_d < best.distance_px) {
-      best.distance_px = palm_d;
-      best.bone = -1;
-      best.t = 0;
-      best.edge_px = edge_px;
-      best.palm_H = edge_H;
-    }
+  Vec2 edge_px = Vec2::Zero();
+  Vec3 edge_H = Vec3::Zero();
+  const double palm_d = palm_distance(hand, px, &edge_px, &edge_H);
+  if (palm_d < best.distance_px) {
+    best.distance_px = palm_d;
+    best.bone = -1;
+    best.t = 0;
+    best.edge_px = edge_px;
+    best.palm_H = edge_H;
   }
   return best;
 }
 
 double part_distance(const ProjectedHand& hand, int part, const Vec2& px) {
   if (part >= 0) return part < kSilhouetteBoneCount ? capsule_distance(hand.bones[part], px) : kInf;
-  if (hand.hull_count < 3) return kInf;
-  bool inside = true;
-  double edge = kInf;  // distance to the hull's boundary
-  for (int k = 0; k < hand.hull_count; ++k) {
-    const Vec2 a = hand.palm_px[hand.hull[k]];
-    const Vec2 d = hand.palm_px[hand.hull[(k + 1) % hand.hull_count]] - a;
-    if (cross2(d, px - a) < 0) inside = false;
-    const double len2 = d.squaredNorm();
-    const double s = len2 > 1e-12 ? std::clamp((px - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-    edge = std::min(edge, (px - (a + s * d)).norm());
-  }
-  return inside ? -edge : edge;
+  return palm_distance(hand, px);
 }
 
 void coverage_evidence(const cv::Mat& silhouette, const std::array<const ProjectedHand*, 2>& hands,

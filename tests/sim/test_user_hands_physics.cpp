@@ -89,24 +89,29 @@ std::array<hand::HandModel, 2> models(const User& u) {
   return {profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
 }
 
+// Runs user `u` through the pressed script (pressed_run) and checks that their hands reach the
+// caps within `bound` [m], stay within their limits and turn the top layer twice.
+void expect_caps_reached(const User& u, double margin, bool shaped, double bound) {
+#ifdef SPIDAR_SANITIZED
+  if (u.name != "user") GTEST_SKIP() << "one case in sanitizer builds (all in the release build)";
+#endif
+  const PressedRun r = pressed_run(models(u), margin, shaped);
+  std::printf("%s length x%.2f width x%.2f%s: cap residual mean %.3f mm, p95 %.3f mm, worst %.3f mm "
+              "(hand %d at t = %.2f s); U %d quarter turns\n",
+              u.name.c_str(), u.length_scale, u.width_scale, shaped ? ", shaped fingers" : "",
+              1e3 * r.mean, 1e3 * r.p95, 1e3 * r.worst, r.worst_h, r.worst_t, r.quarter_turns_u);
+  EXPECT_LT(r.worst, bound) << "hand " << r.worst_h << " at t = " << r.worst_t;
+  EXPECT_TRUE(r.within_limits);
+  EXPECT_EQ(r.quarter_turns_u, 2);
+}
+
 // Fitted with a margin inside the joint ranges, the script leaves the user's fingers room to
 // follow the caps where the contacts press them (the fit with no margin: worst 1.4–2.8 mm, the
 // fingers at their abduction limits), and the grip still turns the top layer twice.
 class PressedCaps : public ::testing::TestWithParam<User> {};
 
 TEST_P(PressedCaps, UserHandsReachTheCapsAndTheLayerTurnsTwice) {
-#ifdef SPIDAR_SANITIZED
-  if (GetParam().name != "user") GTEST_SKIP() << "one case in sanitizer builds (all in the release build)";
-#endif
-  const User& u = GetParam();
-  const PressedRun r = pressed_run(models(u), 0.1, false);
-  std::printf("%s length x%.2f width x%.2f: cap residual mean %.3f mm, p95 %.3f mm, worst %.3f mm "
-              "(hand %d at t = %.2f s); U %d quarter turns\n",
-              u.name.c_str(), u.length_scale, u.width_scale, 1e3 * r.mean, 1e3 * r.p95, 1e3 * r.worst,
-              r.worst_h, r.worst_t, r.quarter_turns_u);
-  EXPECT_LT(r.worst, 0.001) << "hand " << r.worst_h << " at t = " << r.worst_t;
-  EXPECT_TRUE(r.within_limits);
-  EXPECT_EQ(r.quarter_turns_u, 2);
+  expect_caps_reached(GetParam(), 0.1, false, 0.001);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -122,21 +127,10 @@ INSTANTIATE_TEST_SUITE_P(
 class ShapedFingers : public ::testing::TestWithParam<User> {};
 
 TEST_P(ShapedFingers, UserHandsReachTheCapsWithoutAMarginAndTheLayerTurnsTwice) {
-#ifdef SPIDAR_SANITIZED
-  if (GetParam().name != "user") GTEST_SKIP() << "one case in sanitizer builds (all in the release build)";
-#endif
-  const User& u = GetParam();
-  const PressedRun r = pressed_run(models(u), 0.0, true);
-  std::printf("%s length x%.2f width x%.2f, shaped fingers: cap residual mean %.3f mm, p95 %.3f mm, "
-              "worst %.3f mm (hand %d at t = %.2f s); U %d quarter turns\n",
-              u.name.c_str(), u.length_scale, u.width_scale, 1e3 * r.mean, 1e3 * r.p95, 1e3 * r.worst,
-              r.worst_h, r.worst_t, r.quarter_turns_u);
   // The short, wide hand with the linear coupling is the one case above 1 mm: 1.23 mm for a few
   // frames while its left hand lets go (t = 10.2 s); p95 0.77 mm.
-  const double bound = u.coupling == hand::Coupling::kLinear ? 0.0013 : 0.001;
-  EXPECT_LT(r.worst, bound) << "hand " << r.worst_h << " at t = " << r.worst_t;
-  EXPECT_TRUE(r.within_limits);
-  EXPECT_EQ(r.quarter_turns_u, 2);
+  const User& u = GetParam();
+  expect_caps_reached(u, 0.0, true, u.coupling == hand::Coupling::kLinear ? 0.0013 : 0.001);
 }
 
 INSTANTIATE_TEST_SUITE_P(
