@@ -73,19 +73,22 @@ struct FramePipeline::Impl {
   /// silhouette pixels each owns (registration/coverage.hpp).
   std::array<registration::ProjectedHand, 2> outlines;
   std::array<std::vector<registration::OwnedPixel>, 2> owned;
-  /// Online size estimates (personalise_shape), and the sizes the skins were last built with.
+  /// Online size estimates (personalise_shape) from the models given at creation (start), and
+  /// the sizes the skins were last built with.
+  std::array<hand::HandModel, 2> start;
   std::array<registration::ShapeEstimator, 2> shape;
   std::array<hand::HandDimensions, 2> skin_dims;
 
   Impl(const FramePipelineParams& p, vision::ChromaKeyer k,
-       const std::array<hand::HandModel, 2>& start)
+       const std::array<hand::HandModel, 2>& given)
       : params(p),
-        models(start),
+        models(given),
         keyer(std::move(k)),
         solver(p.registration),
         main(p.compositor),
-        shape{registration::ShapeEstimator(start[0], p.shape_estimator),
-              registration::ShapeEstimator(start[1], p.shape_estimator)} {
+        start(given),
+        shape{registration::ShapeEstimator(given[0], p.shape_estimator),
+              registration::ShapeEstimator(given[1], p.shape_estimator)} {
     render::CompositorParams o = p.compositor;
     o.mode = p.compositor.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper
                                                                 : render::CompositeMode::kDepth;
@@ -126,7 +129,15 @@ Result<std::unique_ptr<FramePipeline>> FramePipeline::create(
 
 FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 FramePipeline::~FramePipeline() = default;
-void FramePipeline::reset() { impl_->have_previous = false; }
+void FramePipeline::reset() {
+  Impl& s = *impl_;
+  s.have_previous = false;
+  // A cold start forgets the sizes learnt too: a session's warm-up frame (a blank screen) must
+  // not stay among the estimator's keyframes, or a replay, which has no warm-up, would not
+  // reach the live run's sizes.
+  s.models = s.start;
+  for (int h = 0; h < 2; ++h) s.shape[h] = registration::ShapeEstimator(s.start[h], s.params.shape_estimator);
+}
 bool FramePipeline::has_previous() const { return impl_->have_previous; }
 Status FramePipeline::present(render::Context& context, const cv::Mat& bgr) {
   return impl_->renderer->present(context, bgr);

@@ -329,7 +329,7 @@ std::vector<std::vector<Pose>> read_scene_csv(std::istream& in, const std::strin
 }
 
 std::vector<FitRow> read_fits_csv(std::istream& in, const std::string& name) {
-  CsvCursor c(in, name, fit_columns());
+  CsvCursor c(in, name, fit_columns(), fit_size_columns());
   const std::size_t frame = c.col("frame"), hand = c.col("hand"), iterations = c.col("iterations"),
                     converged = c.col("converged"), finite = c.col("finite"), cost0 = c.col("cost_initial"),
                     cost1 = c.col("cost_final"), term0 = c.col("fingertip"), q0 = c.col("q0");
@@ -364,6 +364,14 @@ std::vector<FitRow> read_fits_csv(std::istream& in, const std::string& name) {
       r.cost_initial = r.cost_final = std::nan("");
       r.terms.fill(std::nan(""));
       r.q.fill(std::nan(""));
+    }
+    if (c.has_optional()) {
+      // A hand model's sizes in metres, or 0: not known to the writer (FitRow).
+      for (auto [col, v] : {std::pair{c.col("length_m"), &r.length_m}, std::pair{c.col("width_m"), &r.width_m}}) {
+        *v = c.number(col);
+        if (!(*v == 0.0 || (*v > 0.0 && *v < 1.0)))
+          c.fail(col, "expected a hand size in metres, in (0, 1), or 0 (not recorded), got " + std::string(c.text(col)));
+      }
     }
     out.push_back(r);
   }

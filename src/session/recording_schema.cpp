@@ -45,6 +45,8 @@ std::vector<std::string> fit_columns() {
   return c;
 }
 
+std::vector<std::string> fit_size_columns() { return {"length_m", "width_m"}; }
+
 std::string header_row(const std::vector<std::string>& columns) {
   std::string h;
   for (const auto& c : columns) h += (h.empty() ? "" : ",") + c;

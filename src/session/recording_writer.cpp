@@ -79,6 +79,9 @@ std::string fit_row_text(const FitRow& r) {
   add(r.cost_final);
   for (double v : r.terms) add(v);
   for (double v : r.q) add(v);
+  // The model's sizes are the fit's input, not its result: written even when the fit was not
+  // finite; 0 when unknown (not a size in (0, 1) m).
+  for (double v : {r.length_m, r.width_m}) row += ',' + (v > 0.0 && v < 1.0 ? number_text(v) : std::string("0"));
   return row + '\n';
 }
 
@@ -106,7 +109,9 @@ RecordingWriter::RecordingWriter(std::string dir, const RecordingMeta& meta, std
   fingertips_ = open_csv(d, files::kFingertips, fingertip_header);
   frames_ = open_csv(d, files::kFrames, frame_columns());
   scene_ = open_csv(d, files::kScene, scene_columns());
-  fits_ = open_csv(d, files::kFits, fit_columns());
+  std::vector<std::string> fit_header = fit_columns();
+  for (auto& c : fit_size_columns()) fit_header.push_back(std::move(c));
+  fits_ = open_csv(d, files::kFits, fit_header);
 }
 
 RecordingWriter::~RecordingWriter() = default;

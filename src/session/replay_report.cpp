@@ -66,6 +66,16 @@ void ReplayScorer::on_frame(const FrameEvent& e) {
     ++f_.compared_hands;
     f_.max_dcost = std::max(f_.max_dcost, finite_or_zero(std::abs(result.fits[h].cost_final - fit.cost_final)));
   }
+  for (int h = 0; h < 2; ++h) {
+    const FitRow& fit = rec.fits[i][static_cast<std::size_t>(h)];
+    const hand::HandDimensions& d = result.models[h].shape.dimensions;
+    f_.final_size[h] = {d.length, d.width};
+    f_.live_final_size[h] = {fit.length_m, fit.width_m};
+    if (fit.length_m <= 0) continue;  // not recorded
+    ++f_.compared_sizes;
+    f_.max_dsize_mm = std::max({f_.max_dsize_mm, std::abs(d.length - fit.length_m) * 1e3,
+                                std::abs(d.width - fit.width_m) * 1e3});
+  }
   const device::FingertipSample& recorded = rec.frames[i].measured;
   if (auto s = device::interpolate_samples(newest_first_, e.t_exposure_ns)) {
     ++f_.resampled;
@@ -98,6 +108,14 @@ nlohmann::json write_replay_report(const std::string& out, const RecordingRig& r
                        {"residual_mean", {{"fingertip", mean(f.terms[0])}, {"wrist", mean(f.terms[1])},
                                           {"joint_ball", mean(f.terms[2])}, {"silhouette", mean(f.terms[3])},
                                           {"prior", mean(f.terms[4])}}}};
+  // Each hand's sizes after the last frame: the replay's (personalised when the config says so)
+  // and, when the recording has them, the live run's.
+  for (int h = 0; h < 2; ++h) {
+    nlohmann::json side = {{"length_m", f.final_size[h][0]}, {"width_m", f.final_size[h][1]}};
+    if (f.live_final_size[h][0] > 0)
+      side["live"] = {{"length_m", f.live_final_size[h][0]}, {"width_m", f.live_final_size[h][1]}};
+    j["registration"]["hand_shape"][h == 0 ? "left" : "right"] = side;
+  }
   // Comparisons with no data are null here, not a perfect 0 ...
   const int hands = f.compared_hands;
   j["reproduction"] = {{"frames_compared", f.compared},
@@ -106,6 +124,7 @@ nlohmann::json write_replay_report(const std::string& out, const RecordingRig& r
                        {"mean_param_diff", measured_or_null(hands > 0 ? f.sum_dq / hands : 0.0, hands)},
                        {"recorded_fits_not_finite", f.broken_fits},
                        {"max_cost_diff", measured_or_null(f.max_dcost, hands)},
+                       {"max_hand_size_diff_mm", measured_or_null(f.max_dsize_mm, f.compared_sizes)},
                        {"fingertip_resample_frames", f.resampled},
                        {"fingertip_resample_max_mm", measured_or_null(f.max_resample_mm, f.resampled)},
                        {"frames_store", png ? "png (lossless)"

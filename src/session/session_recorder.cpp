@@ -23,7 +23,8 @@ RecordingMeta schema_meta(const RecorderSetup& m, FrameStore store) {
   return s;
 }
 
-FitRow fit_row(std::int64_t frame, int hand, const registration::FitReport& r, const hand::HandParams& p) {
+FitRow fit_row(std::int64_t frame, int hand, const registration::FitReport& r, const hand::HandParams& p,
+               const hand::HandDimensions& sizes) {
   FitRow row;
   row.frame = frame;
   row.hand = hand;
@@ -33,6 +34,8 @@ FitRow fit_row(std::int64_t frame, int hand, const registration::FitReport& r, c
   row.cost_final = r.cost_final;
   row.terms = {r.terms.fingertip, r.terms.wrist, r.terms.joint_ball, r.terms.silhouette, r.terms.prior};
   for (int i = 0; i < hand::kParamCount; ++i) row.q[static_cast<std::size_t>(i)] = p.q[i];
+  row.length_m = sizes.length;
+  row.width_m = sizes.width;
   return row;  // the writer marks a row with a NaN or infinity as not finite
 }
 
@@ -85,6 +88,7 @@ void SessionRecorder::on_frame(const FrameEvent& e) {
   for (const Shape& sh : e.scene->shapes) fr.scene_poses.push_back(sh.X_WS);
   fr.hands = e.result->hands;
   fr.fits = e.result->fits;
+  for (int h = 0; h < 2; ++h) fr.sizes[h] = e.result->models[h].shape.dimensions;
   add_frame(std::move(fr));
 }
 
@@ -164,8 +168,8 @@ void SessionRecorder::write_frame(FrameRecord& f) {
     row.image = std::to_string(video_->frames());  // frame number in the video
     if (auto st = video_->write(f.bgr); !st) note_error(st.error().message);
   }
-  const std::array<FitRow, 2> fits = {fit_row(f.index, 0, f.fits[0], f.hands[0]),
-                                               fit_row(f.index, 1, f.fits[1], f.hands[1])};
+  const std::array<FitRow, 2> fits = {fit_row(f.index, 0, f.fits[0], f.hands[0], f.sizes[0]),
+                                      fit_row(f.index, 1, f.fits[1], f.hands[1], f.sizes[1])};
   if (writer_->write_frame(row, f.scene_poses, fits)) ++frames_written_;
 }
 

@@ -204,6 +204,14 @@ TEST(LiveRecording, RecordThenReplayReproducesTheRegistration) {
   EXPECT_GT(j["reproduction"]["fingertip_resample_frames"].get<int>(), 0);
   EXPECT_LT(j["reproduction"]["max_param_diff"].get<double>(), 1e-9) << j.dump(2);
   EXPECT_LT(j["reproduction"]["max_cost_diff"].get<double>(), 1e-9) << j.dump(2);
+  // The run personalised the hands' sizes (configs/registration.yaml); fits.csv holds the sizes
+  // every fit used, and the replay, personalising from the same frames, reaches the same ones.
+  EXPECT_LT(j["reproduction"]["max_hand_size_diff_mm"].get<double>(), 1e-9) << j.dump(2);
+  for (const char* side : {"left", "right"}) {
+    const auto& shape = j["registration"]["hand_shape"][side];
+    EXPECT_EQ(shape["length_m"], shape["live"]["length_m"]) << j.dump(2);
+    EXPECT_EQ(shape["width_m"], shape["live"]["width_m"]) << j.dump(2);
+  }
   EXPECT_NEAR(j["registration"]["iou_vs_silhouette_mean"].get<double>(),
               live["registration"]["iou_vs_silhouette_mean"].get<double>(), 1e-9);
   for (const char* f : {"iou.png", "residuals.png", "iterations.png"}) EXPECT_TRUE(fs::exists(d / "replay" / f)) << f;

@@ -151,6 +151,8 @@ inline TestRecording make_test_recording(FrameStore store) {
       r.cost_final = 1.0 / 3.0 / (i + 1);
       for (std::size_t k = 0; k < r.terms.size(); ++k) r.terms[k] = 0.1 * static_cast<double>(k) + h;
       for (std::size_t k = 0; k < r.q.size(); ++k) r.q[k] = std::sin(static_cast<double>(k + i + h));
+      r.length_m = 0.19 + 0.001 * i + 0.01 / 3.0 * h;  // a personalised size moving per frame
+      r.width_m = 0.085 - 0.0005 * i;
     }
     if (i == 3) {  // a live fit that diverged: written as finite = 0
       fits[1].finite = false;

@@ -190,4 +190,13 @@ TEST_F(Damage, AFitRowMarkedNotFiniteMustHaveNoNumbers) {
   EXPECT_HAS(refusal(), where("fits.csv", 9, col) + "q2: expected an empty field");
 }
 
+TEST_F(Damage, AHandSizeOutsideMetresIsNamed) {
+  // fits.csv: 12 fields, q0..q16, then length_m (index 29) and width_m (30); line 4 = frame 1, hand 0.
+  const int col = set_field(dir_ / "fits.csv", 4, 29, "190");  // millimetres, not metres
+  EXPECT_HAS(refusal(), where("fits.csv", 4, col) + "length_m: expected a hand size in metres, in (0, 1), or 0 (not recorded), got 190");
+  set_field(dir_ / "fits.csv", 4, 29, "0.19");
+  const int wc = set_field(dir_ / "fits.csv", 4, 30, "-0.085");
+  EXPECT_HAS(refusal(), where("fits.csv", 4, wc) + "width_m: expected a hand size in metres, in (0, 1), or 0 (not recorded), got -0.085");
+}
+
 }  // namespace

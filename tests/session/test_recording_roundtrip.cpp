@@ -63,6 +63,8 @@ void expect_reads_back(const TestRecording& t, const Recording& r) {
       EXPECT_EQ(a.iterations, b.iterations);
       EXPECT_EQ(a.converged, b.converged);
       EXPECT_EQ(a.finite, b.finite);
+      EXPECT_EQ(a.length_m, b.length_m);  // bit for bit, also for a fit that was not finite
+      EXPECT_EQ(a.width_m, b.width_m);
       if (b.finite) {
         EXPECT_EQ(a.cost_initial, b.cost_initial);
         EXPECT_EQ(a.cost_final, b.cost_final);
@@ -174,6 +176,41 @@ TEST(RecordingRoundTrip, ServoOutputColumnsAreOptionalButAllOrNone) {
     EXPECT_EQ(r.fingertips[k].string_count, 0);
     EXPECT_EQ(r.fingertips[k].tension[0], 0.0);
   }
+}
+
+// fits.csv's hand sizes (length_m, width_m) likewise: a recording made before them reads with
+// sizes 0 (not recorded), one with only one of them is refused naming the other.
+TEST(RecordingRoundTrip, FitSizeColumnsAreOptionalButAllOrNone) {
+  TempFolder d("fit_sizes");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, dir);
+  auto lines = lines_of(dir / "fits.csv");
+  ASSERT_NE(lines.front().find(",q16,length_m,width_m"), std::string::npos) << lines.front();
+  auto drop = [&](int n) {
+    auto cut = lines;
+    for (auto& l : cut)
+      for (int k = 0; k < n; ++k) l.erase(l.rfind(','));
+    write_lines(dir / "fits.csv", cut);
+  };
+  drop(1);  // width_m
+  try {
+    read_recording(dir.string());
+    ADD_FAILURE() << "a fits.csv without width_m was read";
+  } catch (const RecordingError& e) {
+    EXPECT_EQ(e.file(), (dir / "fits.csv").string());
+    EXPECT_EQ(e.line(), 1);
+    EXPECT_NE(std::string(e.what()).find("no column 'width_m'"), std::string::npos) << e.what();
+  }
+  drop(2);
+  const Recording r = read_recording(dir.string());
+  ASSERT_EQ(r.fits.size(), t.fits.size());
+  for (const auto& frame : r.fits)
+    for (const FitRow& f : frame) {
+      EXPECT_EQ(f.length_m, 0.0);
+      EXPECT_EQ(f.width_m, 0.0);
+    }
+  EXPECT_EQ(r.fits[2][1].q, t.fits[2][1].q);
 }
 
 TEST(RecordingWriter, RefusesAFolderHoldingARecording) {

@@ -47,6 +47,12 @@ TEST(RecordingRig, ASimulatedSessionRecordedAsPngReplaysThroughASessionToTheSame
   sp.pipeline = pipeline_params("configs/vision.yaml", "configs/registration.yaml", false,
                                 render::CompositeMode::kDepth, scene->initial_r_W_hand());
   sp.seconds = 1.0;
+  // Personalise the hands' sizes often enough that they change within this one second: the
+  // recording then holds sizes that move, and the replay must reach the same ones frame by frame.
+  sp.pipeline.personalise_shape = true;
+  sp.pipeline.shape_estimator.min_pose_change = 0.02;
+  sp.pipeline.shape_estimator.min_keyframes = 2;
+  sp.pipeline.shape_estimator.solve_every = 2;
 
   // --- live, recorded ---
   FitTrace live;
@@ -112,6 +118,17 @@ TEST(RecordingRig, ASimulatedSessionRecordedAsPngReplaysThroughASessionToTheSame
   // The scorer compares with fits.csv the same way.
   EXPECT_EQ(scorer.figures().compared_hands, 2 * static_cast<int>(live.q.size()));
   EXPECT_LT(scorer.figures().max_dq, 1e-9);
+  // fits.csv holds the sizes each live fit used; they moved, and the replay's follow them exactly.
+  const Recording& played = rig.recording();
+  double moved_mm = 0;
+  for (const auto& frame : played.fits)
+    for (const FitRow& f : frame) {
+      const hand::HandDimensions& start = models[static_cast<std::size_t>(f.hand)].shape.dimensions;
+      moved_mm = std::max({moved_mm, std::abs(f.length_m - start.length) * 1e3, std::abs(f.width_m - start.width) * 1e3});
+    }
+  EXPECT_GT(moved_mm, 0.01) << "the sizes never changed: the test does not exercise them";
+  EXPECT_EQ(scorer.figures().compared_sizes, 2 * static_cast<int>(live.q.size()));
+  EXPECT_LT(scorer.figures().max_dsize_mm, 1e-9);
 }
 
 }  // namespace

@@ -128,7 +128,8 @@ class FramePipeline {
   Status picture(const cv::Mat& bgr, const SceneSnapshot& scene, FrameResult* out);
   /// Shows an image (e.g. the composite) in the window of `context` (error when headless).
   Status present(render::Context& context, const cv::Mat& bgr);
-  /// Forgets the previous frame (the next one is a cold start).
+  /// Forgets the previous frame (the next one is a cold start) and the hands' size estimates
+  /// (the models are again the ones given to create()).
   void reset();
   /// True once a frame was processed since creation or reset() (the next fit starts from it).
   bool has_previous() const;

@@ -39,7 +39,8 @@ namespace spidar::session {
 inline constexpr std::string_view kRecordingFormat = "spidar-mr recording";
 /// session.json "version". 1: the first format (no completion marker; fits.csv without
 /// "finite"). 2: completion marker ("complete", "rows", "seconds"), "frames_file", fits.csv
-/// "finite" column.
+/// "finite" column. Later version-2 recordings add optional columns (servo_output_columns,
+/// fit_size_columns): a reader takes a file with all of a group's columns or none.
 inline constexpr int kRecordingVersion = 2;
 
 /// File names inside a recording folder.
@@ -107,6 +108,10 @@ struct FitRow {
   /// Final cost per term: fingertip, wrist, joint_ball, silhouette, prior.
   std::array<double, 5> terms{};
   std::array<double, hand::kParamCount> q{};  ///< hand parameters (include/spidar/hand/parameters.hpp)
+  /// The hand model's length and width the fit used [m] (they change while the shape is
+  /// personalised: registration/shape_estimator.hpp); 0: not recorded (a recording made before
+  /// fit_size_columns were written, or a writer that did not know them).
+  double length_m = 0, width_m = 0;
 };
 
 /// Column names of each CSV, in the order the writer writes them. The reader finds columns by
@@ -122,6 +127,9 @@ std::vector<std::string> servo_output_columns(int string_count);
 std::vector<std::string> frame_columns();      ///< frame, t_exposure_ns, image, then sample_columns()
 std::vector<std::string> scene_columns();      ///< frame, shape, px..pz [m], qw..qz (unit), world
 std::vector<std::string> fit_columns();
+/// fits.csv's columns after fit_columns(): length_m, width_m (FitRow). Optional on reading: a
+/// recording made before they were written has none (its rows read with sizes 0).
+std::vector<std::string> fit_size_columns();
 /// A fingertip sample's columns: faults, consistent, finger_count, p0x..p7z [m] (world),
 /// f0x..f7z [N] (world).
 std::vector<std::string> sample_columns();

@@ -27,6 +27,13 @@ class ReplayScorer final : public FrameSink {
     std::array<std::vector<double>, 5> terms;    ///< fingertip, wrist, joint-ball, silhouette, prior
     double max_dq = 0, sum_dq = 0, max_dcost = 0, max_resample_mm = 0;
     int compared = 0, compared_hands = 0, broken_fits = 0, resampled = 0;
+    /// The hand models' sizes, replay against live (fits.csv length_m, width_m), where recorded:
+    /// the largest difference [mm] and how many hand fits were compared.
+    double max_dsize_mm = 0;
+    int compared_sizes = 0;
+    /// Each hand's length and width [m] after the last frame: the replay's and the recording's
+    /// (0 when not recorded).
+    std::array<std::array<double, 2>, 2> final_size{}, live_final_size{};
   };
   const Figures& figures() const { return f_; }
 

@@ -27,6 +27,7 @@
 #include "spidar/core/seqlock.hpp"
 #include "spidar/device/device.hpp"
 #include "spidar/device/servo_loop.hpp"
+#include "spidar/hand/hand_shape.hpp"
 #include "spidar/hand/parameters.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/render/video_output.hpp"
@@ -80,6 +81,7 @@ struct FrameRecord {
   std::vector<Pose> scene_poses;    ///< SceneSnapshot shape poses, in snapshot order
   std::array<hand::HandParams, 2> hands;
   std::array<registration::FitReport, 2> fits;
+  std::array<hand::HandDimensions, 2> sizes;  ///< the hand models the fits used (length, width [m])
 };
 
 class SessionRecorder final : public FrameSink {
