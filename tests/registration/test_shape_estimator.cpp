@@ -109,10 +109,18 @@ TEST(ShapeEstimator, StaysWithinItsBoundAndFreezesNothingWithoutEvidence) {
 
 TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
-  bool enabled = true;
+  bool enabled = false;
   const ShapeEstimatorParams p = parse_shape_estimator_params(root["personalisation"], &enabled);
-  EXPECT_FALSE(enabled);  // off in the shipped settings (the demo turns it on)
-  EXPECT_EQ(p.keyframes, ShapeEstimatorParams{}.keyframes);
+  EXPECT_TRUE(enabled);  // on in the shipped settings (demo, run and replay)
+  // The shipped settings are the library's defaults.
+  const ShapeEstimatorParams d;
+  EXPECT_EQ(p.keyframes, d.keyframes);
+  EXPECT_EQ(p.min_pose_change, d.min_pose_change);
+  EXPECT_EQ(p.solve_every, d.solve_every);
+  EXPECT_EQ(p.min_keyframes, d.min_keyframes);
+  EXPECT_EQ(p.prior_sigma_length_m, d.prior_sigma_length_m);
+  EXPECT_EQ(p.prior_sigma_width_m, d.prior_sigma_width_m);
+  EXPECT_EQ(p.max_relative_change, d.max_relative_change);
   const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
     parse_shape_estimator_params(bad["personalisation"], &enabled);

@@ -34,7 +34,7 @@ struct ShapeEstimatorParams {
   double prior_sigma_length_m = 0.015;  ///< σ₀ of the starting profile's length [m]
   double prior_sigma_width_m = 0.008;   ///< σ₀ of its width [m]
   int keyframes = 24;                   ///< kept (the oldest is replaced)
-  double min_pose_change = 0.15;        ///< a keyframe differs from every kept one by this (‖Δθ‖, m/rad)
+  double min_pose_change = 0.08;        ///< a keyframe differs from every kept one by this (‖Δθ‖, m/rad)
   int solve_every = 10;                 ///< re-estimate after this many new keyframes
   int min_keyframes = 6;                ///< no estimate before this many keyframes
   int iterations = 4;                   ///< Gauss-Newton iterations per re-estimate
