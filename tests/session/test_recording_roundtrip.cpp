@@ -142,12 +142,24 @@ TEST(RecordingRoundTrip, CrlfFilesReadTheSame) {
   expect_reads_back(t, read_recording(dir.string()));
 }
 
-/// fingertips.csv without its last `drop` columns (header and rows).
-void drop_last_fingertip_columns(const fs::path& dir, int drop) {
-  auto lines = lines_of(dir / "fingertips.csv");
+/// `file` in `dir` without its last `drop` columns (header and rows).
+void drop_last_columns(const fs::path& dir, const std::string& file, int drop) {
+  auto lines = lines_of(dir / file);
   for (auto& l : lines)
     for (int k = 0; k < drop; ++k) l.erase(l.rfind(','));
-  write_lines(dir / "fingertips.csv", lines);
+  write_lines(dir / file, lines);
+}
+
+/// Reading the recording in `dir` fails at line 1 of `file`, naming the missing `column`.
+void expect_missing_column(const fs::path& dir, const std::string& file, const std::string& column) {
+  try {
+    read_recording(dir.string());
+    ADD_FAILURE() << "a " << file << " without " << column << " was read";
+  } catch (const RecordingError& e) {
+    EXPECT_EQ(e.file(), (dir / file).string());
+    EXPECT_EQ(e.line(), 1);
+    EXPECT_NE(std::string(e.what()).find("no column '" + column + "'"), std::string::npos) << e.what();
+  }
 }
 
 // A version-2 recording made before fingertips.csv had the servo's outputs still reads: its
@@ -159,16 +171,9 @@ TEST(RecordingRoundTrip, ServoOutputColumnsAreOptionalButAllOrNone) {
   write_test_recording(t, dir);
   EXPECT_NE(lines_of(dir / "fingertips.csv").front().find(",tension0,tension1,tension2,motor0,motor1,motor2"),
             std::string::npos);
-  drop_last_fingertip_columns(dir, 1);  // motor2
-  try {
-    read_recording(dir.string());
-    ADD_FAILURE() << "a fingertips.csv without motor2 was read";
-  } catch (const RecordingError& e) {
-    EXPECT_EQ(e.file(), (dir / "fingertips.csv").string());
-    EXPECT_EQ(e.line(), 1);
-    EXPECT_NE(std::string(e.what()).find("no column 'motor2'"), std::string::npos) << e.what();
-  }
-  drop_last_fingertip_columns(dir, 5);  // the rest: as written before the columns existed
+  drop_last_columns(dir, "fingertips.csv", 1);
+  expect_missing_column(dir, "fingertips.csv", "motor2");
+  drop_last_columns(dir, "fingertips.csv", 5);  // the rest: as written before the columns existed
   const Recording r = read_recording(dir.string());
   ASSERT_EQ(r.fingertips.size(), t.fingertips.size());
   for (std::size_t k = 0; k < t.fingertips.size(); ++k) {
@@ -185,24 +190,10 @@ TEST(RecordingRoundTrip, FitSizeColumnsAreOptionalButAllOrNone) {
   const fs::path dir = d.path() / "rec";
   const TestRecording t = make_test_recording(FrameStore::kPng);
   write_test_recording(t, dir);
-  auto lines = lines_of(dir / "fits.csv");
-  ASSERT_NE(lines.front().find(",q16,length_m,width_m"), std::string::npos) << lines.front();
-  auto drop = [&](int n) {
-    auto cut = lines;
-    for (auto& l : cut)
-      for (int k = 0; k < n; ++k) l.erase(l.rfind(','));
-    write_lines(dir / "fits.csv", cut);
-  };
-  drop(1);  // width_m
-  try {
-    read_recording(dir.string());
-    ADD_FAILURE() << "a fits.csv without width_m was read";
-  } catch (const RecordingError& e) {
-    EXPECT_EQ(e.file(), (dir / "fits.csv").string());
-    EXPECT_EQ(e.line(), 1);
-    EXPECT_NE(std::string(e.what()).find("no column 'width_m'"), std::string::npos) << e.what();
-  }
-  drop(2);
+  ASSERT_NE(lines_of(dir / "fits.csv").front().find(",q16,length_m,width_m"), std::string::npos);
+  drop_last_columns(dir, "fits.csv", 1);
+  expect_missing_column(dir, "fits.csv", "width_m");
+  drop_last_columns(dir, "fits.csv", 1);  // length_m too: as written before the columns existed
   const Recording r = read_recording(dir.string());
   ASSERT_EQ(r.fits.size(), t.fits.size());
   for (const auto& frame : r.fits)
