@@ -55,6 +55,15 @@ void ReplayScorer::on_frame(const FrameEvent& e) {
   ++f_.compared;
   for (int h = 0; h < 2; ++h) {
     const FitRow& fit = rec.fits[i][static_cast<std::size_t>(h)];
+    // The model's sizes are the fit's input: compared also where the live fit was not finite.
+    const hand::HandDimensions& d = result.models[h].shape.dimensions;
+    f_.final_size[h] = {d.length, d.width};
+    f_.live_final_size[h] = {fit.length_m, fit.width_m};
+    if (fit.length_m > 0) {  // recorded
+      ++f_.compared_sizes;
+      f_.max_dsize_mm = std::max({f_.max_dsize_mm, std::abs(d.length - fit.length_m) * 1e3,
+                                  std::abs(d.width - fit.width_m) * 1e3});
+    }
     if (!fit.finite) {
       ++f_.broken_fits;
       continue;
@@ -65,16 +74,6 @@ void ReplayScorer::on_frame(const FrameEvent& e) {
     f_.sum_dq += dq;
     ++f_.compared_hands;
     f_.max_dcost = std::max(f_.max_dcost, finite_or_zero(std::abs(result.fits[h].cost_final - fit.cost_final)));
-  }
-  for (int h = 0; h < 2; ++h) {
-    const FitRow& fit = rec.fits[i][static_cast<std::size_t>(h)];
-    const hand::HandDimensions& d = result.models[h].shape.dimensions;
-    f_.final_size[h] = {d.length, d.width};
-    f_.live_final_size[h] = {fit.length_m, fit.width_m};
-    if (fit.length_m <= 0) continue;  // not recorded
-    ++f_.compared_sizes;
-    f_.max_dsize_mm = std::max({f_.max_dsize_mm, std::abs(d.length - fit.length_m) * 1e3,
-                                std::abs(d.width - fit.width_m) * 1e3});
   }
   const device::FingertipSample& recorded = rec.frames[i].measured;
   if (auto s = device::interpolate_samples(newest_first_, e.t_exposure_ns)) {
