@@ -42,7 +42,8 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
   sp.p_W_cube = X_cube0.p;
   sp.proxy_radius = wp.proxy.radius;
   auto script = std::make_shared<sim::RubiksScript>(sp);
-  const double seconds = std::max(o.seconds, sp.duration);
+  // --seconds 0: the script's own length; otherwise the run stops there (a short run is cut).
+  const double seconds = o.seconds > 0 ? o.seconds : sp.duration;
 
   device::SimulatedSpidarParams dp;
   dp.seed = o.seed;

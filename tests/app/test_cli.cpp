@@ -475,7 +475,7 @@ TEST(Cli, DemoWhoseReportCannotBeWrittenFailsNamingIt) {
 TEST(Cli, DemoExitsWithCode1WhenTheServoLatchesAFault) {
   const std::string dir = ::testing::TempDir() + "spidar_demo_fault_" + std::to_string(getpid());
   const std::string cfg = shifted_config(dir);
-  auto r = run("demo --scenario haptic --config " + cfg + " --out " + dir + "/out");
+  auto r = run("demo --scenario haptic --seconds 1.5 --config " + cfg + " --out " + dir + "/out");
   EXPECT_EQ(r.code, 1) << r.err << r.out;
   EXPECT_NE(r.err.find("the servo loop latched"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("workspace"), std::string::npos) << r.err;
