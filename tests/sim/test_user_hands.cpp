@@ -132,11 +132,6 @@ TEST(UserHands, TheRawScriptIsNotReachableByEveryHand) {
 class FittedScript : public ::testing::TestWithParam<std::tuple<double, double, hand::Coupling>> {};
 
 TEST_P(FittedScript, CapsMatchTheDeviceThroughoutTheScript) {
-#ifdef SPIDAR_SANITIZED
-  if (::testing::UnitTest::GetInstance()->current_test_info()->value_param() != nullptr &&
-      std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()).back() != '0')
-    GTEST_SKIP() << "one case in sanitizer builds (all of them in the release build)";
-#endif
   const auto [length_scale, width_scale, coupling] = GetParam();
   hand::HandProfile profile;
   profile.name = "test";
@@ -166,9 +161,6 @@ INSTANTIATE_TEST_SUITE_P(
                       std::make_tuple(0.9, 1.1, hand::Coupling::kLinear)));
 
 TEST(UserHands, FittedScriptKeepsTheUsersProfileWithinOneMillimetre) {
-#ifdef SPIDAR_SANITIZED
-  GTEST_SKIP() << "the same computation as FittedScript/0 (release build only)";
-#endif
   RubiksTask task({});
   task.fit_to_hands(user_models());
   const Residual r = script_residual(task, user_models());
