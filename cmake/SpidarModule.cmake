@@ -13,9 +13,6 @@ if(SPIDAR_SANITIZE)
     target_compile_options(spidar_build_flags INTERFACE -fno-sanitize=${SPIDAR_NO_SANITIZE})
   endif()
   target_link_options(spidar_build_flags INTERFACE -fsanitize=${SPIDAR_SANITIZE})
-  # Tests that repeat one computation over many cases run one case in sanitizer builds (they
-  # check numbers there, which the release build checks in full; the sanitizers check memory).
-  target_compile_definitions(spidar_build_flags INTERFACE SPIDAR_SANITIZED=1)
 endif()
 
 # spidar_add_module(<name> SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
