@@ -41,7 +41,7 @@ std::array<float, 4> rgba(const std::array<float, 3>& c) { return {c[0], c[1], c
 
 }  // namespace
 
-MeshData tapered_segment(double r_a, double r_b, double length, int slices, int rings) {
+MeshData tapered_segment(double r_a, double r_b, double length, int slices, int rings, double cap_a_depth) {
   MeshData m;
   m.name = "tapered_segment";
   // Elevation of the tangent circle: sin α = (r_a − r_b) / length.
@@ -50,7 +50,8 @@ MeshData tapered_segment(double r_a, double r_b, double length, int slices, int 
   std::vector<std::pair<double, double>> profile;  // (radius, z)
   for (int i = 0; i <= rings; ++i) {  // lower cap: −π/2 … α
     const double t = -kPi / 2 + (alpha + kPi / 2) * i / rings;
-    profile.emplace_back(r_a * std::cos(t), r_a * std::sin(t));
+    const double z = r_a * std::sin(t);
+    profile.emplace_back(r_a * std::cos(t), z < 0 ? cap_a_depth * z : z);
   }
   for (int i = 0; i <= rings; ++i) {  // upper cap: α … π/2
     const double t = alpha + (kPi / 2 - alpha) * i / rings;
@@ -97,6 +98,8 @@ Status validate(const HandSkinParams& p) {
     return Error{"hand skin: taper must be in [0, 1), got " + std::to_string(p.taper)};
   if (!(std::isfinite(p.palm_fullness) && p.palm_fullness > 0 && p.palm_fullness <= 3))
     return Error{"hand skin: palm_fullness must be in (0, 3], got " + std::to_string(p.palm_fullness)};
+  if (!(std::isfinite(p.forearm_cap_depth) && p.forearm_cap_depth > 0 && p.forearm_cap_depth <= 1))
+    return Error{"hand skin: forearm_cap_depth must be in (0, 1], got " + std::to_string(p.forearm_cap_depth)};
   if (!(std::isfinite(p.forearm_length_m) && p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
     return Error{"hand skin: forearm_length_m must be in [0, 0.5] m, got " +
                  std::to_string(p.forearm_length_m)};
@@ -115,14 +118,23 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
     skin.bones.push_back({static_cast<int>(meshes->size()) - 1, c.finger});
   }
   const Vec3 h = rest.boxes.at(0).half_extents;
-  meshes->push_back(rounded_box(Vec3(1.05 * h.x(), h.y() * 1.02, p.palm_fullness * h.z()), 0.45,
-                                p.palm_slices, p.palm_stacks));
+  // The palm's skin reaches back to the wrist: the skeleton's palm box starts at the carpus (a
+  // centimetre or so from the wrist), the hand's flesh does not, and the forearm's flattened end
+  // (forearm_cap_depth) no longer fills the gap. The box mesh grows toward the wrist by the gap
+  // and its centre moves by half of it, in the box frame (the axes of H).
+  const double gap = p.palm_reaches_wrist
+                         ? std::max(0.0, model.shape.palm.p_H_centre.y() - model.shape.palm.half_extents.y())
+                         : 0.0;
+  MeshData palm = rounded_box(Vec3(1.05 * h.x(), h.y() * 1.02 + 0.5 * gap, p.palm_fullness * h.z()), 0.45,
+                              p.palm_slices, p.palm_stacks);
+  for (std::size_t k = 1; k < palm.vertices.size(); k += 3) palm.vertices[k] -= static_cast<float>(0.5 * gap);
+  meshes->push_back(std::move(palm));
   skin.palm_mesh = static_cast<int>(meshes->size()) - 1;
   skin.wrist_radius = 0.62 * h.x();
   if (p.forearm_length_m > 0) {
     meshes->push_back(
         tapered_segment(skin.wrist_radius, 1.15 * skin.wrist_radius, p.forearm_length_m,
-                        std::max(p.bone_slices, 16), p.bone_rings));
+                        std::max(p.bone_slices, 16), p.bone_rings, p.forearm_cap_depth));
     skin.forearm_mesh = static_cast<int>(meshes->size()) - 1;
   }
   return skin;

@@ -7,8 +7,14 @@
 //
 //   registration_study [--user PROFILE|--user-file FILE] [--model L,W | --model-user]
 //                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
-//                      [--t0 S] [--t1 S] [--fps F] [--verbose]
+//                      [--t0 S] [--t1 S] [--fps F] [--verbose] [--ceiling-scan]
+//
+// --ceiling-scan: the model ceiling again with the skin's digits thicker or thinner (capsule radii
+// × 0.9 … 1.3) and its palm fuller (palm_fullness), to see which shape parameter the ceiling's
+// loss is in; and where the ceiling's missing (real hand, not model) and extra (model, not real
+// hand) pixels are, by the model part nearest to them.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -21,6 +27,8 @@
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/render/renderer.hpp"
+#include <opencv2/imgproc.hpp>
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/model_ceiling.hpp"
 #include "spidar/sim/rubiks_task.hpp"
@@ -40,6 +48,8 @@ struct Args {
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
+  bool ceiling_scan = false;
+  double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
   std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below 0.5
   double shape_w = 0, shape_dq = 0;
@@ -78,6 +88,8 @@ int main(int argc, char** argv) {
     else if (k == "--t1") a.t1 = std::atof(next().c_str());
     else if (k == "--fps") a.fps = std::atof(next().c_str());
     else if (k == "--verbose") a.verbose = true;
+    else if (k == "--ceiling-scan") a.ceiling_scan = true;
+    else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
     else if (k == "--set") a.sets.push_back(next());
     else {
@@ -109,8 +121,69 @@ int main(int argc, char** argv) {
   }
   const vision::Camera camera = vision::default_rig_camera();
   auto film = sim::SyntheticCamera::create(context, camera, truth_models).value();
-  auto ceiling = sim::ModelCeiling::create(context, camera, truth_models,
-                                           pipeline::FramePipelineParams{}.model_skin).value();
+  render::HandSkinParams model_skin = pipeline::FramePipelineParams{}.model_skin;
+  if (a.forearm_cap > 0) model_skin.forearm_cap_depth = a.forearm_cap;
+  auto ceiling = sim::ModelCeiling::create(context, camera, truth_models, model_skin).value();
+
+  // The ceiling's variants (--ceiling-scan): digit radii scaled, then the palm's fullness.
+  struct Variant {
+    std::string name;
+    std::unique_ptr<sim::ModelCeiling> ceiling;
+    std::vector<double> iou;
+  };
+  std::vector<Variant> variants;
+  if (a.ceiling_scan) {
+    for (double scale : {0.9, 1.1, 1.2, 1.3}) {
+      std::array<hand::HandModel, 2> thick = truth_models;
+      for (auto& m : thick)
+        for (auto& d : m.shape.digits)
+          for (double& r : d.radius) r *= scale;
+      char name[64];
+      std::snprintf(name, sizeof name, "digit radii x%.1f", scale);
+      variants.push_back({name, sim::ModelCeiling::create(context, camera, thick, model_skin).value(), {}});
+    }
+    {  // the skin before 2026-11-24: the forearm's hemispherical end filled the carpus
+      render::HandSkinParams skin = model_skin;
+      skin.forearm_cap_depth = 1.0;
+      skin.palm_reaches_wrist = false;
+      variants.push_back({"a hemispherical forearm end, the palm from the carpus",
+                          sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
+    }
+    for (double depth : {0.1, 0.5}) {
+      render::HandSkinParams skin = model_skin;
+      skin.forearm_cap_depth = depth;
+      char name[64];
+      std::snprintf(name, sizeof name, "forearm cap depth %.2f", depth);
+      variants.push_back({name, sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
+    }
+    for (double fullness : {1.0, 1.5, 1.8}) {
+      render::HandSkinParams skin = model_skin;
+      skin.palm_fullness = fullness;
+      char name[64];
+      std::snprintf(name, sizeof name, "palm fullness %.1f", fullness);
+      variants.push_back({name, sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
+    }
+  }
+
+  // Parts of the ceiling's loss (--ceiling-scan): the model skin at the truth, by part.
+  std::unique_ptr<render::Renderer> part_renderer;
+  std::array<render::HandSkin, 2> part_skins;
+  auto part_meshes = std::make_shared<std::vector<MeshData>>();
+  const render::HandSkinParams part_skin_params = model_skin;
+  // [0..4] digits, 5 palm, 6 wrist (forearm or bracelet of the model): missing and extra pixels.
+  std::array<double, 7> part_missing{}, part_extra{};
+  double missing_under_forearm = 0;  // real hand pixels the model covers with its forearm or bracelet
+  double part_real = 0;
+  if (a.ceiling_scan) {
+    for (int h = 0; h < 2; ++h)
+      part_skins[h] = render::build_hand_skin(truth_models[h], part_skin_params, part_meshes.get());
+    part_renderer = render::Renderer::create(context, camera.width(), camera.height()).value();
+  }
+  auto part_of = [](std::uint8_t id) {
+    const render::HandId d = render::decode_hand_id(id);
+    if (d.finger >= 0 && d.finger <= 4) return d.finger;
+    return d.finger == render::kPalmPart ? 5 : 6;
+  };
 
   const auto vc = vision::load_vision_config(test::source("configs/vision.yaml"));
   pipeline::FramePipelineParams p;
@@ -120,6 +193,7 @@ int main(int argc, char** argv) {
   if (a.no_balls) p.registration.joint_ball_sigma_px = 1000;
   if (a.no_wrist) p.registration.wrist_sigma_px = 1000;
   p.personalise_shape = a.personalise;
+  p.model_skin = model_skin;
   for (const std::string& kv : a.sets) {
     const auto eq = kv.find('=');
     const std::string key = kv.substr(0, eq);
@@ -182,6 +256,63 @@ int main(int argc, char** argv) {
     const auto m = sim::measure_frame(frame, r, p.compositor.mode, r.models, truth_models, truth,
                                       camera, &ws).value();
     const double c = ceiling->iou(truth, frame.hand_only).value();
+    for (Variant& v : variants) v.iou.push_back(v.ceiling->iou(truth, frame.hand_only).value());
+    if (part_renderer) {
+      SceneSnapshot hands_scene;
+      hands_scene.meshes = part_meshes;
+      for (int h = 0; h < 2; ++h)
+        render::pose_hand_skin(truth_models[h], part_skins[h], truth[h], part_skin_params, &hands_scene);
+      render::RenderParams rp;
+      rp.hands = render::HandDrawMode::kHidden;
+      render::RenderTargets tg;
+      if (!part_renderer->render(hands_scene, camera, rp).ok() || !part_renderer->read(&tg, render::kHandId).ok())
+        return 1;
+      // Nearest model pixel (any part) of every pixel: labels of the zero pixels of `empty`.
+      cv::Mat empty = tg.hand_id == 0, dist, labels;
+      cv::distanceTransform(empty, dist, labels, cv::DIST_L2, 3, cv::DIST_LABEL_PIXEL);
+      std::vector<std::uint8_t> label_id(static_cast<std::size_t>(tg.hand_id.total()) + 1, 0);
+      for (int y = 0; y < tg.hand_id.rows; ++y)
+        for (int x = 0; x < tg.hand_id.cols; ++x)
+          if (tg.hand_id.at<std::uint8_t>(y, x) != 0)
+            label_id[static_cast<std::size_t>(labels.at<int>(y, x))] = tg.hand_id.at<std::uint8_t>(y, x);
+      if (!a.dump_dir.empty() && std::fmod(t + 1e-6, 2.0) < 1.0 / a.fps) {
+        // Green: real hand only; red: model hand only; yellow: both; blue: model forearm over
+        // real hand; grey: the rest of the model's forearm.
+        cv::Mat o(tg.hand_id.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+        for (int y = 0; y < o.rows; ++y)
+          for (int x = 0; x < o.cols; ++x) {
+            const std::uint8_t id = tg.hand_id.at<std::uint8_t>(y, x);
+            const bool real = frame.hand_only.at<std::uint8_t>(y, x) != 0;
+            const bool arm = id != 0 && part_of(id) == 6, model = id != 0 && !arm;
+            cv::Vec3b colour(0, 0, 0);
+            if (real && model) colour = {0, 220, 220};
+            else if (real && arm) colour = {255, 80, 0};
+            else if (real) colour = {0, 200, 0};
+            else if (model) colour = {0, 0, 220};
+            else if (arm) colour = {90, 90, 90};
+            o.at<cv::Vec3b>(y, x) = colour;
+          }
+        cv::Mat row;
+        cv::hconcat(frame.bgr, o, row);
+        char name[64];
+        std::snprintf(name, sizeof name, "/ceiling_t%05.2f.png", t);
+        cv::imwrite(a.dump_dir + name, row);
+      }
+      for (int y = 0; y < tg.hand_id.rows; ++y) {
+        for (int x = 0; x < tg.hand_id.cols; ++x) {
+          const std::uint8_t id = tg.hand_id.at<std::uint8_t>(y, x);
+          const bool real = frame.hand_only.at<std::uint8_t>(y, x) != 0;
+          const bool model = id != 0 && part_of(id) != 6;
+          part_real += real;
+          if (model && !real) part_extra[static_cast<std::size_t>(part_of(id))] += 1;
+          if (real && !model && id != 0) missing_under_forearm += 1;
+          if (real && !model) {
+            const std::uint8_t near = id != 0 ? id : label_id[static_cast<std::size_t>(labels.at<int>(y, x))];
+            part_missing[static_cast<std::size_t>(near == 0 ? 6 : part_of(near))] += 1;
+          }
+        }
+      }
+    }
     // Fitted caps to the strings' caps, and the truth's caps to the strings' (the user's IK).
     double obs_res = 0, cap_res = 0;
     for (int h = 0; h < 2; ++h) {
@@ -257,6 +388,19 @@ int main(int argc, char** argv) {
       "%.2f px  contested %.2f %% (paper %.2f %%)\n",
       iou.size(), mean(iou), quantile(iou, 0.05), mean(ceil_iou), quantile(ceil_iou, 0.05),
       mean(tip), quantile(tip, 0.95), mean(joint), mean(contested), mean(contested_paper));
+  if (!variants.empty()) std::printf("ceiling as the model's skin: %.3f (p5 %.3f)\n", mean(ceil_iou), quantile(ceil_iou, 0.05));
+  for (const Variant& v : variants)
+    std::printf("ceiling with %s: %.3f (p5 %.3f)\n", v.name.c_str(), mean(v.iou), quantile(v.iou, 0.05));
+  if (part_real > 0) {
+    const char* names[7] = {"thumb", "index", "middle", "ring", "little", "palm", "wrist"};
+    std::printf("ceiling's loss by nearest model part, %% of the real hand pixels: missing / extra\n");
+    for (int k = 0; k < 7; ++k)
+      std::printf("  %-7s %5.1f / %5.1f\n", names[k], 100 * part_missing[static_cast<std::size_t>(k)] / part_real,
+                  100 * part_extra[static_cast<std::size_t>(k)] / part_real);
+  }
+  if (part_real > 0)
+    std::printf("  (wrist: %.1f %% under the model's forearm or bracelet, the rest not covered)\n",
+                100 * missing_under_forearm / part_real);
   std::printf("fitted caps to the strings %.2f mm (p95 %.2f), truth caps to the strings %.2f mm (max %.2f)\n",
               mean(obs), quantile(obs, 0.95), mean(caps), quantile(caps, 1.0));
   std::printf("bracelet midpoint to the band's axis centre %.2f px (p95 %.2f), to its visible surface %.2f px (p95 %.2f)\n",

@@ -1,11 +1,15 @@
 // The model hand's skin (render/hand_skin.hpp): its tessellation and its parameter checks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
+#include <utility>
+#include <vector>
 #include <limits>
 #include <opencv2/core.hpp>
 
 #include "gl_test_support.hpp"
+#include "spidar/hand/hand_model.hpp"
 #include "spidar/render/hand_skin.hpp"
 #include "spidar/render/renderer.hpp"
 #include "spidar/vision/camera.hpp"
@@ -84,6 +88,59 @@ TEST(HandSkin, ValidateNamesTheFieldOutOfRange) {
   s = render::validate(p);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("taper"), std::string::npos) << s.error().message;
+  for (double bad : {0.0, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+    p = {};
+    p.forearm_cap_depth = bad;
+    s = render::validate(p);
+    ASSERT_FALSE(s.ok()) << bad;
+    EXPECT_NE(s.error().message.find("forearm_cap_depth must be in (0, 1]"), std::string::npos) << s.error().message;
+  }
+}
+
+/// Extent of a mesh's vertices along axis `k` of its frame: {min, max} [m].
+std::pair<double, double> extent(const MeshData& m, int k) {
+  double lo = 1e300, hi = -1e300;
+  for (std::size_t i = static_cast<std::size_t>(k); i < m.vertices.size(); i += 3) {
+    lo = std::min(lo, static_cast<double>(m.vertices[i]));
+    hi = std::max(hi, static_cast<double>(m.vertices[i]));
+  }
+  return {lo, hi};
+}
+
+// The carpus is hand: the forearm's end reaches a quarter of its radius past the wrist (it reached
+// its whole radius, 2.5–3 cm into the palm), and the palm's skin reaches back to the wrist from
+// the skeleton's palm box, which starts at the carpus.
+TEST(HandSkin, TheForearmEndsAtTheWristAndThePalmReachesIt) {
+  for (const hand::Side side : {hand::Side::kLeft, hand::Side::kRight}) {
+    const hand::HandModel model = hand::default_hand_model(side);
+    const hand::PalmBox& box = model.shape.palm;
+    const double carpus = box.p_H_centre.y() - box.half_extents.y();  // the palm box's start
+    ASSERT_GT(carpus, 0.005) << "the skeleton's palm box starts at the carpus, not at the wrist";
+    std::vector<double> ends;
+    for (const bool reaches : {true, false}) {
+      render::HandSkinParams p;
+      p.palm_reaches_wrist = reaches;
+      std::vector<MeshData> meshes;
+      const render::HandSkin skin = render::build_hand_skin(model, p, &meshes);
+      ASSERT_GE(skin.forearm_mesh, 0);
+      // The forearm's frame: z from the wrist toward the elbow.
+      const auto arm_z = extent(meshes[static_cast<std::size_t>(skin.forearm_mesh)], 2);
+      EXPECT_NEAR(arm_z.first, -0.25 * skin.wrist_radius, 1e-6);
+      // The palm mesh in the box frame (the axes of H, at the box's centre).
+      const auto palm_y = extent(meshes[static_cast<std::size_t>(skin.palm_mesh)], 1);
+      const double start_H = box.p_H_centre.y() + palm_y.first;
+      const double end_H = box.p_H_centre.y() + palm_y.second;
+      if (reaches) {
+        EXPECT_NEAR(start_H, 0.0, 0.002) << "the palm's skin starts at the wrist";
+      } else {
+        EXPECT_NEAR(start_H, carpus, 0.002) << "the palm's skin starts at the carpus";
+      }
+      ends.push_back(end_H);
+    }
+    // Its distal end stays at the MCP line either way (within 0.2 mm: the tessellation's outermost
+    // vertices sit a little inside the longer box's end).
+    EXPECT_NEAR(ends[0], ends[1], 2e-4);
+  }
 }
 
 }  // namespace

@@ -108,7 +108,7 @@ TEST(SyntheticCamera, FilmsAnAnatomicalHandNotTheModelsSkin) {
   SyntheticFrame frame;
   ASSERT_TRUE(camera->film({&q[0], &q[1]}, &frame).ok());
 
-  render::HandSkinParams model_skin{0.12, 1.2, 0.10, false};  // the pipeline's model skin
+  render::HandSkinParams model_skin{.taper = 0.12, .palm_fullness = 1.2, .forearm_length_m = 0.10, .bracelet = false};  // the pipeline's model skin
   auto meshes = std::make_shared<std::vector<MeshData>>();
   std::array<render::HandSkin, 2> skins;
   for (int h = 0; h < 2; ++h) skins[h] = render::build_hand_skin(models[h], model_skin, meshes.get());

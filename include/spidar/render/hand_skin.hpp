@@ -20,6 +20,15 @@ struct HandSkinParams {
   double taper = 0.12;                ///< bone radius: (1 + taper)·r proximal, (1 − taper)·r distal
   double palm_fullness = 1.2;         ///< palm thickness × this (vs the model's box)
   double forearm_length_m = 0.10;     ///< visible forearm beyond the wrist [m]; 0 = none
+  /// How far the forearm's end reaches past the wrist into the hand, as a share of its radius
+  /// (0..1]. A hemisphere (1) of the forearm's radius, about two thirds of the palm's half
+  /// breadth, reaches 2.5–3 cm into the palm and stands out of it above and below, so that the
+  /// pixels of the carpus were drawn (and labelled) forearm: 9 % of the real hands' pixels on the
+  /// default user (tests/pipeline/registration_study --ceiling-scan).
+  double forearm_cap_depth = 0.25;
+  /// The palm's skin reaches back to the wrist (the skeleton's palm box starts at the carpus,
+  /// about a centimetre from it): with the forearm's end flattened, the carpus is palm.
+  bool palm_reaches_wrist = true;
   bool bracelet = true;               ///< a bracelet around the wrist
   double bracelet_width_m = 0.018;    ///< along the forearm [m]
   double bracelet_offset_m = 0.012;   ///< bracelet centre, from the wrist toward the elbow [m]
@@ -47,7 +56,10 @@ inline constexpr int kForearmPart = 6;
 
 /// A surface of revolution about z: sphere of radius r_a at z = 0, sphere of radius r_b at
 /// z = length, joined by their common tangent cone. Shared vertices (smooth normals).
-MeshData tapered_segment(double r_a, double r_b, double length, int slices = 16, int rings = 6);
+/// `cap_a_depth` flattens the end at z = 0: its cap reaches to z = −cap_a_depth·r_a (1: a
+/// hemisphere; less: a shallow dome).
+MeshData tapered_segment(double r_a, double r_b, double length, int slices = 16, int rings = 6,
+                         double cap_a_depth = 1.0);
 /// |x/a|^(2/e) + |y/b|^(2/e) + |z/c|^(2/e) = 1 with e < 1 a rounded box of half extents (a, b, c).
 MeshData rounded_box(const Vec3& half_extents, double exponent = 0.45, int slices = 24,
                      int stacks = 16);
