@@ -98,6 +98,8 @@ Status validate(const HandSkinParams& p) {
     return Error{"hand skin: taper must be in [0, 1), got " + std::to_string(p.taper)};
   if (!(std::isfinite(p.palm_fullness) && p.palm_fullness > 0 && p.palm_fullness <= 3))
     return Error{"hand skin: palm_fullness must be in (0, 3], got " + std::to_string(p.palm_fullness)};
+  if (!(std::isfinite(p.palm_wrist_breadth) && p.palm_wrist_breadth >= 0.5 && p.palm_wrist_breadth <= 1))
+    return Error{"hand skin: palm_wrist_breadth must be in [0.5, 1], got " + std::to_string(p.palm_wrist_breadth)};
   if (!(std::isfinite(p.forearm_cap_depth) && p.forearm_cap_depth > 0 && p.forearm_cap_depth <= 1))
     return Error{"hand skin: forearm_cap_depth must be in (0, 1], got " + std::to_string(p.forearm_cap_depth)};
   if (!(std::isfinite(p.forearm_length_m) && p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
@@ -128,6 +130,18 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
   MeshData palm = rounded_box(Vec3(1.05 * h.x(), h.y() * 1.02 + 0.5 * gap, p.palm_fullness * h.z()), 0.45,
                               p.palm_slices, p.palm_stacks);
   for (std::size_t k = 1; k < palm.vertices.size(); k += 3) palm.vertices[k] -= static_cast<float>(0.5 * gap);
+  // The palm narrows toward the wrist (palm_wrist_breadth of its breadth at the wrist end, full
+  // breadth from halfway to the knuckles on), smoothly.
+  if (p.palm_wrist_breadth < 1.0) {
+    float y_lo = 1e30f, y_hi = -1e30f;
+    for (std::size_t k = 1; k < palm.vertices.size(); k += 3)
+      y_lo = std::min(y_lo, palm.vertices[k]), y_hi = std::max(y_hi, palm.vertices[k]);
+    for (std::size_t k = 0; k + 2 < palm.vertices.size(); k += 3) {
+      const double t = std::clamp((palm.vertices[k + 1] - y_lo) / std::max(y_hi - y_lo, 1e-6f) / 0.5, 0.0, 1.0);
+      const double smooth = t * t * (3 - 2 * t);
+      palm.vertices[k] *= static_cast<float>(p.palm_wrist_breadth + (1 - p.palm_wrist_breadth) * smooth);
+    }
+  }
   meshes->push_back(std::move(palm));
   skin.palm_mesh = static_cast<int>(meshes->size()) - 1;
   skin.wrist_radius = 0.62 * h.x();

@@ -146,6 +146,7 @@ int main(int argc, char** argv) {
       render::HandSkinParams skin = model_skin;
       skin.forearm_cap_depth = 1.0;
       skin.palm_reaches_wrist = false;
+      skin.palm_wrist_breadth = 1.0;
       variants.push_back({"a hemispherical forearm end, the palm from the carpus",
                           sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
     }
@@ -154,6 +155,13 @@ int main(int argc, char** argv) {
       skin.forearm_cap_depth = depth;
       char name[64];
       std::snprintf(name, sizeof name, "forearm cap depth %.2f", depth);
+      variants.push_back({name, sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
+    }
+    for (double breadth : {1.0, 0.9, 0.7}) {
+      render::HandSkinParams skin = model_skin;
+      skin.palm_wrist_breadth = breadth;
+      char name[64];
+      std::snprintf(name, sizeof name, "palm breadth at the wrist %.1f", breadth);
       variants.push_back({name, sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
     }
     for (double fullness : {1.0, 1.5, 1.8}) {

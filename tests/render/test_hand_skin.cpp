@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <utility>
 #include <vector>
@@ -88,6 +89,13 @@ TEST(HandSkin, ValidateNamesTheFieldOutOfRange) {
   s = render::validate(p);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("taper"), std::string::npos) << s.error().message;
+  for (double bad : {0.4, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+    p = {};
+    p.palm_wrist_breadth = bad;
+    s = render::validate(p);
+    ASSERT_FALSE(s.ok()) << bad;
+    EXPECT_NE(s.error().message.find("palm_wrist_breadth must be in [0.5, 1]"), std::string::npos) << s.error().message;
+  }
   for (double bad : {0.0, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
     p = {};
     p.forearm_cap_depth = bad;
@@ -137,6 +145,21 @@ TEST(HandSkin, TheForearmEndsAtTheWristAndThePalmReachesIt) {
       }
       ends.push_back(end_H);
     }
+    // Its breadth (x) at the wrist end is palm_wrist_breadth of the breadth at the knuckles.
+    render::HandSkinParams p;
+    std::vector<MeshData> meshes;
+    const render::HandSkin skin = render::build_hand_skin(model, p, &meshes);
+    const MeshData& palm = meshes[static_cast<std::size_t>(skin.palm_mesh)];
+    const auto y = extent(palm, 1);
+    auto breadth_near = [&](double y_at) {  // x extent of the vertices within 3 mm of y_at
+      double lo = 1e300, hi = -1e300;
+      for (std::size_t i = 0; i + 2 < palm.vertices.size(); i += 3)
+        if (std::abs(palm.vertices[i + 1] - y_at) < 0.003)
+          lo = std::min(lo, static_cast<double>(palm.vertices[i])), hi = std::max(hi, static_cast<double>(palm.vertices[i]));
+      return hi - lo;
+    };
+    const double wrist = breadth_near(y.first + 0.004), knuckles = breadth_near(y.second - 0.004);
+    EXPECT_NEAR(wrist / knuckles, p.palm_wrist_breadth, 0.05) << wrist << " vs " << knuckles;
     // Its distal end stays at the MCP line either way (within 0.2 mm: the tessellation's outermost
     // vertices sit a little inside the longer box's end).
     EXPECT_NEAR(ends[0], ends[1], 2e-4);

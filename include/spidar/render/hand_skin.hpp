@@ -29,6 +29,11 @@ struct HandSkinParams {
   /// The palm's skin reaches back to the wrist (the skeleton's palm box starts at the carpus,
   /// about a centimetre from it): with the forearm's end flattened, the carpus is palm.
   bool palm_reaches_wrist = true;
+  /// The palm's breadth at its wrist end, as a share of its breadth at the knuckles [0.5, 1]
+  /// (it widens smoothly to full breadth halfway to the knuckles; 1: a box). A real palm is
+  /// about 0.7–0.8 as broad at the wrist as across the knuckles; the box's square end added
+  /// 5 % of the real hands' pixels at the wrist (registration_study --ceiling-scan).
+  double palm_wrist_breadth = 0.8;
   bool bracelet = true;               ///< a bracelet around the wrist
   double bracelet_width_m = 0.018;    ///< along the forearm [m]
   double bracelet_offset_m = 0.012;   ///< bracelet centre, from the wrist toward the elbow [m]
