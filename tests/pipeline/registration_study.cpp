@@ -133,43 +133,40 @@ int main(int argc, char** argv) {
   };
   std::vector<Variant> variants;
   if (a.ceiling_scan) {
+    // One variant: the hands `hands` drawn with `skin`, named by printf(format, value).
+    auto add = [&](const std::array<hand::HandModel, 2>& hands, const render::HandSkinParams& skin,
+                   const char* format, double value) {
+      char name[96];
+      std::snprintf(name, sizeof name, format, value);
+      variants.push_back({name, sim::ModelCeiling::create(context, camera, hands, skin).value(), {}});
+    };
     for (double scale : {0.9, 1.1, 1.2, 1.3}) {
       std::array<hand::HandModel, 2> thick = truth_models;
       for (auto& m : thick)
         for (auto& d : m.shape.digits)
           for (double& r : d.radius) r *= scale;
-      char name[64];
-      std::snprintf(name, sizeof name, "digit radii x%.1f", scale);
-      variants.push_back({name, sim::ModelCeiling::create(context, camera, thick, model_skin).value(), {}});
+      add(thick, model_skin, "digit radii x%.1f", scale);
     }
-    {  // the skin before 2026-11-24: the forearm's hemispherical end filled the carpus
-      render::HandSkinParams skin = model_skin;
-      skin.forearm_cap_depth = 1.0;
-      skin.palm_reaches_wrist = false;
-      skin.palm_wrist_breadth = 1.0;
-      variants.push_back({"a hemispherical forearm end, the palm from the carpus",
-                          sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
-    }
-    for (double depth : {0.1, 0.5}) {
-      render::HandSkinParams skin = model_skin;
-      skin.forearm_cap_depth = depth;
-      char name[64];
-      std::snprintf(name, sizeof name, "forearm cap depth %.2f", depth);
-      variants.push_back({name, sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
-    }
-    for (double breadth : {1.0, 0.9, 0.7}) {
-      render::HandSkinParams skin = model_skin;
-      skin.palm_wrist_breadth = breadth;
-      char name[64];
-      std::snprintf(name, sizeof name, "palm breadth at the wrist %.1f", breadth);
-      variants.push_back({name, sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
-    }
-    for (double fullness : {1.0, 1.5, 1.8}) {
-      render::HandSkinParams skin = model_skin;
-      skin.palm_fullness = fullness;
-      char name[64];
-      std::snprintf(name, sizeof name, "palm fullness %.1f", fullness);
-      variants.push_back({name, sim::ModelCeiling::create(context, camera, truth_models, skin).value(), {}});
+    // The skin before 2026-11-24: the forearm's hemispherical end filled the carpus.
+    render::HandSkinParams before = model_skin;
+    before.forearm_cap_depth = 1.0;
+    before.palm_reaches_wrist = false;
+    before.palm_wrist_breadth = 1.0;
+    add(truth_models, before, "a hemispherical forearm end, the palm from the carpus", 0);
+    // One skin parameter at a time.
+    struct Setting {
+      double render::HandSkinParams::*field;
+      const char* format;
+      std::vector<double> values;
+    };
+    for (const Setting& set : {Setting{&render::HandSkinParams::forearm_cap_depth, "forearm cap depth %.2f", {0.1, 0.5}},
+                               Setting{&render::HandSkinParams::palm_wrist_breadth, "palm breadth at the wrist %.1f", {1.0, 0.9, 0.7}},
+                               Setting{&render::HandSkinParams::palm_fullness, "palm fullness %.1f", {1.0, 1.5, 1.8}}}) {
+      for (double v : set.values) {
+        render::HandSkinParams skin = model_skin;
+        skin.*set.field = v;
+        add(truth_models, skin, set.format, v);
+      }
     }
   }
 

@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <iostream>
+#include <string>
 #include <utility>
 #include <vector>
 #include <limits>
@@ -89,20 +91,20 @@ TEST(HandSkin, ValidateNamesTheFieldOutOfRange) {
   s = render::validate(p);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("taper"), std::string::npos) << s.error().message;
-  for (double bad : {0.4, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
-    p = {};
-    p.palm_wrist_breadth = bad;
-    s = render::validate(p);
-    ASSERT_FALSE(s.ok()) << bad;
-    EXPECT_NE(s.error().message.find("palm_wrist_breadth must be in [0.5, 1]"), std::string::npos) << s.error().message;
-  }
-  for (double bad : {0.0, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
-    p = {};
-    p.forearm_cap_depth = bad;
-    s = render::validate(p);
-    ASSERT_FALSE(s.ok()) << bad;
-    EXPECT_NE(s.error().message.find("forearm_cap_depth must be in (0, 1]"), std::string::npos) << s.error().message;
-  }
+  // Each value of `field` is refused with `message`.
+  auto refused = [](double render::HandSkinParams::*field, std::initializer_list<double> values,
+                    const std::string& message) {
+    for (double bad : values) {
+      render::HandSkinParams q;
+      q.*field = bad;
+      const auto st = render::validate(q);
+      ASSERT_FALSE(st.ok()) << bad;
+      EXPECT_NE(st.error().message.find(message), std::string::npos) << st.error().message;
+    }
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  refused(&render::HandSkinParams::palm_wrist_breadth, {0.4, 1.5, nan}, "palm_wrist_breadth must be in [0.5, 1]");
+  refused(&render::HandSkinParams::forearm_cap_depth, {0.0, 1.5, nan}, "forearm_cap_depth must be in (0, 1]");
 }
 
 /// Extent of a mesh's vertices along axis `k` of its frame: {min, max} [m].
