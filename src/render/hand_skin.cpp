@@ -123,24 +123,19 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
   // The palm's skin reaches back to the wrist: the skeleton's palm box starts at the carpus (a
   // centimetre or so from the wrist), the hand's flesh does not, and the forearm's flattened end
   // (forearm_cap_depth) no longer fills the gap. The box mesh grows toward the wrist by the gap
-  // and its centre moves by half of it, in the box frame (the axes of H).
-  const double gap = p.palm_reaches_wrist
-                         ? std::max(0.0, model.shape.palm.p_H_centre.y() - model.shape.palm.half_extents.y())
-                         : 0.0;
-  MeshData palm = rounded_box(Vec3(1.05 * h.x(), h.y() * 1.02 + 0.5 * gap, p.palm_fullness * h.z()), 0.45,
-                              p.palm_slices, p.palm_stacks);
-  for (std::size_t k = 1; k < palm.vertices.size(); k += 3) palm.vertices[k] -= static_cast<float>(0.5 * gap);
-  // The palm narrows toward the wrist (palm_wrist_breadth of its breadth at the wrist end, full
-  // breadth from halfway to the knuckles on), smoothly.
-  if (p.palm_wrist_breadth < 1.0) {
-    float y_lo = 1e30f, y_hi = -1e30f;
-    for (std::size_t k = 1; k < palm.vertices.size(); k += 3)
-      y_lo = std::min(y_lo, palm.vertices[k]), y_hi = std::max(y_hi, palm.vertices[k]);
-    for (std::size_t k = 0; k + 2 < palm.vertices.size(); k += 3) {
-      const double t = std::clamp((palm.vertices[k + 1] - y_lo) / std::max(y_hi - y_lo, 1e-6f) / 0.5, 0.0, 1.0);
-      const double smooth = t * t * (3 - 2 * t);
-      palm.vertices[k] *= static_cast<float>(p.palm_wrist_breadth + (1 - p.palm_wrist_breadth) * smooth);
-    }
+  // and its centre moves by half of it, in the box frame (the axes of H). It also narrows toward
+  // the wrist: palm_wrist_breadth of its breadth at the wrist end, full breadth from halfway to
+  // the knuckles on, smoothly.
+  const hand::PalmBox& box = model.shape.palm;
+  const double gap = p.palm_reaches_wrist ? std::max(0.0, box.p_H_centre.y() - box.half_extents.y()) : 0.0;
+  const double half_y = h.y() * 1.02 + 0.5 * gap;
+  MeshData palm = rounded_box(Vec3(1.05 * h.x(), half_y, p.palm_fullness * h.z()), 0.45, p.palm_slices,
+                              p.palm_stacks);
+  for (std::size_t k = 0; k + 2 < palm.vertices.size(); k += 3) {
+    const double t = std::clamp((palm.vertices[k + 1] + half_y) / half_y, 0.0, 1.0);  // 0 wrist, 1 halfway
+    const double smooth = t * t * (3 - 2 * t);
+    palm.vertices[k] *= static_cast<float>(p.palm_wrist_breadth + (1 - p.palm_wrist_breadth) * smooth);
+    palm.vertices[k + 1] -= static_cast<float>(0.5 * gap);
   }
   meshes->push_back(std::move(palm));
   skin.palm_mesh = static_cast<int>(meshes->size()) - 1;

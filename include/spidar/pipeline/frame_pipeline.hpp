@@ -56,7 +56,8 @@ struct FramePipelineParams {
   /// front), no bracelet. The simulated user's hand is another mesh altogether
   /// (sim/anatomical_hand.hpp) and also differs in length, width, fingertip caps, joint ranges and
   /// an independent little finger.
-  render::HandSkinParams model_skin{.taper = 0.12, .palm_fullness = 1.2, .forearm_length_m = 0.10, .bracelet = false};
+  render::HandSkinParams model_skin{
+      .taper = 0.12, .palm_fullness = 1.2, .forearm_length_m = 0.10, .bracelet = false};
   /// Estimate each hand's length and width while the session runs (registration/shape_estimator.hpp)
   /// and fit with the estimate, starting from the given models; off: their sizes stay as given.
   bool personalise_shape = false;
