@@ -37,11 +37,24 @@ Pose along(const Vec3& p_W_origin, const Vec3& dir_W) {
   return X;
 }
 
+/// The forearm's frame at `p_W_origin`: z toward the elbow (−y_H), x along x_H, y dorsal (z_H).
+Pose forearm_frame(const Vec3& p_W_origin, const Mat3& R_WH) {
+  Mat3 R;
+  R.col(0) = R_WH.col(0);
+  R.col(1) = R_WH.col(2);
+  R.col(2) = -R_WH.col(1);
+  Pose X;
+  X.p = p_W_origin;
+  X.R = Quat(R);
+  return X;
+}
+
 std::array<float, 4> rgba(const std::array<float, 3>& c) { return {c[0], c[1], c[2], 1.f}; }
 
 }  // namespace
 
-MeshData tapered_segment(double r_a, double r_b, double length, int slices, int rings, double cap_a_depth) {
+MeshData tapered_segment(double r_a, double r_b, double length, int slices, int rings, double cap_a_depth,
+                         double cap_b_depth) {
   MeshData m;
   m.name = "tapered_segment";
   // Elevation of the tangent circle: sin α = (r_a − r_b) / length.
@@ -55,7 +68,7 @@ MeshData tapered_segment(double r_a, double r_b, double length, int slices, int 
   }
   for (int i = 0; i <= rings; ++i) {  // upper cap: α … π/2
     const double t = alpha + (kPi / 2 - alpha) * i / rings;
-    profile.emplace_back(r_b * std::cos(t), length + r_b * std::sin(t));
+    profile.emplace_back(r_b * std::cos(t), length + cap_b_depth * r_b * std::sin(t));
   }
   const int rows = static_cast<int>(profile.size());
   for (const auto& [r, z] : profile)
@@ -65,6 +78,13 @@ MeshData tapered_segment(double r_a, double r_b, double length, int slices, int 
     }
   grid_faces(m, rows, slices);
   return m;
+}
+
+void scale_across(MeshData* mesh, double sx, double sy) {
+  for (std::size_t k = 0; k + 2 < mesh->vertices.size(); k += 3) {
+    mesh->vertices[k] *= static_cast<float>(sx);
+    mesh->vertices[k + 1] *= static_cast<float>(sy);
+  }
 }
 
 MeshData rounded_box(const Vec3& half, double e, int slices, int stacks) {
@@ -100,6 +120,10 @@ Status validate(const HandSkinParams& p) {
     return Error{"hand skin: palm_fullness must be in (0, 3], got " + std::to_string(p.palm_fullness)};
   if (!(std::isfinite(p.palm_wrist_breadth) && p.palm_wrist_breadth >= 0.5 && p.palm_wrist_breadth <= 1))
     return Error{"hand skin: palm_wrist_breadth must be in [0.5, 1], got " + std::to_string(p.palm_wrist_breadth)};
+  if (!(std::isfinite(p.forearm_breadth) && p.forearm_breadth >= 0.4 && p.forearm_breadth <= 1))
+    return Error{"hand skin: forearm_breadth must be in [0.4, 1], got " + std::to_string(p.forearm_breadth)};
+  if (!(std::isfinite(p.forearm_depth) && p.forearm_depth >= 0.4 && p.forearm_depth <= 1))
+    return Error{"hand skin: forearm_depth must be in [0.4, 1], got " + std::to_string(p.forearm_depth)};
   if (!(std::isfinite(p.forearm_cap_depth) && p.forearm_cap_depth > 0 && p.forearm_cap_depth <= 1))
     return Error{"hand skin: forearm_cap_depth must be in (0, 1], got " + std::to_string(p.forearm_cap_depth)};
   if (!(std::isfinite(p.forearm_length_m) && p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
@@ -139,12 +163,26 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
   }
   meshes->push_back(std::move(palm));
   skin.palm_mesh = static_cast<int>(meshes->size()) - 1;
-  skin.wrist_radius = 0.62 * h.x();
+  // The forearm: an elliptic section, forearm_breadth of the palm's half breadth across and
+  // forearm_depth of that deep, widening by 15 % over its length toward the elbow.
+  skin.wrist_radius = p.forearm_breadth * h.x();
+  skin.wrist_half_depth = p.forearm_depth * skin.wrist_radius;
+  const int arm_slices = std::max(p.bone_slices, 16);
   if (p.forearm_length_m > 0) {
-    meshes->push_back(
-        tapered_segment(skin.wrist_radius, 1.15 * skin.wrist_radius, p.forearm_length_m,
-                        std::max(p.bone_slices, 16), p.bone_rings, p.forearm_cap_depth));
+    MeshData arm = tapered_segment(skin.wrist_radius, 1.15 * skin.wrist_radius, p.forearm_length_m, arm_slices,
+                                   p.bone_rings, p.forearm_cap_depth);
+    scale_across(&arm, 1.0, p.forearm_depth);
+    meshes->push_back(std::move(arm));
     skin.forearm_mesh = static_cast<int>(meshes->size()) - 1;
+  }
+  if (p.bracelet) {
+    // A band 2 mm proud of the forearm where it sits, with nearly flat ends.
+    const double grow = p.forearm_length_m > 0 ? 0.15 * p.bracelet_offset_m / p.forearm_length_m : 0;
+    const double a = skin.wrist_radius * (1 + grow) + 0.002, b = skin.wrist_half_depth * (1 + grow) + 0.002;
+    MeshData band = tapered_segment(a, a, p.bracelet_width_m, arm_slices, 2, 0.05, 0.05);
+    scale_across(&band, 1.0, b / a);
+    meshes->push_back(std::move(band));
+    skin.bracelet_mesh = static_cast<int>(meshes->size()) - 1;
   }
   return skin;
 }
@@ -179,15 +217,14 @@ void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const ha
     Shape arm;
     arm.type = Shape::Type::kMesh;
     arm.mesh = skin.forearm_mesh;
-    arm.X_WS = along(q.p_W_wrist(), toward_elbow);
+    arm.X_WS = forearm_frame(q.p_W_wrist(), R_WH);
     add(arm, kForearmPart, p.skin_rgb);
   }
-  if (!p.bracelet) return;
+  if (skin.bracelet_mesh < 0 || !p.bracelet) return;
   Shape bracelet;
-  bracelet.type = Shape::Type::kCylinder;
-  bracelet.X_WS = along(q.p_W_wrist() + p.bracelet_offset_m * toward_elbow, toward_elbow);
-  const double grow = p.forearm_length_m > 0 ? 0.15 * p.bracelet_offset_m / p.forearm_length_m : 0;
-  bracelet.size = Vec3(skin.wrist_radius * (1 + grow) + 0.002, 0.5 * p.bracelet_width_m, 0);
+  bracelet.type = Shape::Type::kMesh;
+  bracelet.mesh = skin.bracelet_mesh;
+  bracelet.X_WS = forearm_frame(q.p_W_wrist() + (p.bracelet_offset_m - 0.5 * p.bracelet_width_m) * toward_elbow, R_WH);
   add(bracelet, kBraceletPart, p.bracelet_rgb);
 }
 

@@ -152,6 +152,8 @@ int main(int argc, char** argv) {
     before.forearm_cap_depth = 1.0;
     before.palm_reaches_wrist = false;
     before.palm_wrist_breadth = 1.0;
+    before.forearm_breadth = 0.62;
+    before.forearm_depth = 1.0;
     add(truth_models, before, "a hemispherical forearm end, the palm from the carpus", 0);
     // One skin parameter at a time.
     struct Setting {
@@ -161,7 +163,9 @@ int main(int argc, char** argv) {
     };
     for (const Setting& set : {Setting{&render::HandSkinParams::forearm_cap_depth, "forearm cap depth %.2f", {0.1, 0.5}},
                                Setting{&render::HandSkinParams::palm_wrist_breadth, "palm breadth at the wrist %.1f", {1.0, 0.9, 0.7}},
-                               Setting{&render::HandSkinParams::palm_fullness, "palm fullness %.1f", {1.0, 1.5, 1.8}}}) {
+                               Setting{&render::HandSkinParams::palm_fullness, "palm fullness %.1f", {1.0, 1.5, 1.8}},
+                               Setting{&render::HandSkinParams::forearm_breadth, "forearm breadth %.2f", {0.62, 0.75}},
+                               Setting{&render::HandSkinParams::forearm_depth, "forearm depth %.2f", {1.0, 0.8, 0.5}}}) {
       for (double v : set.values) {
         render::HandSkinParams skin = model_skin;
         skin.*set.field = v;

@@ -13,6 +13,7 @@
 
 #include "gl_test_support.hpp"
 #include "spidar/hand/hand_model.hpp"
+#include "spidar/hand/rotation_vector.hpp"
 #include "spidar/render/hand_skin.hpp"
 #include "spidar/render/renderer.hpp"
 #include "spidar/vision/camera.hpp"
@@ -105,6 +106,8 @@ TEST(HandSkin, ValidateNamesTheFieldOutOfRange) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   refused(&render::HandSkinParams::palm_wrist_breadth, {0.4, 1.5, nan}, "palm_wrist_breadth must be in [0.5, 1]");
   refused(&render::HandSkinParams::forearm_cap_depth, {0.0, 1.5, nan}, "forearm_cap_depth must be in (0, 1]");
+  refused(&render::HandSkinParams::forearm_breadth, {0.3, 1.2, nan}, "forearm_breadth must be in [0.4, 1]");
+  refused(&render::HandSkinParams::forearm_depth, {0.3, 1.2, nan}, "forearm_depth must be in [0.4, 1]");
 }
 
 /// Extent of a mesh's vertices along axis `k` of its frame: {min, max} [m].
@@ -166,6 +169,58 @@ TEST(HandSkin, TheForearmEndsAtTheWristAndThePalmReachesIt) {
     // vertices sit a little inside the longer box's end).
     EXPECT_NEAR(ends[0], ends[1], 2e-4);
   }
+}
+
+// A wrist is broader than it is deep: the forearm's section is an ellipse forearm_breadth of the
+// palm's half breadth across x_H and forearm_depth of that along z_H (a round forearm as broad as
+// the wrist stood out of the palm above and below), and the bracelet is a band just proud of it.
+// Posed, the broad axis lies along the hand's x for any rotation of the hand.
+TEST(HandSkin, TheForearmIsBroaderThanDeepAcrossThePalm) {
+  const hand::HandModel model = hand::default_hand_model(hand::Side::kRight);
+  render::HandSkinParams p;
+  std::vector<MeshData> meshes;
+  const render::HandSkin skin = render::build_hand_skin(model, p, &meshes);
+  ASSERT_GE(skin.forearm_mesh, 0);
+  ASSERT_GE(skin.bracelet_mesh, 0);
+  const double half_breadth = p.forearm_breadth * model.shape.palm.half_extents.x();
+  EXPECT_NEAR(skin.wrist_radius, half_breadth, 1e-12);
+  EXPECT_NEAR(skin.wrist_half_depth, p.forearm_depth * half_breadth, 1e-12);
+  // Near the wrist (z within 1 mm of it) the vertices span the ellipse's axes, and everywhere the
+  // section is forearm_depth as deep as it is broad.
+  const MeshData& arm = meshes[static_cast<std::size_t>(skin.forearm_mesh)];
+  double x_wrist = 0, x_max = 0, y_max = 0;
+  for (std::size_t i = 0; i + 2 < arm.vertices.size(); i += 3) {
+    const double x = std::abs(static_cast<double>(arm.vertices[i]));
+    if (std::abs(arm.vertices[i + 2]) < 1e-3) x_wrist = std::max(x_wrist, x);
+    x_max = std::max(x_max, x);
+    y_max = std::max(y_max, std::abs(static_cast<double>(arm.vertices[i + 1])));
+  }
+  EXPECT_NEAR(x_wrist, half_breadth, 5e-4);
+  EXPECT_NEAR(y_max / x_max, p.forearm_depth, 1e-5);
+  // The band: 2 mm proud of the forearm at its centre, bracelet_width_m long (ends 5 % domed).
+  const MeshData& band = meshes[static_cast<std::size_t>(skin.bracelet_mesh)];
+  const auto band_x = extent(band, 0), band_y = extent(band, 1), band_z = extent(band, 2);
+  const double grow = 1 + 0.15 * p.bracelet_offset_m / p.forearm_length_m;
+  EXPECT_NEAR(band_x.second, half_breadth * grow + 0.002, 1e-4);
+  EXPECT_NEAR(band_y.second, p.forearm_depth * half_breadth * grow + 0.002, 1e-4);
+  EXPECT_NEAR(band_z.second - band_z.first, p.bracelet_width_m + 0.1 * (half_breadth * grow + 0.002), 1e-4);
+
+  // Posed with the hand turned about an arbitrary axis: the forearm's x is x_H, its z −y_H.
+  hand::HandParams q;
+  q.set_wrist(Vec3(0.01, 0.02, 0.3), Vec3(0.3, -1.1, 0.7));
+  SceneSnapshot scene;
+  render::pose_hand_skin(model, skin, q, p, &scene);
+  const Mat3 R_WH = hand::rotation_from_vector(q.r_W_hand());
+  int checked = 0;
+  for (const Shape& s : scene.shapes) {
+    if (s.finger != render::kForearmPart && s.finger != render::kBraceletPart) continue;
+    const Mat3 R = s.X_WS.R.toRotationMatrix();
+    EXPECT_LT((R.col(0) - R_WH.col(0)).norm(), 1e-9);
+    EXPECT_LT((R.col(2) + R_WH.col(1)).norm(), 1e-9);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-9);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2);
 }
 
 }  // namespace

@@ -34,6 +34,13 @@ struct HandSkinParams {
   /// about 0.7–0.8 as broad at the wrist as across the knuckles; the box's square end added
   /// 5 % of the real hands' pixels at the wrist (registration_study --ceiling-scan).
   double palm_wrist_breadth = 0.8;
+  /// The forearm's half breadth at the wrist, as a share of the palm's half breadth across the
+  /// knuckles (0.4..1). Anthropometric tables give a wrist about 0.65–0.70 as broad as the hand.
+  double forearm_breadth = 0.68;
+  /// The forearm's half depth (back to front) as a share of its half breadth (0.4..1; 1: round).
+  /// A wrist is about two thirds as deep as it is broad; a round forearm as broad as the wrist
+  /// stood out of the palm above and below and hid the carpus (registration_study --ceiling-scan).
+  double forearm_depth = 0.65;
   bool bracelet = true;               ///< a bracelet around the wrist
   double bracelet_width_m = 0.018;    ///< along the forearm [m]
   double bracelet_offset_m = 0.012;   ///< bracelet centre, from the wrist toward the elbow [m]
@@ -63,8 +70,11 @@ inline constexpr int kForearmPart = 6;
 /// z = length, joined by their common tangent cone. Shared vertices (smooth normals).
 /// `cap_a_depth` flattens the end at z = 0: its cap reaches to z = −cap_a_depth·r_a (1: a
 /// hemisphere; less: a shallow dome).
+/// `cap_b_depth` the same for the end at z = length.
 MeshData tapered_segment(double r_a, double r_b, double length, int slices = 16, int rings = 6,
-                         double cap_a_depth = 1.0);
+                         double cap_a_depth = 1.0, double cap_b_depth = 1.0);
+/// Scales `mesh` across its z axis: x by `sx`, y by `sy` (an elliptic section from a round one).
+void scale_across(MeshData* mesh, double sx, double sy);
 /// |x/a|^(2/e) + |y/b|^(2/e) + |z/c|^(2/e) = 1 with e < 1 a rounded box of half extents (a, b, c).
 MeshData rounded_box(const Vec3& half_extents, double exponent = 0.45, int slices = 24,
                      int stacks = 16);
@@ -78,7 +88,9 @@ struct HandSkin {
   std::vector<Bone> bones;  ///< one per capsule of hand::hand_render_shapes, same order
   int palm_mesh = -1;
   int forearm_mesh = -1;
-  double wrist_radius = 0.0;  ///< forearm radius at the wrist [m]
+  int bracelet_mesh = -1;
+  double wrist_radius = 0.0;      ///< forearm's half breadth at the wrist (along x_H) [m]
+  double wrist_half_depth = 0.0;  ///< forearm's half depth at the wrist (along z_H) [m]
 };
 
 /// Builds one hand's meshes into `meshes`.
