@@ -8,6 +8,7 @@
 //   registration_study [--user PROFILE|--user-file FILE] [--model L,W | --model-user]
 //                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
 //                      [--t0 S] [--t1 S] [--fps F] [--verbose] [--ceiling-scan]
+//                      [--dump DIR [--dump-below IOU]]
 //
 // --ceiling-scan: the model ceiling again with the skin's digits thicker or thinner (capsule radii
 // × 0.9 … 1.3) and its palm fuller (palm_fullness), to see which shape parameter the ceiling's
@@ -51,7 +52,8 @@ struct Args {
   bool ceiling_scan = false;
   double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
-  std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below 0.5
+  std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below --dump-below
+  double dump_below = 0.5;
   double shape_w = 0, shape_dq = 0;
 };
 
@@ -91,6 +93,7 @@ int main(int argc, char** argv) {
     else if (k == "--ceiling-scan") a.ceiling_scan = true;
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
+    else if (k == "--dump-below") a.dump_below = std::atof(next().c_str());
     else if (k == "--set") a.sets.push_back(next());
     else {
       std::fprintf(stderr, "registration_study: unknown argument %s\n", k.c_str());
@@ -362,7 +365,7 @@ int main(int argc, char** argv) {
         brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
       ++brace_n;
     }
-    if (!a.dump_dir.empty() && m.iou < 0.5) {
+    if (!a.dump_dir.empty() && m.iou < a.dump_below) {
       // Green: the real hands only; red: the fitted model's hand pixels; the frame beside.
       cv::Mat overlay(frame.hand_only.size(), CV_8UC3, cv::Scalar(0, 0, 0));
       overlay.setTo(cv::Scalar(0, 200, 0), frame.hand_only);
@@ -370,6 +373,19 @@ int main(int argc, char** argv) {
       cv::bitwise_and(frame.hand_only, ws.model_mask, both);
       overlay.setTo(cv::Scalar(0, 0, 220), ws.model_mask);
       overlay.setTo(cv::Scalar(0, 220, 220), both);
+      // Joints: the truth's white, the fit's magenta, joined.
+      for (int h = 0; h < 2; ++h) {
+        const auto fit_pts = hand::forward_kinematics(r.models[h], r.hands[h]);
+        const auto true_pts = hand::forward_kinematics(truth_models[h], truth[h]);
+        for (std::size_t j = 0; j < fit_pts.p_W_joint.size(); ++j) {
+          const Vec2 a2 = camera.project(true_pts.p_W_joint[j]), b2 = camera.project(fit_pts.p_W_joint[j]);
+          const cv::Point pa(static_cast<int>(a2.x()), static_cast<int>(a2.y()));
+          const cv::Point pb(static_cast<int>(b2.x()), static_cast<int>(b2.y()));
+          cv::line(overlay, pa, pb, cv::Scalar(255, 255, 255), 1);
+          cv::circle(overlay, pa, 2, cv::Scalar(255, 255, 255), -1);
+          cv::circle(overlay, pb, 2, cv::Scalar(255, 0, 255), -1);
+        }
+      }
       cv::Mat row;
       cv::hconcat(frame.bgr, overlay, row);
       char name[64];
