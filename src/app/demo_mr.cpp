@@ -104,6 +104,7 @@ int run_mr_demo(const DemoOptions& o) {
   session::SimulatedRigParams rp;
   rp.seed = o.seed;
   rp.fps = o.fps;
+  rp.bending_wrists = o.bending_wrists;
   session::SimulatedRig rig(cfg, scene, camera, truth_models, rp);
   auto run = session::Session::create(rig, scene, *context, camera, models, sp);
 
@@ -187,6 +188,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.main_silhouette = o.silhouette;
   summary.personalised = !o.fixed_hand_size;
   summary.shaped_fingers = o.shaped_fingers;
+  summary.bending_wrists = o.bending_wrists;
   summary.compositor = o.compositor;
   summary.width = o.width;
   summary.height = o.height;

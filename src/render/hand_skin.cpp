@@ -5,6 +5,7 @@
 #include <string>
 #include <numbers>
 
+#include "spidar/hand/forearm.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/hand/rotation_vector.hpp"
 
@@ -188,7 +189,7 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
 }
 
 void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const hand::HandParams& q,
-                    const HandSkinParams& p, SceneSnapshot* scene) {
+                    const HandSkinParams& p, SceneSnapshot* scene, const Vec3* toward_elbow_W) {
   const hand::HandRenderShapes shapes = hand::hand_render_shapes(model, q);
   const int hand = static_cast<int>(model.side);
   auto add = [&](Shape s, int finger, const std::array<float, 3>& colour) {
@@ -212,19 +213,22 @@ void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const ha
   add(palm, kPalmPart, p.skin_rgb);
 
   const Mat3 R_WH = hand::rotation_from_vector(q.r_W_hand());
-  const Vec3 toward_elbow = -R_WH.col(1);
+  // The forearm's frame as if in line with the hand, then bent at the wrist onto toward_elbow_W.
+  Mat3 R_arm = R_WH;
+  if (toward_elbow_W) R_arm = hand::wrist_bend(R_WH, *toward_elbow_W) * R_WH;
+  const Vec3 toward_elbow = -R_arm.col(1);
   if (skin.forearm_mesh >= 0) {
     Shape arm;
     arm.type = Shape::Type::kMesh;
     arm.mesh = skin.forearm_mesh;
-    arm.X_WS = forearm_frame(q.p_W_wrist(), R_WH);
+    arm.X_WS = forearm_frame(q.p_W_wrist(), R_arm);
     add(arm, kForearmPart, p.skin_rgb);
   }
   if (skin.bracelet_mesh < 0 || !p.bracelet) return;
   Shape bracelet;
   bracelet.type = Shape::Type::kMesh;
   bracelet.mesh = skin.bracelet_mesh;
-  bracelet.X_WS = forearm_frame(q.p_W_wrist() + (p.bracelet_offset_m - 0.5 * p.bracelet_width_m) * toward_elbow, R_WH);
+  bracelet.X_WS = forearm_frame(q.p_W_wrist() + (p.bracelet_offset_m - 0.5 * p.bracelet_width_m) * toward_elbow, R_arm);
   add(bracelet, kBraceletPart, p.bracelet_rgb);
 }
 

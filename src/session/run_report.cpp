@@ -272,6 +272,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"scene", s.scene},
       {"user_hand", s.user_hand},
       {"shaped_fingers", s.shaped_fingers},
+      {"bending_wrists", s.bending_wrists},
       {"haptic",
        {{"rate_hz", s.servo.rate_hz},
         {"jitter_p50_us", s.servo.jitter_p50_us},

@@ -26,7 +26,8 @@ SimulatedRig::SimulatedRig(const strings::DeviceConfig& config, const Scene& sce
   } else if (interactive_) {
     camera_ = make_interactive_source(camera, *interactive_, params.fps, params.seed);
   } else {
-    camera_ = make_synthetic_source(camera, user, *scene.task, *device_, params.fps, params.seed);
+    camera_ = make_synthetic_source(camera, user, *scene.task, *device_, params.fps, params.seed,
+                                    params.bending_wrists);
   }
 }
 

@@ -1,6 +1,7 @@
 // The simulated rig's camera: sim::CameraThread filming the scripted user's true hands.
 #include "spidar/device/sample_interpolation.hpp"
 #include "spidar/session/frame_source.hpp"
+#include "spidar/sim/user_hands.hpp"
 
 namespace spidar::session {
 namespace {
@@ -9,8 +10,9 @@ class SyntheticSource final : public FrameSource {
  public:
   SyntheticSource(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
                   const sim::RubiksTask& task, device::SimulatedSpidar& dev, double fps,
-                  std::uint64_t seed)
-      : camera_(camera), truth_(truth), task_(task), dev_(dev), fps_(fps), seed_(seed) {}
+                  std::uint64_t seed, bool bending_wrists)
+      : camera_(camera), truth_(truth), task_(task), dev_(dev), fps_(fps), seed_(seed),
+        bending_wrists_(bending_wrists) {}
   ~SyntheticSource() override { stop(); }
 
   Status start(std::int64_t t0_ns) override {
@@ -26,6 +28,7 @@ class SyntheticSource final : public FrameSource {
     };
     sim::SyntheticCameraParams cp;
     cp.seed = seed_;
+    if (bending_wrists_) cp.elbows_W = sim::user_elbows(task_);
     sim::CameraThreadParams ctp;
     ctp.fps = fps_;
     ctp.t0_ns = t0_ns;
@@ -58,6 +61,7 @@ class SyntheticSource final : public FrameSource {
   device::SimulatedSpidar& dev_;
   double fps_;
   std::uint64_t seed_;
+  bool bending_wrists_;
   std::vector<device::FingertipSample> truth_buf_;
   std::unique_ptr<sim::CameraThread> thread_;
   bool stopped_ = false;
@@ -69,8 +73,8 @@ std::unique_ptr<FrameSource> make_synthetic_source(const vision::Camera& camera,
                                                    const std::array<hand::HandModel, 2>& truth,
                                                    const sim::RubiksTask& task,
                                                    device::SimulatedSpidar& dev, double fps,
-                                                   std::uint64_t seed) {
-  return std::make_unique<SyntheticSource>(camera, truth, task, dev, fps, seed);
+                                                   std::uint64_t seed, bool bending_wrists) {
+  return std::make_unique<SyntheticSource>(camera, truth, task, dev, fps, seed, bending_wrists);
 }
 
 }  // namespace spidar::session

@@ -2,23 +2,27 @@
 #include <algorithm>
 #include <cmath>
 
+#include "spidar/hand/forearm.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/rotation_vector.hpp"
 #include "spidar/sim/anatomical_hand.hpp"
 
 namespace spidar::sim {
 
-SkinTransforms skin_transforms(const AnatomicalHand& hand, const hand::HandParams& params) {
+SkinTransforms skin_transforms(const AnatomicalHand& hand, const hand::HandParams& params,
+                               const Vec3* toward_elbow_W) {
   const HandBoneFrames now = hand_bone_frames(hand.model, params);
   // A = R_WH·M: right-hand H coordinates to world directions (M mirrors x for the left hand).
-  Mat3 A = hand::rotation_from_vector(params.r_W_hand());
+  const Mat3 R_WH = hand::rotation_from_vector(params.r_W_hand());
+  Mat3 A = R_WH;
   if (hand.model.side == hand::Side::kLeft) A.col(0) = -A.col(0);
   const Vec3 p_W_wrist = params.p_W_wrist();
   SkinTransforms X;
   for (int b = 0; b < kHandBoneCount; ++b) {
     // X_W(B now) · X_H(B rest)⁻¹ applied to a rest point q: A·(R_now R_restᵀ (q − p_rest) + p_now).
     const Mat3 R = now.R_HB[b] * hand.rest.R_HB[b].transpose();
-    const Mat3 L = A * R;
+    Mat3 L = A * R;
+    if (b == kForearmBone && toward_elbow_W) L = hand::wrist_bend(R_WH, *toward_elbow_W) * L;  // about the wrist
     X.L[b] = L.cast<float>();
     X.t[b] = (p_W_wrist + A * (now.p_HB[b] - R * hand.rest.p_HB[b])).cast<float>();
   }
@@ -66,8 +70,8 @@ std::vector<MeshData> part_meshes(const AnatomicalHand& hand) {
 }
 
 void pose_anatomical_hand(const AnatomicalHand& hand, const hand::HandParams& params,
-                          std::span<MeshData> meshes) {
-  const SkinTransforms X = skin_transforms(hand, params);
+                          std::span<MeshData> meshes, const Vec3* toward_elbow_W) {
+  const SkinTransforms X = skin_transforms(hand, params, toward_elbow_W);
   for (std::size_t i = 0; i < hand.parts.size() && i < meshes.size(); ++i) {
     pose_part(hand.parts[i], X, meshes[i].vertices, meshes[i].normals);
     ++meshes[i].version;

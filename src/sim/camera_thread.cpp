@@ -20,6 +20,7 @@ void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to) {
     if (a->empty()) b->release();
     else a->copyTo(*b);
   }
+  to->frame.toward_elbow_W = from.frame.toward_elbow_W;
   to->truth = from.truth;
   to->cap_residual_m = from.cap_residual_m;
   to->film_ms = from.film_ms;

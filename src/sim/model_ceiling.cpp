@@ -42,14 +42,18 @@ Result<std::unique_ptr<ModelCeiling>> ModelCeiling::create(render::Context& cont
 }
 
 Result<double> ModelCeiling::iou(const std::array<hand::HandParams, 2>& truth,
-                                 const cv::Mat& real_hand_only) {
+                                 const cv::Mat& real_hand_only,
+                                 const std::array<std::optional<Vec3>, 2>& toward_elbow_W) {
   Impl& s = *impl_;
   if (real_hand_only.type() != CV_8UC1 || real_hand_only.cols != s.camera.width() ||
       real_hand_only.rows != s.camera.height())
     return Error{"model ceiling: expected a CV_8UC1 mask of the camera's size"};
   s.scene.shapes.clear();
   s.scene.meshes = s.meshes;
-  for (int h = 0; h < 2; ++h) render::pose_hand_skin(s.user[h], s.skins[h], truth[h], s.skin, &s.scene);
+  for (std::size_t h = 0; h < 2; ++h) {
+    const auto& d = toward_elbow_W[h];
+    render::pose_hand_skin(s.user[h], s.skins[h], truth[h], s.skin, &s.scene, d ? &*d : nullptr);
+  }
   render::RenderParams rp;
   rp.hands = render::HandDrawMode::kHidden;
   if (auto st = s.renderer->render(s.scene, s.camera, rp); !st) return st.error();

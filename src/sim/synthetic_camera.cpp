@@ -1,9 +1,13 @@
 #include "spidar/sim/synthetic_camera.hpp"
 
 #include <cmath>
+#include <numbers>
+#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "spidar/hand/forearm.hpp"
+#include "spidar/hand/rotation_vector.hpp"
 #include "spidar/render/hand_skin.hpp"  // part ids
 #include "spidar/render/renderer.hpp"
 #include "spidar/sim/anatomical_hand.hpp"
@@ -19,6 +23,10 @@ Status validate(const SyntheticCameraParams& p) {
     return bad("bracelet_width_m must be in (0, 0.1) m, got " + std::to_string(p.bracelet_width_m));
   if (!(p.bracelet_offset_m >= 0 && p.bracelet_offset_m < 0.1))
     return bad("bracelet_offset_m must be in [0, 0.1) m");
+  if (!(p.max_wrist_bend_rad > 0 && p.max_wrist_bend_rad <= 0.5 * std::numbers::pi))
+    return bad("max_wrist_bend_rad must be in (0, pi/2], got " + std::to_string(p.max_wrist_bend_rad));
+  if (p.elbows_W && !((*p.elbows_W)[0].allFinite() && (*p.elbows_W)[1].allFinite()))
+    return bad("elbows_W must be finite");
   if (!(p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
     return bad("forearm_length_m must be in [0, 0.5] m");
   if (!(p.ambient >= 0.f && p.ambient <= 1.f)) return bad("ambient must be in [0, 1]");
@@ -44,14 +52,27 @@ struct SyntheticCamera::Impl {
   cv::Mat accumulator, noise;
   cv::RNG rng;
 
+  /// Where each forearm pointed in the last build_scene.
+  std::array<std::optional<Vec3>, 2> toward_elbow;
+
   void build_scene(const HandPoses& poses) {
     scene.shapes.clear();
+    toward_elbow = {};
     scene.meshes = meshes;
     for (int h = 0; h < 2; ++h) {
       if (!poses[h]) continue;
       const AnatomicalHand& hand = hands[static_cast<std::size_t>(h)];
       const std::size_t first = first_mesh[static_cast<std::size_t>(h)];
-      pose_anatomical_hand(hand, *poses[h], std::span<MeshData>(*meshes).subspan(first, hand.parts.size()));
+      Vec3 toward_elbow = Vec3::Zero();
+      if (params.elbows_W) {
+        const hand::HandParams& q = *poses[h];
+        toward_elbow = hand::forearm_direction(hand::rotation_from_vector(q.r_W_hand()), q.p_W_wrist(),
+                                               (*params.elbows_W)[static_cast<std::size_t>(h)],
+                                               params.max_wrist_bend_rad);
+      }
+      pose_anatomical_hand(hand, *poses[h], std::span<MeshData>(*meshes).subspan(first, hand.parts.size()),
+                           params.elbows_W ? &toward_elbow : nullptr);
+      if (params.elbows_W) this->toward_elbow[static_cast<std::size_t>(h)] = toward_elbow;
       for (std::size_t i = 0; i < hand.parts.size(); ++i) {
         Shape s;  // vertices are in world already: X_WS = identity
         s.type = Shape::Type::kMesh;
@@ -148,6 +169,7 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
   else s.targets.colour.copyTo(out->bgr);
 
   // Ground truth at `poses`.
+  out->toward_elbow_W = s.toward_elbow;
   cv::compare(s.targets.hand_id, 0, out->mask, cv::CMP_GT);
   out->hand_index.create(out->mask.size(), CV_8UC1);
   out->hand_only.create(out->mask.size(), CV_8UC1);

@@ -3,10 +3,16 @@
 
 #include <cmath>
 
+#include "spidar/hand/forearm.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/joint_limits.hpp"
 
 namespace spidar::sim {
+
+std::array<Vec3, 2> user_elbows(const RubiksTask& task, double forearm_length_m) {
+  return {hand::elbow_in_line(task.nominal(0.0, hand::Side::kLeft), forearm_length_m),
+          hand::elbow_in_line(task.nominal(0.0, hand::Side::kRight), forearm_length_m)};
+}
 namespace {
 
 /// Mean distance of the hand's fingertip caps from the observed ones [m] (0 without any).

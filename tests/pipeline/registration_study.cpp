@@ -8,7 +8,7 @@
 //   registration_study [--user PROFILE|--user-file FILE] [--model L,W | --model-user]
 //                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
 //                      [--t0 S] [--t1 S] [--fps F] [--verbose] [--ceiling-scan]
-//                      [--dump DIR [--dump-below IOU]]
+//                      [--dump DIR [--dump-below IOU]] [--bending-wrists]
 //
 // --ceiling-scan: the model ceiling again with the skin's digits thicker or thinner (capsule radii
 // × 0.9 … 1.3) and its palm fuller (palm_fullness), to see which shape parameter the ceiling's
@@ -54,6 +54,7 @@ struct Args {
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
   std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below --dump-below
   double dump_below = 0.5;
+  bool bending_wrists = false;  ///< --bending-wrists: the user's forearms point at fixed elbows (sim::user_elbows)
   double shape_w = 0, shape_dq = 0;
 };
 
@@ -93,6 +94,7 @@ int main(int argc, char** argv) {
     else if (k == "--ceiling-scan") a.ceiling_scan = true;
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
+    else if (k == "--bending-wrists") a.bending_wrists = true;
     else if (k == "--dump-below") a.dump_below = std::atof(next().c_str());
     else if (k == "--set") a.sets.push_back(next());
     else {
@@ -123,7 +125,6 @@ int main(int argc, char** argv) {
               hand::make_hand_model(hand::Side::kRight, d).value()};
   }
   const vision::Camera camera = vision::default_rig_camera();
-  auto film = sim::SyntheticCamera::create(context, camera, truth_models).value();
   render::HandSkinParams model_skin = pipeline::FramePipelineParams{}.model_skin;
   if (a.forearm_cap > 0) model_skin.forearm_cap_depth = a.forearm_cap;
   auto ceiling = sim::ModelCeiling::create(context, camera, truth_models, model_skin).value();
@@ -227,6 +228,9 @@ int main(int argc, char** argv) {
   if (a.shape_dq > 0) p.shape_estimator.min_pose_change = a.shape_dq;
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models);
+  sim::SyntheticCameraParams film_params;
+  if (a.bending_wrists) film_params.elbows_W = sim::user_elbows(task);
+  auto film = sim::SyntheticCamera::create(context, camera, truth_models, film_params).value();
   for (int h = 0; h < 2; ++h)
     p.initial_r_W_hand[h] =
         task.nominal(a.t0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
@@ -267,13 +271,14 @@ int main(int argc, char** argv) {
     }
     const auto m = sim::measure_frame(frame, r, p.compositor.mode, r.models, truth_models, truth,
                                       camera, &ws).value();
-    const double c = ceiling->iou(truth, frame.hand_only).value();
-    for (Variant& v : variants) v.iou.push_back(v.ceiling->iou(truth, frame.hand_only).value());
+    const double c = ceiling->iou(truth, frame.hand_only, frame.toward_elbow_W).value();
+    for (Variant& v : variants) v.iou.push_back(v.ceiling->iou(truth, frame.hand_only, frame.toward_elbow_W).value());
     if (part_renderer) {
       SceneSnapshot hands_scene;
       hands_scene.meshes = part_meshes;
       for (int h = 0; h < 2; ++h)
-        render::pose_hand_skin(truth_models[h], part_skins[h], truth[h], part_skin_params, &hands_scene);
+        render::pose_hand_skin(truth_models[h], part_skins[h], truth[h], part_skin_params, &hands_scene,
+                               frame.toward_elbow_W[static_cast<std::size_t>(h)] ? &*frame.toward_elbow_W[static_cast<std::size_t>(h)] : nullptr);
       render::RenderParams rp;
       rp.hands = render::HandDrawMode::kHidden;
       render::RenderTargets tg;

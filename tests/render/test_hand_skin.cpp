@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include "gl_test_support.hpp"
+#include "spidar/hand/forearm.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/hand/rotation_vector.hpp"
 #include "spidar/render/hand_skin.hpp"
@@ -218,6 +219,24 @@ TEST(HandSkin, TheForearmIsBroaderThanDeepAcrossThePalm) {
     EXPECT_LT((R.col(0) - R_WH.col(0)).norm(), 1e-9);
     EXPECT_LT((R.col(2) + R_WH.col(1)).norm(), 1e-9);
     EXPECT_NEAR(R.determinant(), 1.0, 1e-9);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2);
+
+  // Bent at the wrist toward an elbow: the forearm and the band point along it, pronated with the
+  // hand (the shortest arc from −y_H), and start at the wrist.
+  const Vec3 d = Eigen::AngleAxisd(0.7, R_WH.col(2)) * Vec3(-R_WH.col(1));
+  SceneSnapshot bent;
+  render::pose_hand_skin(model, skin, q, p, &bent, &d);
+  const Mat3 B = hand::wrist_bend(R_WH, d);
+  checked = 0;
+  for (const Shape& s : bent.shapes) {
+    if (s.finger != render::kForearmPart && s.finger != render::kBraceletPart) continue;
+    const Mat3 R = s.X_WS.R.toRotationMatrix();
+    EXPECT_LT((R.col(2) - d).norm(), 1e-9);
+    EXPECT_LT((R.col(0) - B * R_WH.col(0)).norm(), 1e-9);
+    const double along = (s.X_WS.p - q.p_W_wrist()).dot(d);
+    EXPECT_LT((s.X_WS.p - q.p_W_wrist() - along * d).norm(), 1e-9) << "on the forearm's axis";
     ++checked;
   }
   EXPECT_EQ(checked, 2);

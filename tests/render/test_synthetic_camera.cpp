@@ -72,6 +72,40 @@ TEST(SyntheticCamera, BraceletsSitAtTheWrists) {
   }
 }
 
+// With elbows (a bending wrist), the bracelet sits on the forearm pointing at the elbow, not on
+// the hand's axis, and the frame says where each forearm pointed; without, the frame says nothing.
+TEST(SyntheticCamera, WithElbowsTheBraceletFollowsTheForearm) {
+  SPIDAR_REQUIRE_GL();
+  const vision::Camera cam = vision::default_rig_camera();
+  const auto models = render::test::truth_models();
+  const auto q = render::test::reaching_hands();
+  SyntheticCameraParams p;
+  std::array<Vec3, 2> toward;
+  p.elbows_W.emplace();
+  for (int h = 0; h < 2; ++h) {
+    const Mat3 R = hand::hand_pose(q[h]).R.toRotationMatrix();
+    // Elbows 0.5 rad (29 deg) off the hands' axes, about their x axes.
+    toward[h] = Eigen::AngleAxisd(0.5, R.col(0)) * Vec3(-R.col(1));
+    (*p.elbows_W)[h] = q[h].p_W_wrist() + 0.26 * toward[h];
+  }
+  auto camera = SyntheticCamera::create(*gl_context(), cam, models, p).value();
+  SyntheticFrame frame;
+  ASSERT_TRUE(camera->film({&q[0], &q[1]}, &frame).ok());
+  vision::BraceletWorkspace ws;
+  auto wrists = vision::detect_bracelets(frame.bgr, vision::BraceletParams{}, nullptr, &ws);
+  ASSERT_TRUE(wrists.ok()) << wrists.error().message;
+  for (int h = 0; h < 2; ++h) {
+    ASSERT_TRUE(frame.toward_elbow_W[h].has_value());
+    EXPECT_LT((*frame.toward_elbow_W[h] - toward[h]).norm(), 1e-9);
+    ASSERT_TRUE((*wrists)[h].found) << "hand " << h;
+    const Vec3 on_arm = q[h].p_W_wrist() + 0.012 * toward[h];
+    EXPECT_LT(((*wrists)[h].wrist_px - cam.project(on_arm)).norm(), 15.0) << "hand " << h;
+  }
+  auto straight = SyntheticCamera::create(*gl_context(), cam, models).value();
+  ASSERT_TRUE(straight->film({&q[0], &q[1]}, &frame).ok());
+  EXPECT_FALSE(frame.toward_elbow_W[0].has_value() || frame.toward_elbow_W[1].has_value());
+}
+
 TEST(SyntheticCamera, DiffersFromTheModelsCapsules) {
   SPIDAR_REQUIRE_GL();
   // The "real" hands are not the registration's geometry: same pose, visibly different masks.
@@ -191,6 +225,12 @@ TEST(SyntheticCamera, RejectsBadParams) {
   p = {};
   p.noise_sigma = -1;
   EXPECT_NE(validate(p).error().message.find("noise_sigma"), std::string::npos);
+  p = {};
+  p.max_wrist_bend_rad = 2.0;
+  EXPECT_NE(validate(p).error().message.find("max_wrist_bend_rad"), std::string::npos);
+  p = {};
+  p.elbows_W = std::array<Vec3, 2>{Vec3(NAN, 0, 0), Vec3::Zero()};
+  EXPECT_NE(validate(p).error().message.find("elbows_W"), std::string::npos);
 }
 
 }  // namespace

@@ -8,7 +8,9 @@
 #include <random>
 
 #include "allocation_counter.hpp"
+#include "spidar/hand/forearm.hpp"
 #include "spidar/hand/joint_limits.hpp"
+#include "spidar/hand/rotation_vector.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/render/hand_skin.hpp"
 #include "spidar/sim/anatomical_hand.hpp"
@@ -207,6 +209,34 @@ TEST(AnatomicalHand, AJointMovesOnlyItsDigit) {
       } else {
         EXPECT_LT(m[i], 1e-6) << n;
       }
+    }
+  }
+}
+
+// A bending wrist: given where the forearm points, the forearm and its bracelet turn about the
+// wrist onto that direction, and nothing of the hand moves.
+TEST(AnatomicalHand, TheForearmAndBraceletTurnAboutTheWristOntoTheElbow) {
+  for (auto side : {hand::Side::kLeft, hand::Side::kRight}) {
+    const AnatomicalHand h = build(side);
+    hand::HandParams q;
+    const Vec3 wrist(0.05, -0.02, 0.3);
+    q.set_wrist(wrist, Vec3(0.2, -0.1, 0.9));
+    const Mat3 R = hand::rotation_from_vector(q.r_W_hand());
+    const Vec3 d = Eigen::AngleAxisd(0.8, R.col(0)) * Vec3(-R.col(1));
+    std::vector<MeshData> straight = part_meshes(h), bent = part_meshes(h);
+    pose_anatomical_hand(h, q, straight);
+    pose_anatomical_hand(h, q, bent, &d);
+    const Mat3 B = hand::wrist_bend(R, d);
+    for (std::size_t i = 0; i < h.parts.size(); ++i) {
+      const bool arm = h.parts[i].kind == HandPart::kForearm || h.parts[i].kind == HandPart::kBracelet;
+      double worst = 0;
+      for (std::size_t j = 0; j + 2 < straight[i].vertices.size(); j += 3) {
+        const Vec3 a(straight[i].vertices[j], straight[i].vertices[j + 1], straight[i].vertices[j + 2]);
+        const Vec3 b(bent[i].vertices[j], bent[i].vertices[j + 1], bent[i].vertices[j + 2]);
+        const Vec3 expected = arm ? Vec3(wrist + B * (a - wrist)) : a;
+        worst = std::max(worst, (b - expected).norm());
+      }
+      EXPECT_LT(worst, 2e-6) << h.parts[i].name;  // float vertices
     }
   }
 }

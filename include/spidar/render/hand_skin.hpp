@@ -99,7 +99,9 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& par
 
 /// Appends the hand posed by `q` (non-hand shapes with their own colours; hand/finger set so the
 /// renderer's hand targets give ground truth).
+/// `toward_elbow_W` (unit, world; hand/forearm.hpp): the forearm and bracelet point along it,
+/// bent at the wrist; null: in line with the hand (−y_H).
 void pose_hand_skin(const hand::HandModel& model, const HandSkin& skin, const hand::HandParams& q,
-                    const HandSkinParams& params, SceneSnapshot* scene);
+                    const HandSkinParams& params, SceneSnapshot* scene, const Vec3* toward_elbow_W = nullptr);
 
 }  // namespace spidar::render

@@ -62,7 +62,7 @@ std::unique_ptr<FrameSource> make_synthetic_source(const vision::Camera& camera,
                                                    const std::array<hand::HandModel, 2>& truth,
                                                    const sim::RubiksTask& task,
                                                    device::SimulatedSpidar& dev, double fps,
-                                                   std::uint64_t seed);
+                                                   std::uint64_t seed, bool bending_wrists = false);
 
 /// The synthetic camera filming the interactively controlled hands (their commanded posture).
 std::unique_ptr<FrameSource> make_interactive_source(const vision::Camera& camera,

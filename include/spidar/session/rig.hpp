@@ -41,6 +41,10 @@ struct SimulatedRigParams {
   std::uint64_t seed = 0;    ///< device noise and camera noise
   double fps = 30.0;         ///< synthetic camera rate [frames/s]
   bool interactive = false;  ///< the GUI moves the hands instead of the scene's script
+  /// The user's forearms point at their elbows, which stay where the forearms pointed at the
+  /// script's start; the wrists bend (up to 60°) when the hands turn (sim::user_elbows). Off: the
+  /// forearms stay in line with the hands, as the registration's model has them.
+  bool bending_wrists = false;
 };
 
 /// The simulated SPIDAR-8 held by a simulated user (the scene's script, or interactive hands

@@ -38,6 +38,7 @@ struct MrSummary {
   double user_length_m = 0, user_width_m = 0;  ///< the simulated user's true hand sizes
   bool main_silhouette = false;
   bool personalised = false;  ///< the registration estimated the hands' sizes online
+  bool bending_wrists = false;  ///< the simulated user's forearms point at fixed elbows
   bool shaped_fingers = false;  ///< the simulated user's fingertips held by their own fingers' stiffness
   int width = 0, height = 0;
   std::string ended_by = "completed";  ///< completed | SIGINT | SIGTERM

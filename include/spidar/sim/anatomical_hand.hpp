@@ -95,7 +95,10 @@ struct SkinTransforms {
   std::array<Eigen::Matrix3f, kHandBoneCount> L;
   std::array<Eigen::Vector3f, kHandBoneCount> t;
 };
-SkinTransforms skin_transforms(const AnatomicalHand& hand, const hand::HandParams& params);
+/// `toward_elbow_W` (unit, world; hand::forearm_direction): the forearm bone points along it,
+/// bent at the wrist from the hand's axis (hand::wrist_bend); null: in line with the hand.
+SkinTransforms skin_transforms(const AnatomicalHand& hand, const hand::HandParams& params,
+                               const Vec3* toward_elbow_W = nullptr);
 
 /// Writes part's posed vertices and unit normals into p_W and n_W (x y z per vertex, world),
 /// which must hold 3 floats per vertex. Allocates nothing.
@@ -109,6 +112,6 @@ std::vector<MeshData> part_meshes(const AnatomicalHand& hand);
 /// Poses every part of `hand` by `params` into meshes[i] (i = part index; made by part_meshes),
 /// in world, and increments each mesh's version so a renderer uploads it again. Allocates nothing.
 void pose_anatomical_hand(const AnatomicalHand& hand, const hand::HandParams& params,
-                          std::span<MeshData> meshes);
+                          std::span<MeshData> meshes, const Vec3* toward_elbow_W = nullptr);
 
 }  // namespace spidar::sim

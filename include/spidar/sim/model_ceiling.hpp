@@ -5,6 +5,7 @@
 /// finger's own posture), so it is reported beside every fitted IoU: what is below it is the
 /// fit's; what is between it and 1 is the model's shape.
 #include <array>
+#include <optional>
 #include <memory>
 #include <opencv2/core/mat.hpp>
 
@@ -28,7 +29,10 @@ class ModelCeiling {
   ~ModelCeiling();
   /// IoU of the model skin at `truth` (left, right) against `real_hand_only` (CV_8UC1, the
   /// real palms and digits, no forearm or bracelet: SyntheticFrame::hand_only).
-  Result<double> iou(const std::array<hand::HandParams, 2>& truth, const cv::Mat& real_hand_only);
+  /// `toward_elbow_W`: where the real forearms pointed (SyntheticFrame::toward_elbow_W); the
+  /// model's forearms point there too (the elbow is part of the true pose).
+  Result<double> iou(const std::array<hand::HandParams, 2>& truth, const cv::Mat& real_hand_only,
+                     const std::array<std::optional<Vec3>, 2>& toward_elbow_W = {});
 
  private:
   struct Impl;

@@ -12,6 +12,7 @@
 /// Ground truth comes with every frame: the mask of everything in front of the screen (skin,
 /// nails, bracelet, forearm), which hand, and depth.
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <memory>
 #include <opencv2/core/mat.hpp>
@@ -37,6 +38,11 @@ struct SyntheticCameraParams {
   double noise_sigma = 2.0;           ///< sensor noise [8-bit levels], i.i.d. per pixel and
                                       ///< channel within a frame; 0 = off
   int motion_blur_samples = 1;        ///< sub-frames per frame when a previous pose is given; 1 = off
+  /// The user's elbows (left, right) [m, world]: each forearm points from its wrist toward its
+  /// elbow, bending at the wrist at most max_wrist_bend_rad from the hand's axis
+  /// (hand/forearm.hpp). Unset: the forearms stay in line with the hands.
+  std::optional<std::array<Vec3, 2>> elbows_W;
+  double max_wrist_bend_rad = 1.05;   ///< (0, π/2]: about 60°
   std::uint64_t seed = 1;             ///< noise seed (frames are reproducible)
 };
 
@@ -50,6 +56,9 @@ struct SyntheticFrame {
   cv::Mat hand_only;   ///< CV_8UC1, 255 where the hand itself (palm, digits) is in front: no
                        ///< bracelet, no forearm (what a hand model should cover)
   cv::Mat depth;       ///< CV_32FC1 z_C [m] of the ground-truth surface; +inf on the screen
+  /// Where each forearm (left, right) pointed, from the wrist toward the elbow (unit, world);
+  /// unset where it was in line with the hand (no elbows given) or the hand was not filmed.
+  std::array<std::optional<Vec3>, 2> toward_elbow_W;
 };
 
 /// The poses to film: entry 0 left, 1 right; nullptr = that hand is out of view.

@@ -36,6 +36,11 @@ struct UserHandsParams {
 /// tight on the caps, loose around the prior: the user's inverse kinematics.
 registration::RegistrationParams fingertip_ik_params(const UserHandsParams& params);
 
+/// The simulated user's elbows (left, right) [m, world]: where the forearms point at the start of
+/// the script (the nominal poses at t = 0, forearms in line with the hands), forearm_length_m from
+/// the wrists. The user's arms stay there while the hands turn (SyntheticCameraParams::elbows_W).
+std::array<Vec3, 2> user_elbows(const RubiksTask& task, double forearm_length_m = 0.26);
+
 class UserHands {
  public:
   /// `truth`: the user's hands (left, right) with their own proportions.

@@ -1,0 +1,26 @@
+#pragma once
+/// Where a forearm points. The 17-DOF hand has no wrist joint: its forearm, if drawn in line with
+/// the hand (along −y_H), swings with every turn of the hand as if the elbow went round with it,
+/// and a hand turned back toward the camera pointed its forearm into it. A real forearm points
+/// from the wrist to the elbow, which stays put while the hand turns; the wrist bends, but only
+/// so far (flexion and deviation of 60–80° and 20–30°). Here the forearm points at an elbow point
+/// and bends away from the hand's axis by at most a given angle: beyond it, the elbow gives way.
+#include "spidar/core/types.hpp"
+#include "spidar/hand/parameters.hpp"
+
+namespace spidar::hand {
+
+/// Unit direction [world] from the wrist p_W_wrist toward the elbow p_W_elbow, turned back toward
+/// the hand's own axis −y_H (R_WH: the hand's rotation) until it is at most max_bend_rad from it.
+/// An elbow at the wrist gives −y_H.
+Vec3 forearm_direction(const Mat3& R_WH, const Vec3& p_W_wrist, const Vec3& p_W_elbow, double max_bend_rad);
+
+/// The wrist's bend: the shortest rotation [world] taking the hand's axis −y_H onto
+/// toward_elbow_W (unit). Applied to the forearm drawn in line with the hand, it points the
+/// forearm along toward_elbow_W, pronated with the hand.
+Mat3 wrist_bend(const Mat3& R_WH, const Vec3& toward_elbow_W);
+
+/// The elbow of a forearm in line with the hand at pose q, forearm_length_m from the wrist [world].
+Vec3 elbow_in_line(const HandParams& q, double forearm_length_m);
+
+}  // namespace spidar::hand

@@ -1,0 +1,36 @@
+#include "spidar/hand/forearm.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "spidar/hand/rotation_vector.hpp"
+
+namespace spidar::hand {
+
+Vec3 forearm_direction(const Mat3& R_WH, const Vec3& p_W_wrist, const Vec3& p_W_elbow, double max_bend_rad) {
+  const Vec3 axis = -R_WH.col(1);
+  const Vec3 to_elbow = p_W_elbow - p_W_wrist;
+  const double n = to_elbow.norm();
+  if (!(n > 1e-9) || !to_elbow.allFinite()) return axis;
+  const Vec3 d = to_elbow / n;
+  const double angle = std::atan2(axis.cross(d).norm(), axis.dot(d));
+  const double limit = std::clamp(max_bend_rad, 0.0, std::numbers::pi);
+  if (angle <= limit) return d;
+  // Turn the hand's axis toward d by the limit, in the plane of the two.
+  Vec3 normal = axis.cross(d);
+  if (normal.norm() < 1e-12) {  // d opposite the axis: any plane; take the one through x_H
+    normal = R_WH.col(0);
+  }
+  return Eigen::AngleAxisd(limit, normal.normalized()) * axis;
+}
+
+Mat3 wrist_bend(const Mat3& R_WH, const Vec3& toward_elbow_W) {
+  return Quat::FromTwoVectors(-R_WH.col(1), toward_elbow_W).toRotationMatrix();
+}
+
+Vec3 elbow_in_line(const HandParams& q, double forearm_length_m) {
+  return q.p_W_wrist() - forearm_length_m * rotation_from_vector(q.r_W_hand()).col(1);
+}
+
+}  // namespace spidar::hand
