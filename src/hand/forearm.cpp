@@ -1,6 +1,5 @@
 #include "spidar/hand/forearm.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -13,16 +12,16 @@ Vec3 forearm_direction(const Mat3& R_WH, const Vec3& p_W_wrist, const Vec3& p_W_
   const Vec3 to_elbow = p_W_elbow - p_W_wrist;
   const double n = to_elbow.norm();
   if (!(n > 1e-9) || !to_elbow.allFinite()) return axis;
+  if (!(max_bend_rad >= 0 && max_bend_rad <= std::numbers::pi)) return axis;
   const Vec3 d = to_elbow / n;
   const double angle = std::atan2(axis.cross(d).norm(), axis.dot(d));
-  const double limit = std::clamp(max_bend_rad, 0.0, std::numbers::pi);
-  if (angle <= limit) return d;
+  if (angle <= max_bend_rad) return d;
   // Turn the hand's axis toward d by the limit, in the plane of the two.
   Vec3 normal = axis.cross(d);
-  if (normal.norm() < 1e-12) {  // d opposite the axis: any plane; take the one through x_H
+  if (normal.norm() < 1e-12) {  // d opposite the axis: any plane will do; flex about x_H
     normal = R_WH.col(0);
   }
-  return Eigen::AngleAxisd(limit, normal.normalized()) * axis;
+  return Eigen::AngleAxisd(max_bend_rad, normal.normalized()) * axis;
 }
 
 Mat3 wrist_bend(const Mat3& R_WH, const Vec3& toward_elbow_W) {

@@ -52,6 +52,15 @@ Pose forearm_frame(const Vec3& p_W_origin, const Mat3& R_WH) {
 
 std::array<float, 4> rgba(const std::array<float, 3>& c) { return {c[0], c[1], c[2], 1.f}; }
 
+/// Scales `mesh` across its z axis: x by `sx`, y by `sy` (an elliptic section from a round one).
+/// Positions only: the renderer derives normals from the faces when a mesh has none.
+void scale_across(MeshData* mesh, double sx, double sy) {
+  for (std::size_t k = 0; k + 2 < mesh->vertices.size(); k += 3) {
+    mesh->vertices[k] *= static_cast<float>(sx);
+    mesh->vertices[k + 1] *= static_cast<float>(sy);
+  }
+}
+
 }  // namespace
 
 MeshData tapered_segment(double r_a, double r_b, double length, int slices, int rings, double cap_a_depth,
@@ -69,7 +78,8 @@ MeshData tapered_segment(double r_a, double r_b, double length, int slices, int 
   }
   for (int i = 0; i <= rings; ++i) {  // upper cap: α … π/2
     const double t = alpha + (kPi / 2 - alpha) * i / rings;
-    profile.emplace_back(r_b * std::cos(t), length + cap_b_depth * r_b * std::sin(t));
+    const double z = r_b * std::sin(t);
+    profile.emplace_back(r_b * std::cos(t), length + (z > 0 ? cap_b_depth * z : z));
   }
   const int rows = static_cast<int>(profile.size());
   for (const auto& [r, z] : profile)
@@ -81,12 +91,6 @@ MeshData tapered_segment(double r_a, double r_b, double length, int slices, int 
   return m;
 }
 
-void scale_across(MeshData* mesh, double sx, double sy) {
-  for (std::size_t k = 0; k + 2 < mesh->vertices.size(); k += 3) {
-    mesh->vertices[k] *= static_cast<float>(sx);
-    mesh->vertices[k + 1] *= static_cast<float>(sy);
-  }
-}
 
 MeshData rounded_box(const Vec3& half, double e, int slices, int stacks) {
   MeshData m;
@@ -127,6 +131,10 @@ Status validate(const HandSkinParams& p) {
     return Error{"hand skin: forearm_depth must be in [0.4, 1], got " + std::to_string(p.forearm_depth)};
   if (!(std::isfinite(p.forearm_cap_depth) && p.forearm_cap_depth > 0 && p.forearm_cap_depth <= 1))
     return Error{"hand skin: forearm_cap_depth must be in (0, 1], got " + std::to_string(p.forearm_cap_depth)};
+  if (p.bracelet && !(std::isfinite(p.bracelet_width_m) && p.bracelet_width_m > 0 && p.bracelet_width_m < 0.1))
+    return Error{"hand skin: bracelet_width_m must be in (0, 0.1) m, got " + std::to_string(p.bracelet_width_m)};
+  if (p.bracelet && !(std::isfinite(p.bracelet_offset_m) && p.bracelet_offset_m >= 0 && p.bracelet_offset_m < 0.1))
+    return Error{"hand skin: bracelet_offset_m must be in [0, 0.1) m, got " + std::to_string(p.bracelet_offset_m)};
   if (!(std::isfinite(p.forearm_length_m) && p.forearm_length_m >= 0 && p.forearm_length_m <= 0.5))
     return Error{"hand skin: forearm_length_m must be in [0, 0.5] m, got " +
                  std::to_string(p.forearm_length_m)};
@@ -166,11 +174,11 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
   skin.palm_mesh = static_cast<int>(meshes->size()) - 1;
   // The forearm: an elliptic section, forearm_breadth of the palm's half breadth across and
   // forearm_depth of that deep, widening by 15 % over its length toward the elbow.
-  skin.wrist_radius = p.forearm_breadth * h.x();
-  skin.wrist_half_depth = p.forearm_depth * skin.wrist_radius;
+  skin.wrist_half_breadth = p.forearm_breadth * h.x();
+  skin.wrist_half_depth = p.forearm_depth * skin.wrist_half_breadth;
   const int arm_slices = std::max(p.bone_slices, 16);
   if (p.forearm_length_m > 0) {
-    MeshData arm = tapered_segment(skin.wrist_radius, 1.15 * skin.wrist_radius, p.forearm_length_m, arm_slices,
+    MeshData arm = tapered_segment(skin.wrist_half_breadth, 1.15 * skin.wrist_half_breadth, p.forearm_length_m, arm_slices,
                                    p.bone_rings, p.forearm_cap_depth);
     scale_across(&arm, 1.0, p.forearm_depth);
     meshes->push_back(std::move(arm));
@@ -179,7 +187,7 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
   if (p.bracelet) {
     // A band 2 mm proud of the forearm where it sits, with nearly flat ends.
     const double grow = p.forearm_length_m > 0 ? 0.15 * p.bracelet_offset_m / p.forearm_length_m : 0;
-    const double a = skin.wrist_radius * (1 + grow) + 0.002, b = skin.wrist_half_depth * (1 + grow) + 0.002;
+    const double a = skin.wrist_half_breadth * (1 + grow) + 0.002, b = skin.wrist_half_depth * (1 + grow) + 0.002;
     MeshData band = tapered_segment(a, a, p.bracelet_width_m, arm_slices, 2, 0.05, 0.05);
     scale_across(&band, 1.0, b / a);
     meshes->push_back(std::move(band));

@@ -22,9 +22,14 @@ SkinTransforms skin_transforms(const AnatomicalHand& hand, const hand::HandParam
     // X_W(B now) · X_H(B rest)⁻¹ applied to a rest point q: A·(R_now R_restᵀ (q − p_rest) + p_now).
     const Mat3 R = now.R_HB[b] * hand.rest.R_HB[b].transpose();
     Mat3 L = A * R;
-    if (b == kForearmBone && toward_elbow_W) L = hand::wrist_bend(R_WH, *toward_elbow_W) * L;  // about the wrist
+    Vec3 t = p_W_wrist + A * (now.p_HB[b] - R * hand.rest.p_HB[b]);
+    if (b == kForearmBone && toward_elbow_W) {  // the forearm turns about the wrist
+      const Mat3 B = hand::wrist_bend(R_WH, *toward_elbow_W);
+      L = B * L;
+      t = p_W_wrist + B * (t - p_W_wrist);
+    }
     X.L[b] = L.cast<float>();
-    X.t[b] = (p_W_wrist + A * (now.p_HB[b] - R * hand.rest.p_HB[b])).cast<float>();
+    X.t[b] = t.cast<float>();
   }
   return X;
 }

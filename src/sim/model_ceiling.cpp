@@ -28,6 +28,7 @@ Result<std::unique_ptr<ModelCeiling>> ModelCeiling::create(render::Context& cont
                                                            const render::HandSkinParams& model_skin) {
   if (user[0].side != hand::Side::kLeft || user[1].side != hand::Side::kRight)
     return Error{"model ceiling: hands must be {left, right}"};
+  if (auto st = render::validate(model_skin); !st) return Error{"model ceiling: " + st.error().message};
   auto impl = std::make_unique<Impl>();
   impl->camera = camera;
   impl->user = user;
@@ -50,6 +51,9 @@ Result<double> ModelCeiling::iou(const std::array<hand::HandParams, 2>& truth,
     return Error{"model ceiling: expected a CV_8UC1 mask of the camera's size"};
   s.scene.shapes.clear();
   s.scene.meshes = s.meshes;
+  for (const auto& d : toward_elbow_W)
+    if (d && !(d->allFinite() && std::abs(d->norm() - 1.0) < 1e-6))
+      return Error{"model ceiling: a forearm direction must be a finite unit vector"};
   for (std::size_t h = 0; h < 2; ++h) {
     const auto& d = toward_elbow_W[h];
     render::pose_hand_skin(s.user[h], s.skins[h], truth[h], s.skin, &s.scene, d ? &*d : nullptr);

@@ -44,6 +44,11 @@ TEST(Forearm, BendsNoFurtherThanTheLimitTowardTheElbow) {
   // An elbow at the wrist (or not finite) leaves the forearm in line with the hand.
   EXPECT_LT((forearm_direction(R, wrist, wrist, limit) - axis).norm(), 1e-12);
   EXPECT_LT((forearm_direction(R, wrist, Vec3(NAN, 0, 0), limit) - axis).norm(), 1e-12);
+  EXPECT_LT((forearm_direction(R, wrist, wrist + 0.3 * Vec3(-axis), NAN) - axis).norm(), 1e-12);
+  // An elbow straight ahead of the fingers: the forearm flexes by the limit about x_H.
+  const Vec3 got = forearm_direction(R, wrist, wrist - 0.3 * axis, limit);
+  EXPECT_NEAR(angle_between(axis, got), limit, 1e-9);
+  EXPECT_NEAR(got.dot(R.col(0)), 0.0, 1e-9);
 }
 
 TEST(Forearm, TheWristBendTakesTheHandsAxisOntoTheForearm) {

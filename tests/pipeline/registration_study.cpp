@@ -95,7 +95,15 @@ int main(int argc, char** argv) {
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
     else if (k == "--bending-wrists") a.bending_wrists = true;
-    else if (k == "--dump-below") a.dump_below = std::atof(next().c_str());
+    else if (k == "--dump-below") {
+      const std::string v = next();
+      char* end = nullptr;
+      a.dump_below = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !(a.dump_below >= 0 && a.dump_below <= 1)) {
+        std::fprintf(stderr, "registration_study: --dump-below: expected an IoU in [0, 1], got '%s'\n", v.c_str());
+        std::exit(2);
+      }
+    }
     else if (k == "--set") a.sets.push_back(next());
     else {
       std::fprintf(stderr, "registration_study: unknown argument %s\n", k.c_str());
@@ -276,9 +284,11 @@ int main(int argc, char** argv) {
     if (part_renderer) {
       SceneSnapshot hands_scene;
       hands_scene.meshes = part_meshes;
-      for (int h = 0; h < 2; ++h)
+      for (int h = 0; h < 2; ++h) {
+        const auto& bent = frame.toward_elbow_W[static_cast<std::size_t>(h)];
         render::pose_hand_skin(truth_models[h], part_skins[h], truth[h], part_skin_params, &hands_scene,
-                               frame.toward_elbow_W[static_cast<std::size_t>(h)] ? &*frame.toward_elbow_W[static_cast<std::size_t>(h)] : nullptr);
+                               bent ? &*bent : nullptr);
+      }
       render::RenderParams rp;
       rp.hands = render::HandDrawMode::kHidden;
       render::RenderTargets tg;
@@ -356,9 +366,12 @@ int main(int argc, char** argv) {
     // forearm's axis) and of the band's visible surface centre (toward the camera).
     for (int h = 0; h < 2; ++h) {
       if (!r.bracelets[h].found) continue;
+      // The band sits bracelet_offset_m along the forearm (which points at the elbow with bending
+      // wrists, else along −y_H).
       const Pose X_WH = hand::hand_pose(truth[h]);
-      const Vec3 p_WB = X_WH * Vec3(0.0, -0.012, 0.0);
-      const Vec3 axis = X_WH.R * Vec3::UnitY();
+      const auto& bent = frame.toward_elbow_W[static_cast<std::size_t>(h)];
+      const Vec3 axis = bent ? Vec3(-*bent) : Vec3(X_WH.R * Vec3::UnitY());
+      const Vec3 p_WB = X_WH.p - film_params.bracelet_offset_m * axis;
       Vec3 n = camera.X_WC().p - p_WB;
       n -= n.dot(axis) * axis;
       n.normalize();
@@ -384,6 +397,8 @@ int main(int argc, char** argv) {
         const auto true_pts = hand::forward_kinematics(truth_models[h], truth[h]);
         for (std::size_t j = 0; j < fit_pts.p_W_joint.size(); ++j) {
           const Vec2 a2 = camera.project(true_pts.p_W_joint[j]), b2 = camera.project(fit_pts.p_W_joint[j]);
+          if (!a2.allFinite() || !b2.allFinite() || a2.cwiseAbs().maxCoeff() > 1e4 || b2.cwiseAbs().maxCoeff() > 1e4)
+            continue;  // behind the camera or far outside the image
           const cv::Point pa(static_cast<int>(a2.x()), static_cast<int>(a2.y()));
           const cv::Point pb(static_cast<int>(b2.x()), static_cast<int>(b2.y()));
           cv::line(overlay, pa, pb, cv::Scalar(255, 255, 255), 1);

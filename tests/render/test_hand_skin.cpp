@@ -139,7 +139,7 @@ TEST(HandSkin, TheForearmEndsAtTheWristAndThePalmReachesIt) {
       ASSERT_GE(skin.forearm_mesh, 0);
       // The forearm's frame: z from the wrist toward the elbow.
       const auto arm_z = extent(meshes[static_cast<std::size_t>(skin.forearm_mesh)], 2);
-      EXPECT_NEAR(arm_z.first, -0.25 * skin.wrist_radius, 1e-6);
+      EXPECT_NEAR(arm_z.first, -0.25 * skin.wrist_half_breadth, 1e-6);
       // The palm mesh in the box frame (the axes of H, at the box's centre).
       const auto palm_y = extent(meshes[static_cast<std::size_t>(skin.palm_mesh)], 1);
       const double start_H = box.p_H_centre.y() + palm_y.first;
@@ -184,7 +184,7 @@ TEST(HandSkin, TheForearmIsBroaderThanDeepAcrossThePalm) {
   ASSERT_GE(skin.forearm_mesh, 0);
   ASSERT_GE(skin.bracelet_mesh, 0);
   const double half_breadth = p.forearm_breadth * model.shape.palm.half_extents.x();
-  EXPECT_NEAR(skin.wrist_radius, half_breadth, 1e-12);
+  EXPECT_NEAR(skin.wrist_half_breadth, half_breadth, 1e-12);
   EXPECT_NEAR(skin.wrist_half_depth, p.forearm_depth * half_breadth, 1e-12);
   // Near the wrist (z within 1 mm of it) the vertices span the ellipse's axes, and everywhere the
   // section is forearm_depth as deep as it is broad.

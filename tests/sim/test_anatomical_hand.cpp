@@ -10,8 +10,8 @@
 #include "allocation_counter.hpp"
 #include "spidar/hand/forearm.hpp"
 #include "spidar/hand/joint_limits.hpp"
-#include "spidar/hand/rotation_vector.hpp"
 #include "spidar/hand/kinematics.hpp"
+#include "spidar/hand/rotation_vector.hpp"
 #include "spidar/render/hand_skin.hpp"
 #include "spidar/sim/anatomical_hand.hpp"
 

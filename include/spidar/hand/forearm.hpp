@@ -4,15 +4,17 @@
 /// and a hand turned back toward the camera pointed its forearm into it. A real forearm points
 /// from the wrist to the elbow, which stays put while the hand turns; the wrist bends, but only
 /// so far (flexion and deviation of 60–80° and 20–30°). Here the forearm points at an elbow point
-/// and bends away from the hand's axis by at most a given angle: beyond it, the elbow gives way.
+/// and bends away from the hand's axis by at most a given angle, the same in every direction (a
+/// cone: a simplification of the wrist's flexion and deviation ranges); beyond it, the elbow gives
+/// way.
 #include "spidar/core/types.hpp"
 #include "spidar/hand/parameters.hpp"
 
 namespace spidar::hand {
 
 /// Unit direction [world] from the wrist p_W_wrist toward the elbow p_W_elbow, turned back toward
-/// the hand's own axis −y_H (R_WH: the hand's rotation) until it is at most max_bend_rad from it.
-/// An elbow at the wrist gives −y_H.
+/// the hand's own axis −y_H (R_WH: the hand's rotation) until it is at most max_bend_rad from it
+/// ([0, π]; outside, or not finite: −y_H, no bend). An elbow at the wrist or not finite gives −y_H.
 Vec3 forearm_direction(const Mat3& R_WH, const Vec3& p_W_wrist, const Vec3& p_W_elbow, double max_bend_rad);
 
 /// The wrist's bend: the shortest rotation [world] taking the hand's axis −y_H onto

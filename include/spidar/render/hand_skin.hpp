@@ -49,9 +49,9 @@ struct HandSkinParams {
   /// Tessellation. The frame pipeline draws both hands every frame in software (llvmpipe), where
   /// the cost grows with the triangle count: 10 slices and 3 rings per end cap keep a bone's
   /// outline within 5 % of its radius (< 0.5 mm on a finger). With 14/8 for the palm, both hands
-  /// have 6,216 triangles instead of 18,176 at 16/6 and 24/16, and their silhouettes agree with
-  /// IoU 0.992–0.995 (tests/render/test_hand_skin.cpp); bench_pipeline's CPU time per frame fell
-  /// by about a quarter.
+  /// have 6,216 triangles (without the bracelet) instead of 18,176 at 16/6 and 24/16, and their
+  /// silhouettes agree with IoU 0.992–0.995 (tests/render/test_hand_skin.cpp); bench_pipeline's
+  /// CPU time per frame fell by about a quarter.
   int bone_slices = 10;   ///< vertices around a bone, 6..64
   int bone_rings = 3;     ///< rings per hemispherical end of a bone, 2..32
   int palm_slices = 14;   ///< vertices around the palm, 8..64
@@ -73,8 +73,7 @@ inline constexpr int kForearmPart = 6;
 /// `cap_b_depth` the same for the end at z = length.
 MeshData tapered_segment(double r_a, double r_b, double length, int slices = 16, int rings = 6,
                          double cap_a_depth = 1.0, double cap_b_depth = 1.0);
-/// Scales `mesh` across its z axis: x by `sx`, y by `sy` (an elliptic section from a round one).
-void scale_across(MeshData* mesh, double sx, double sy);
+
 /// |x/a|^(2/e) + |y/b|^(2/e) + |z/c|^(2/e) = 1 with e < 1 a rounded box of half extents (a, b, c).
 MeshData rounded_box(const Vec3& half_extents, double exponent = 0.45, int slices = 24,
                      int stacks = 16);
@@ -88,8 +87,8 @@ struct HandSkin {
   std::vector<Bone> bones;  ///< one per capsule of hand::hand_render_shapes, same order
   int palm_mesh = -1;
   int forearm_mesh = -1;
-  int bracelet_mesh = -1;
-  double wrist_radius = 0.0;      ///< forearm's half breadth at the wrist (along x_H) [m]
+  int bracelet_mesh = -1;  ///< the band (HandSkinParams::bracelet), or −1
+  double wrist_half_breadth = 0.0;  ///< forearm's half breadth at the wrist (along x_H) [m]
   double wrist_half_depth = 0.0;  ///< forearm's half depth at the wrist (along z_H) [m]
 };
 

@@ -43,7 +43,8 @@ struct SimulatedRigParams {
   bool interactive = false;  ///< the GUI moves the hands instead of the scene's script
   /// The user's forearms point at their elbows, which stay where the forearms pointed at the
   /// script's start; the wrists bend (up to 60°) when the hands turn (sim::user_elbows). Off: the
-  /// forearms stay in line with the hands, as the registration's model has them.
+  /// forearms stay in line with the hands, as the registration's model has them. Only the scripted
+  /// user's synthetic camera (not `interactive`, not another camera).
   bool bending_wrists = false;
 };
 

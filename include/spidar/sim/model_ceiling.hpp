@@ -5,11 +5,12 @@
 /// finger's own posture), so it is reported beside every fitted IoU: what is below it is the
 /// fit's; what is between it and 1 is the model's shape.
 #include <array>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <opencv2/core/mat.hpp>
 
 #include "spidar/core/result.hpp"
+#include "spidar/core/types.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/render/hand_skin.hpp"
@@ -32,7 +33,7 @@ class ModelCeiling {
   /// `toward_elbow_W`: where the real forearms pointed (SyntheticFrame::toward_elbow_W); the
   /// model's forearms point there too (the elbow is part of the true pose).
   Result<double> iou(const std::array<hand::HandParams, 2>& truth, const cv::Mat& real_hand_only,
-                     const std::array<std::optional<Vec3>, 2>& toward_elbow_W = {});
+                     const std::array<std::optional<Vec3>, 2>& toward_elbow_W);
 
  private:
   struct Impl;
