@@ -68,7 +68,7 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
        "contested_error_pct,contested_error_pct_paper,iterations_left,"
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
        "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou,"
-       "length_mm_left,width_mm_left,length_mm_right,width_mm_right,dropped_before\n";
+       "length_mm_left,width_mm_left,length_mm_right,width_mm_right,dropped_before,joint_px_floor\n";
   f << std::setprecision(6);
   for (const MrFrame& m : t.frames) {
     const auto& a = m.truth[0];
@@ -84,7 +84,7 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
       << m.truth_cap_residual_mm[1] << ',';
     if (m.ceiling_measured) f << m.ceiling_iou;
     for (int h = 0; h < 2; ++h) f << ',' << 1e3 * m.shape[h].length_m << ',' << 1e3 * m.shape[h].width_m;
-    f << ',' << m.dropped_before << '\n';
+    f << ',' << m.dropped_before << ',' << 0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1]) << '\n';
   }
   core::write_file_atomic(path, f.str());
 }
@@ -228,6 +228,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   std::vector<double> ceiling;
   for (const MrFrame& m : t.frames)
     if (m.ceiling_measured) ceiling.push_back(m.ceiling_iou);
+  const auto joint_floor = column(t, [](const MrFrame& m) { return 0.5 * (m.truth[0].joint_px_floor[0] + m.truth[0].joint_px_floor[1]); });
   const auto cap_res = column(t, [](const MrFrame& m) { return std::max(m.truth_cap_residual_mm[0], m.truth_cap_residual_mm[1]); });
   // Frames delivered per second of the run: processed frames over the span of their exposures
   // (the camera runs at its rate; every frame the frame thread could not take is missing here).
@@ -347,6 +348,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                         {"model_ceiling_iou", mean(ceiling)},
                         {"model_ceiling_iou_p5", quantile(ceiling, 0.05)},
                         {"model_ceiling_frames", ceiling.size()},
+                        {"joint_px_floor", mean(joint_floor)},
                         {"hand_shape", {{"length_m", s.user_length_m}, {"width_m", s.user_width_m}}}}},
       {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
   nlohmann::json forces = nlohmann::json::array();

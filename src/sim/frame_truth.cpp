@@ -28,6 +28,10 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     const hand::HandPoints f = hand::forward_kinematics(models[h], result.hands[h]);
     m.fingertip_mm[h] = registration::fingertip_error_m(f, t) * 1e3;
     m.joint_px[h] = registration::joint_px_error(f, t, camera);
+    hand::HandParams coupled = truth[h];
+    coupled.little_independent = false;
+    m.joint_px_floor[h] =
+        registration::joint_px_error(hand::forward_kinematics(truth_models[h], coupled), t, camera);
   }
   // The fitted hands' own pixels, where no forearm of theirs is in front (the truth's hand_only
   // mask is filmed without a scene, so scene occlusion does not enter either).

@@ -257,6 +257,7 @@ int main(int argc, char** argv) {
   pipeline::FrameResult r;
   sim::FrameTruthWorkspace ws;
   std::array<double, 6> brace_k{};
+  std::array<double, 6> joint_part_sum{}, joint_floor_sum{}, joint_part_n{};  // wrist, thumb … little
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
   std::array<Vec3, 8> g;
@@ -412,6 +413,27 @@ int main(int argc, char** argv) {
       std::snprintf(name, sizeof name, "/t%05.2f.png", t);
       cv::imwrite(a.dump_dir + name, row);
     }
+    // The joint error by part (the wrist, then each digit's four joints), and its floor: the
+    // model's skeleton with the user's true sizes at the true pose, whose little finger can only
+    // follow the ring finger's (the model has no parameters of its own for it).
+    for (int h = 0; h < 2; ++h) {
+      const auto fit_pts = hand::forward_kinematics(r.models[h], r.hands[h]);
+      const auto true_pts = hand::forward_kinematics(truth_models[h], truth[h]);
+      hand::HandParams coupled = truth[h];
+      coupled.little_independent = false;
+      const auto floor_pts = hand::forward_kinematics(truth_models[h], coupled);
+      for (int j = 0; j < hand::kJointCount; ++j) {
+        const Vec3& pt = true_pts.p_W_joint[static_cast<std::size_t>(j)];
+        if (!(camera.depth(pt) > 0)) continue;
+        const int part = j == 0 ? 0 : 1 + (j - 1) / 4;
+        const Vec2 at = camera.project(pt);
+        joint_part_sum[static_cast<std::size_t>(part)] +=
+            (camera.project(fit_pts.p_W_joint[static_cast<std::size_t>(j)]) - at).norm();
+        joint_floor_sum[static_cast<std::size_t>(part)] +=
+            (camera.project(floor_pts.p_W_joint[static_cast<std::size_t>(j)]) - at).norm();
+        joint_part_n[static_cast<std::size_t>(part)] += 1;
+      }
+    }
     obs.push_back(1e3 * obs_res);
     caps.push_back(1e3 * cap_res);
     iou.push_back(m.iou);
@@ -446,6 +468,23 @@ int main(int argc, char** argv) {
   if (part_real > 0)
     std::printf("  (wrist: %.1f %% under the model's forearm or bracelet, the rest not covered)\n",
                 100 * missing_under_forearm / part_real);
+  {
+    const char* names[6] = {"wrist", "thumb", "index", "middle", "ring", "little"};
+    double fit_all = 0, floor_all = 0, n_all = 0;
+    std::printf("joint error by part [px], fit / floor (true pose and sizes, the little finger following the ring):\n");
+    for (std::size_t k = 0; k < 6; ++k) {
+      const double n = std::max(joint_part_n[k], 1.0);
+      std::printf("  %-7s %5.2f / %5.2f\n", names[k], joint_part_sum[k] / n, joint_floor_sum[k] / n);
+      fit_all += joint_part_sum[k];
+      floor_all += joint_floor_sum[k];
+      n_all += joint_part_n[k];
+    }
+    const double little_n = std::max(joint_part_n[5], 1.0);
+    std::printf("  all     %5.2f / %5.2f; without the little finger's error %.2f px\n", fit_all / std::max(n_all, 1.0),
+                floor_all / std::max(n_all, 1.0),
+                (fit_all - joint_part_sum[5] + joint_part_n[5] * (joint_part_sum[5] / little_n - joint_floor_sum[5] / little_n)) /
+                    std::max(n_all, 1.0));
+  }
   std::printf("fitted caps to the strings %.2f mm (p95 %.2f), truth caps to the strings %.2f mm (max %.2f)\n",
               mean(obs), quantile(obs, 0.95), mean(caps), quantile(caps, 1.0));
   std::printf("bracelet midpoint to the band's axis centre %.2f px (p95 %.2f), to its visible surface %.2f px (p95 %.2f)\n",
