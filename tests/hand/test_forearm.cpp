@@ -11,7 +11,7 @@
 namespace spidar::hand {
 namespace {
 
-double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+double bend_angle(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
 TEST(Forearm, PointsAtTheElbowWithinTheWristsBend) {
   const Mat3 R = rotation_from_vector(Vec3(0.4, -0.9, 0.2));
@@ -36,10 +36,10 @@ TEST(Forearm, BendsNoFurtherThanTheLimitTowardTheElbow) {
     const Vec3 d = Eigen::AngleAxisd(bend, plane) * axis;
     const Vec3 got = forearm_direction(R, wrist, wrist + 0.3 * d, limit);
     EXPECT_NEAR(got.norm(), 1.0, 1e-12);
-    EXPECT_NEAR(angle_between(axis, got), limit, 1e-9) << bend;
+    EXPECT_NEAR(bend_angle(axis, got), limit, 1e-9) << bend;
     // On the way from the axis to the elbow: in their plane, on the elbow's side.
     EXPECT_NEAR(got.dot(plane), 0.0, 1e-9);
-    EXPECT_NEAR(angle_between(axis, got) + angle_between(got, d), bend, 1e-9);
+    EXPECT_NEAR(bend_angle(axis, got) + bend_angle(got, d), bend, 1e-9);
   }
   // An elbow at the wrist (or not finite) leaves the forearm in line with the hand.
   EXPECT_LT((forearm_direction(R, wrist, wrist, limit) - axis).norm(), 1e-12);
@@ -47,7 +47,7 @@ TEST(Forearm, BendsNoFurtherThanTheLimitTowardTheElbow) {
   EXPECT_LT((forearm_direction(R, wrist, wrist + 0.3 * Vec3(-axis), NAN) - axis).norm(), 1e-12);
   // An elbow straight ahead of the fingers: the forearm flexes by the limit about x_H.
   const Vec3 got = forearm_direction(R, wrist, wrist - 0.3 * axis, limit);
-  EXPECT_NEAR(angle_between(axis, got), limit, 1e-9);
+  EXPECT_NEAR(bend_angle(axis, got), limit, 1e-9);
   EXPECT_NEAR(got.dot(R.col(0)), 0.0, 1e-9);
 }
 
