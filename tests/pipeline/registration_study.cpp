@@ -28,6 +28,7 @@
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/registration/residuals.hpp"
 #include "spidar/render/renderer.hpp"
 #include <opencv2/imgproc.hpp>
 #include "spidar/sim/frame_truth.hpp"
@@ -257,6 +258,7 @@ int main(int argc, char** argv) {
   pipeline::FrameResult r;
   sim::FrameTruthWorkspace ws;
   std::array<double, 6> brace_k{};
+  std::vector<double> brace_term;
   std::array<double, 6> joint_part_sum{}, joint_floor_sum{}, joint_part_n{};  // wrist, thumb … little
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
@@ -380,6 +382,10 @@ int main(int argc, char** argv) {
       const Vec2 det = r.bracelets[h].wrist_px;
       brace_axis.push_back((det - camera.project(p_WB)).norm());
       brace_surf.push_back((det - camera.project(p_WB + (2.0 / 3.14159265) * radius * n)).norm());
+      // The wrist term's own expectation, at the true pose and sizes (its residual, in px).
+      brace_term.push_back((det - camera.project(registration::bracelet_visible_point(
+                                      X_WH, truth_models[h].shape.dimensions.width, camera.X_WC().p,
+                                      p.registration, nullptr))).norm());
       for (int k = 0; k < 6; ++k)
         brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
       ++brace_n;
@@ -490,6 +496,8 @@ int main(int argc, char** argv) {
   std::printf("bracelet midpoint to the band's axis centre %.2f px (p95 %.2f), to its visible surface %.2f px (p95 %.2f)\n",
               mean(brace_axis), quantile(brace_axis, 0.95), mean(brace_surf), quantile(brace_surf, 0.95));
   for (int k = 0; k < 6; ++k) std::printf("  shift %.1f r: %.2f px\n", 0.2 * k, brace_k[k] / std::max(brace_n, 1));
+  std::printf("  the wrist term's point at the true pose: %.2f px (p95 %.2f)\n", mean(brace_term),
+              quantile(brace_term, 0.95));
   std::printf("final shape: left L %.4f W %.4f, right L %.4f W %.4f (truth L %.4f W %.4f)\n",
               r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
               r.models[1].shape.dimensions.length, r.models[1].shape.dimensions.width,
