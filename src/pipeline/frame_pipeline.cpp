@@ -187,8 +187,14 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
         prediction.length_px[h] = 2.0 * radius * s.camera.intrinsics().fx / depth;
       }
       // The band's long axis in the image: across the forearm (hand y) and the line of sight.
-      const Vec3 across = (X_WH.R * Vec3::UnitY()).cross(p_WB - s.camera.X_WC().p);
-      if (across.norm() > 1e-9) {
+      // Only where the camera sees the forearm from the side (its axis more than 58° off the line
+      // of sight, sin > 0.85): nearer end-on the band is a ring whose visible arc's long axis
+      // need not lie across the forearm, and a predicted axis made the detector refuse the
+      // right band there (registration_study: the right bracelet lost for 14 frames at 6.1–6.6 s,
+      // its wrist drifting 3 cm).
+      const Vec3 sight = p_WB - s.camera.X_WC().p;
+      const Vec3 across = (X_WH.R * Vec3::UnitY()).cross(sight);
+      if (across.norm() > 0.85 * sight.norm()) {
         const Vec2 a = s.camera.project(p_WB + 0.01 * across.normalized()) - predicted[h];
         if (a.norm() > 1e-6) prediction.axis_px[h] = a.normalized();
       }

@@ -333,14 +333,16 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
   if (pred && (pred->wrist_px[0] || pred->wrist_px[1])) {
     const int nc = std::min<int>(static_cast<int>(cands.size()), 6);
     const double sigma_d = p.max_prediction_distance_px / 3.0;
-    constexpr double kSigmaAngle = 0.35, kMaxAngle = 1.05, kNone = 9.0;
+    constexpr double kSigmaAngle = 0.35, kMaxAngle = 1.05, kNone = 9.0, kMinAxisAspect = 1.5;
     auto match_cost = [&](int h, int i) {
       if (i < 0 || !pred->wrist_px[h]) return kNone;
       const auto& o = cands[i].observation;
       const double d = (o.wrist_px - *pred->wrist_px[h]).norm();
       if (d > p.max_prediction_distance_px) return 1e9;
       double c = (d / sigma_d) * (d / sigma_d);
-      if (pred->axis_px[h] && o.length_px > 0) {
+      // The axis only where both are defined: a band seen end-on is a ring, nearly round, whose
+      // principal direction says nothing (its pixels still tell where the wrist is).
+      if (pred->axis_px[h] && o.length_px > 0 && o.length_px >= kMinAxisAspect * o.thickness_px) {
         const Vec2 ax = (o.end_b_px - o.end_a_px).normalized();
         const double ang = std::acos(std::clamp(std::abs(ax.dot(pred->axis_px[h]->normalized())), 0.0, 1.0));
         if (ang > kMaxAngle) return 1e9;

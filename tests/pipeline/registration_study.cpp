@@ -36,6 +36,7 @@
 #include "spidar/sim/rubiks_task.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
 #include "spidar/sim/user_hands.hpp"
+#include "spidar/vision/bracelet.hpp"
 #include "spidar/vision/vision_config.hpp"
 
 using namespace spidar;
