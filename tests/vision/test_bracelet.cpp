@@ -183,6 +183,31 @@ TEST(Bracelet, BandDirectionsTellHandsApartWhenWristsProjectClose) {
   EXPECT_LT((obs[0].wrist_px - *scene.wrist[1]).norm(), 1.0);
 }
 
+// A forearm pointing at the camera shows its band as a ring, nearly round: its principal
+// direction is arbitrary, so a predicted axis must not refuse it (the demo's regrasp lost the
+// right bracelet for 14 frames that way). An elongated band at the wrong angle still is refused.
+TEST(Bracelet, ARingSeenEndOnIsMatchedWhateverTheAxisPredicted) {
+  cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));  // the blue screen (BGR)
+  const cv::Point centre(450, 120);
+  cv::ellipse(bgr, centre, cv::Size(70, 60), 0.0, 0.0, 360.0, cv::Scalar(30, 30, 210), 14);  // red ring
+  BraceletPrediction pred;
+  pred.wrist_px = {std::nullopt, Vec2(447, 116)};
+  pred.length_px = {0.0, 140.0};
+  for (double a : {0.0, 0.8, 1.6}) {
+    pred.axis_px[1] = Vec2(std::cos(a), std::sin(a));
+    const auto obs = detect(bgr, &pred);
+    ASSERT_TRUE(obs[1].found) << "predicted axis at " << a << " rad";
+    EXPECT_LT((obs[1].wrist_px - Vec2(centre.x, centre.y)).norm(), 3.0);
+  }
+  // A band (aspect 4) across the predicted axis: refused, as before.
+  cv::Mat band(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));
+  cv::rectangle(band, cv::Point(410, 105), cv::Point(490, 125), cv::Scalar(30, 30, 210), cv::FILLED);
+  pred.axis_px[1] = Vec2(0.0, 1.0);
+  EXPECT_FALSE(detect(band, &pred)[1].found);
+  pred.axis_px[1] = Vec2(1.0, 0.0);
+  EXPECT_TRUE(detect(band, &pred)[1].found);
+}
+
 TEST(Bracelet, LoneBandNearTheMidlineIsAmbiguousWithoutPredictions) {
   const std::vector<DrawnHand> hands = {{{322, 400}, -1.57, 170}};
   const auto scene = test::draw_scene(hands);
