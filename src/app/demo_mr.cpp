@@ -173,7 +173,8 @@ int run_mr_demo(const DemoOptions& o) {
   summary.servo = end.servo;
   summary.physics = end.physics;
   if (auto s = scene.monitor->status().read()) {
-    summary.turns = s->turns;
+    summary.turns = s->top_turns;
+    summary.other_turns = s->turns - s->top_turns;
     summary.solved = s->solved;
   }
   summary.task = task.progress();

@@ -23,9 +23,16 @@ void TurnCounter::update(const physics::RubiksCube& cube) {
     const int q = static_cast<int>(std::lround(a / (units::kPi / 2)));
     if (q != quarter_[f]) {
       turns_ += std::abs(q - quarter_[f]);
+      per_face_[static_cast<std::size_t>(f)] += std::abs(q - quarter_[f]);
       quarter_[f] = q;
     }
   }
+}
+
+int TurnCounter::turns_of(char face) const {
+  for (int f = 0; f < 6; ++f)
+    if (kFaces[f] == face) return per_face_[static_cast<std::size_t>(f)];
+  return 0;
 }
 
 CubeMonitor::CubeMonitor(std::optional<physics::RubiksCube>* cube, const Pose& X_cube0)
@@ -50,11 +57,12 @@ void CubeMonitor::before_step(physics::World& w) {
     const physics::RubiksCube& cube = **cube_;
     const Pose X = cube.core_pose();
     turns_.update(cube);
-    pose_.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}, turns_.turns()});
+    pose_.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}, turns_.turns_of('U')});
     s.lift = X.p.z() - X_cube0_.p.z();
     s.u_angle = cube.face_angle('U');
     s.d_angle = cube.face_angle('D');
     s.turns = turns_.turns();
+    s.top_turns = turns_.turns_of('U');
     s.solved = cube.is_solved();
   }
   status_.publish(s);

@@ -333,6 +333,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
        {{"present", s.has_cube},
         {"turns_completed", s.turns},
         {"turns_planned", s.task.turns_planned},
+        {"turns_other_faces", s.other_turns},
         {"turn_attempts", s.task.attempts},
         {"retries", {{"turn", s.task.retries_turn}, {"grasp", s.task.retries_grasp}}},
         {"gave_up", s.task.gave_up},
@@ -398,7 +399,11 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << (s.has_cube ? std::to_string(s.turns) + " of " + std::to_string(s.task.turns_planned) +
                           " layer turns completed (" + std::to_string(s.task.retries_turn) +
                           " turn and " + std::to_string(s.task.retries_grasp) + " grasp retries" +
-                          (s.task.gave_up ? ", then out of time" : "") + "), " +
+                          (s.task.gave_up ? ", then out of time" : "") + ")" +
+                          (s.other_turns > 0 ? ", and " + std::to_string(s.other_turns) +
+                                                   " quarter turns of other layers"
+                                             : "") +
+                          ", " +
                           (s.solved ? "solved" : "not solved")
                     : std::string("none in this scene"))
      << "\n"

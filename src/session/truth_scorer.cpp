@@ -78,7 +78,7 @@ void TruthScorer::on_frame(const FrameEvent& e) {
     m.lift_mm = s->lift * 1e3;
     m.u_angle_deg = s->u_angle * 180 / units::kPi;
     m.d_angle_deg = s->d_angle * 180 / units::kPi;
-    m.turns = s->turns;
+    m.turns = s->top_turns;
   }
   for (int f = 0; f < 8; ++f) {
     const auto& F = e.measured->f_W[f];

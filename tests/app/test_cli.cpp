@@ -274,6 +274,7 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_GE(j["pipeline"]["fps"].get<double>() * 3.0, j["frames"].get<double>() - 1.0 - 1e-6);
   EXPECT_TRUE(j["cube"]["present"].get<bool>());
   EXPECT_GE(j["cube"]["turns_completed"].get<int>(), 0);  // the turns come after 3 s
+  EXPECT_GE(j["cube"]["turns_other_faces"].get<int>(), 0);
   EXPECT_TRUE(j["cube"]["face_angles_deg"].is_object());
   EXPECT_TRUE(exists(dir + "/registration_error.png"));
   EXPECT_TRUE(exists(dir + "/fingertip_forces.png"));

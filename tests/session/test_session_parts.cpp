@@ -65,6 +65,14 @@ TEST(TurnCounter, CountsSettledQuarterTurnsOfTheUser) {
   turns.rebase(cube);  // e.g. a scramble: not the user's
   turns.update(cube);
   EXPECT_EQ(turns.turns(), 1);
+  // Per face: the scripted user's layer (U) apart from a layer dragged along (R, a half turn).
+  ASSERT_TRUE(cube.turn('R', 2));
+  turns.update(cube);
+  EXPECT_EQ(turns.turns(), 3);
+  EXPECT_EQ(turns.turns_of('U'), 1);
+  EXPECT_EQ(turns.turns_of('R'), 2);
+  EXPECT_EQ(turns.turns_of('F'), 0);
+  EXPECT_EQ(turns.turns_of('x'), 0);
 }
 
 TEST(ScaledCamera, KeepsTheFieldOfViewAndPixelCentres) {

@@ -20,7 +20,8 @@ struct CubeStatus {
   double lift = 0;                 ///< core height above its start [m]
   double u_angle = 0, d_angle = 0; ///< top and bottom layer angles [rad]
   double u_misalign = 0;           ///< top layer's angle from its nearest click [rad]
-  int turns = 0;
+  int turns = 0;      ///< completed quarter turns of every face
+  int top_turns = 0;  ///< of them, the top layer's (U): the layer the scripted user turns
   bool solved = true;
   int contacts = 0;
 };
@@ -34,9 +35,12 @@ class TurnCounter {
   /// scramble or a reset: those are not the user's turns).
   void rebase(const physics::RubiksCube& cube);
   int turns() const { return turns_; }
+  /// Quarter turns of one face ('U', 'D', 'F', 'B', 'R', 'L'); 0 for any other letter.
+  int turns_of(char face) const;
 
  private:
   std::array<int, 6> quarter_{};
+  std::array<int, 6> per_face_{};
   int turns_ = 0;
 };
 

@@ -30,7 +30,8 @@ struct MrSummary {
   double output_wait_ms = 0;
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;
-  int turns = 0;
+  int turns = 0;        ///< completed quarter turns of the top layer, the one the user turns
+  int other_turns = 0;  ///< quarter turns of the other faces (a layer dragged along)
   sim::TaskProgress task;  ///< the scripted user's plan: turns planned, retries
   bool solved = false, has_cube = false;
   std::map<char, double> face_deg;  ///< each face layer's final angle [deg]

@@ -44,7 +44,7 @@ struct TruthFrame {
   std::array<registration::ShapeEstimate, 2> shape{};
   std::array<double, 2> truth_cap_residual_mm{};
   double lift_mm = 0, u_angle_deg = 0, d_angle_deg = 0;
-  int turns = 0;
+  int turns = 0;  ///< completed quarter turns of the top layer (CubeStatus::top_turns)
   std::array<double, 8> force_n{};
   double servo_rate_hz = 0, servo_jitter_max_us = 0;
 };

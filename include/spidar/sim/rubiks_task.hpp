@@ -82,7 +82,9 @@ struct RubiksTaskParams {
 struct CubePoseSample {
   std::array<double, 3> p_W{};           ///< centre [m]
   std::array<double, 4> q_WC{1, 0, 0, 0};  ///< orientation (w, x, y, z)
-  std::int32_t turns = -1;               ///< completed quarter turns so far (−1: not counted)
+  /// Completed quarter turns of the top layer so far, the layer the user turns (−1: not counted);
+  /// another layer dragged along does not count as the user's turn.
+  std::int32_t turns = -1;
 };
 
 /// How the closed-loop user is doing (published for the frame thread and the report).
