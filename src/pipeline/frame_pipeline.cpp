@@ -179,11 +179,10 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       predicted[h] = s.camera.project(registration::bracelet_visible_point(
           X_WH, s.models[h].shape.dimensions.width, s.camera.X_WC().p, p.registration));
       prediction.wrist_px[h] = predicted[h];
-      // The band's expected length: the forearm's projected diameter there (forearm radius ≈
-      // 0.31 × palm breadth, as the skin models it, plus the band's thickness).
+      // The band's expected length: its projected diameter there.
       const double depth = (s.camera.X_CW() * p_WB).z();
       if (depth > 1e-3) {
-        const double radius = 0.31 * s.models[h].shape.dimensions.width + 0.002;
+        const double radius = registration::bracelet_radius_m(p.registration, s.models[h].shape.dimensions.width);
         prediction.length_px[h] = 2.0 * radius * s.camera.intrinsics().fx / depth;
       }
       // The band's long axis in the image: across the forearm (hand y) and the line of sight.
@@ -222,8 +221,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     if (s.have_previous) {
       for (int h = 0; h < 2; ++h) {
         const double forearm_radius =
-            p.registration.bracelet_radius_per_width * s.models[h].shape.dimensions.width +
-            p.registration.bracelet_standoff_m;
+            registration::bracelet_radius_m(p.registration, s.models[h].shape.dimensions.width);
         registration::project_hand(s.models[h], s.previous[h], s.camera, forearm_radius, &s.outlines[h]);
       }
       registration::coverage_evidence(out->key.silhouette, {&s.outlines[0], &s.outlines[1]},

@@ -121,7 +121,7 @@ Vec3 bracelet_visible_point(const Pose& X_WH, double hand_width_m, const Vec3& p
   Vec3 shift = Vec3::Zero();
   const double n = toward.norm();
   if (n > 1e-9) {
-    const double radius = params.bracelet_radius_per_width * hand_width_m + params.bracelet_standoff_m;
+    const double radius = bracelet_radius_m(params, hand_width_m);
     shift = (params.bracelet_surface_shift * radius / n) * toward;
   }
   if (shift_W) *shift_W = shift;

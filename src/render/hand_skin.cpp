@@ -52,13 +52,10 @@ Pose forearm_frame(const Vec3& p_W_origin, const Mat3& R_WH) {
 
 std::array<float, 4> rgba(const std::array<float, 3>& c) { return {c[0], c[1], c[2], 1.f}; }
 
-/// Scales `mesh` across its z axis: x by `sx`, y by `sy` (an elliptic section from a round one).
-/// Positions only: the renderer derives normals from the faces when a mesh has none.
-void scale_across(MeshData* mesh, double sx, double sy) {
-  for (std::size_t k = 0; k + 2 < mesh->vertices.size(); k += 3) {
-    mesh->vertices[k] *= static_cast<float>(sx);
-    mesh->vertices[k + 1] *= static_cast<float>(sy);
-  }
+/// Scales `mesh`'s y by `sy` (an elliptic section about z from a round one). Positions only: the
+/// renderer derives normals from the faces when a mesh has none.
+void flatten_y(MeshData* mesh, double sy) {
+  for (std::size_t k = 1; k < mesh->vertices.size(); k += 3) mesh->vertices[k] *= static_cast<float>(sy);
 }
 
 }  // namespace
@@ -180,7 +177,7 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
   if (p.forearm_length_m > 0) {
     MeshData arm = tapered_segment(skin.wrist_half_breadth, 1.15 * skin.wrist_half_breadth, p.forearm_length_m, arm_slices,
                                    p.bone_rings, p.forearm_cap_depth);
-    scale_across(&arm, 1.0, p.forearm_depth);
+    flatten_y(&arm, p.forearm_depth);
     meshes->push_back(std::move(arm));
     skin.forearm_mesh = static_cast<int>(meshes->size()) - 1;
   }
@@ -189,7 +186,7 @@ HandSkin build_hand_skin(const hand::HandModel& model, const HandSkinParams& p,
     const double grow = p.forearm_length_m > 0 ? 0.15 * p.bracelet_offset_m / p.forearm_length_m : 0;
     const double a = skin.wrist_half_breadth * (1 + grow) + 0.002, b = skin.wrist_half_depth * (1 + grow) + 0.002;
     MeshData band = tapered_segment(a, a, p.bracelet_width_m, arm_slices, 2, 0.05, 0.05);
-    scale_across(&band, 1.0, b / a);
+    flatten_y(&band, b / a);
     meshes->push_back(std::move(band));
     skin.bracelet_mesh = static_cast<int>(meshes->size()) - 1;
   }

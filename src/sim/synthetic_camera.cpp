@@ -63,16 +63,14 @@ struct SyntheticCamera::Impl {
       if (!poses[h]) continue;
       const AnatomicalHand& hand = hands[static_cast<std::size_t>(h)];
       const std::size_t first = first_mesh[static_cast<std::size_t>(h)];
-      Vec3 d = Vec3::Zero();
+      auto& d = toward_elbow[static_cast<std::size_t>(h)];
       if (params.elbows_W) {
         const hand::HandParams& q = *poses[h];
         d = hand::forearm_direction(hand::rotation_from_vector(q.r_W_hand()), q.p_W_wrist(),
-                                               (*params.elbows_W)[static_cast<std::size_t>(h)],
-                                               params.max_wrist_bend_rad);
+                                    (*params.elbows_W)[static_cast<std::size_t>(h)], params.max_wrist_bend_rad);
       }
       pose_anatomical_hand(hand, *poses[h], std::span<MeshData>(*meshes).subspan(first, hand.parts.size()),
-                           params.elbows_W ? &d : nullptr);
-      if (params.elbows_W) toward_elbow[static_cast<std::size_t>(h)] = d;
+                           d ? &*d : nullptr);
       for (std::size_t i = 0; i < hand.parts.size(); ++i) {
         Shape s;  // vertices are in world already: X_WS = identity
         s.type = Shape::Type::kMesh;

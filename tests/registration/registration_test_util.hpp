@@ -113,8 +113,7 @@ inline std::array<std::vector<OwnedPixel>, 2> owned_pixels(const cv::Mat& silhou
                                                      const RegistrationParams& params) {
   std::array<ProjectedHand, 2> outline;
   for (int h = 0; h < 2; ++h) {
-    const double forearm = params.bracelet_radius_per_width * models[h].shape.dimensions.width +
-                           params.bracelet_standoff_m;
+    const double forearm = bracelet_radius_m(params, models[h].shape.dimensions.width);
     project_hand(models[h], poses[h], camera, forearm, &outline[h]);
   }
   std::array<std::vector<OwnedPixel>, 2> owned;

@@ -100,8 +100,7 @@ TEST(Coverage, EachHandOwnsItsOwnPixelsAndNoForearmPixels) {
   std::array<ProjectedHand, 2> outline;
   cv::Mat forearms = cv::Mat::zeros(mask.size(), CV_8UC1);
   for (int h = 0; h < 2; ++h) {
-    const double r = params.bracelet_radius_per_width * models[h].shape.dimensions.width +
-                     params.bracelet_standoff_m;
+    const double r = bracelet_radius_m(params, models[h].shape.dimensions.width);
     project_hand(models[h], poses[h], camera, r, &outline[h]);
     const ImageCapsule& f = outline[h].forearm;
     ASSERT_TRUE(f.valid);

@@ -81,6 +81,12 @@ struct ResidualProblem {
   const RegistrationParams* params = nullptr;
 };
 
+/// The band's radius [m] on a hand `hand_width_m` broad: the forearm's radius there
+/// (bracelet_radius_per_width × width) plus the band's standoff.
+inline double bracelet_radius_m(const RegistrationParams& params, double hand_width_m) {
+  return params.bracelet_radius_per_width * hand_width_m + params.bracelet_standoff_m;
+}
+
 /// Where the bracelet's detected midpoint should lie for a hand at pose `X_WH` seen from
 /// `p_W_camera` (world, m): the band centre, bracelet_offset_m from the wrist toward the elbow,
 /// shifted toward the camera across the forearm by bracelet_surface_shift × the band's radius
