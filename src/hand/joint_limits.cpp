@@ -65,6 +65,19 @@ ParamLimits parameter_limits(const JointRanges& r, Coupling coupling) {
   return lim;
 }
 
+ParamLimits passive_limits(const ParamLimits& limits, const PassiveRange& passive) {
+  ParamLimits out = limits;
+  for (int f : {kIndex, kMiddle, kRing}) {
+    const auto d = digit_params(f);
+    out.lower[d.flexion] -= passive.mcp_extension;
+    if (d.abduction >= 0) {
+      out.lower[d.abduction] -= passive.mcp_abduction;
+      out.upper[d.abduction] += passive.mcp_abduction;
+    }
+  }
+  return out;
+}
+
 HandParams clamp_to_limits(const HandParams& params, const ParamLimits& limits) {
   HandParams out = params;
   for (int i = 0; i < kParamCount; ++i) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/core.hpp>
 
+#include "spidar/hand/joint_limits.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/coverage.hpp"
@@ -50,6 +51,14 @@ Status check_frame(const cv::Mat& bgr, const vision::Camera& camera) {
                std::to_string(bgr.rows)};
 }
 
+/// The models the fits use: the given ones, their joint boxes widened by the passive range
+/// (FramePipelineParams::passive_range).
+std::array<hand::HandModel, 2> fitted_models(std::array<hand::HandModel, 2> given, const FramePipelineParams& p) {
+  if (p.passive_range)
+    for (hand::HandModel& m : given) m.limits = hand::passive_limits(m.limits);
+  return given;
+}
+
 }  // namespace
 
 struct FramePipeline::Impl {
@@ -82,13 +91,13 @@ struct FramePipeline::Impl {
   Impl(const FramePipelineParams& p, vision::ChromaKeyer k,
        const std::array<hand::HandModel, 2>& given)
       : params(p),
-        models(given),
+        models(fitted_models(given, p)),
         keyer(std::move(k)),
         solver(p.registration),
         main(p.compositor),
-        start(given),
-        shape{registration::ShapeEstimator(given[0], p.shape_estimator),
-              registration::ShapeEstimator(given[1], p.shape_estimator)} {
+        start(models),
+        shape{registration::ShapeEstimator(models[0], p.shape_estimator),
+              registration::ShapeEstimator(models[1], p.shape_estimator)} {
     render::CompositorParams o = p.compositor;
     o.mode = p.compositor.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper
                                                                 : render::CompositeMode::kDepth;

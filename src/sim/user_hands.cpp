@@ -46,7 +46,9 @@ registration::RegistrationParams fingertip_ik_params(const UserHandsParams& p) {
 
 UserHands::UserHands(const std::array<hand::HandModel, 2>& truth, const RubiksTask& task,
                      const UserHandsParams& params)
-    : truth_(truth), task_(task), p_(params), solver_(fingertip_ik_params(params)) {}
+    : truth_(truth), pushed_(truth), task_(task), p_(params), solver_(fingertip_ik_params(params)) {
+  for (auto& m : pushed_) m.limits = hand::passive_limits(m.limits, p_.passive);
+}
 
 void UserHands::update(double t, std::span<const Vec3> caps) {
   for (int h = 0; h < 2; ++h) {
@@ -63,11 +65,16 @@ void UserHands::update(double t, std::span<const Vec3> caps) {
     obs.wrist_px.reset();
     // First frame: many iterations from the nominal pose; then a warm start, with more rounds
     // while the caps are not yet reached (a fast motion between two frames).
+    // Within the active ranges first (the previous frame's posture clamped back into them, so a
+    // finger leaves its passive range when the force lets go); only caps still out of reach push
+    // the fingers on into their passive ranges, from there.
     const int rounds = first_ ? 8 : 1;
     for (int r = 0; r < rounds + p_.extra_rounds; ++r) {
       solver_.fit(truth_[h], obs, registration::ImageEvidence{}, &nominal, &q_[h]);
       if (r + 1 >= rounds && mean_cap_distance(truth_[h], q_[h], obs) <= p_.target_residual_m) break;
     }
+    for (int r = 0; r < p_.extra_rounds && mean_cap_distance(truth_[h], q_[h], obs) > p_.target_residual_m; ++r)
+      solver_.fit(pushed_[h], obs, registration::ImageEvidence{}, &nominal, &q_[h]);
     q_[h].little_independent = true;
     q_[h].little = Vec3(q_[h][hand::kRingMcpFlexion], q_[h][hand::kRingMcpAbduction],
                         q_[h][hand::kRingDip]) +

@@ -124,6 +124,31 @@ TEST(JointLimits, ClampPutsEveryParameterInRange) {
   EXPECT_EQ(clamp_to_limits(z, lim).q, z.q);
 }
 
+// The passive range widens exactly the fingers' MCP joints: hyperextension past the flexion's
+// lower end, abduction past both ends; the thumb, the distal joints and the wrist keep their box.
+TEST(JointLimits, PassiveRangeWidensOnlyTheFingersMcpJoints) {
+  const auto active = parameter_limits(JointRanges{}, Coupling::kPaperQuadratic);
+  const PassiveRange passive{.mcp_extension = 0.2, .mcp_abduction = 0.1};
+  const auto wide = passive_limits(active, passive);
+  for (int i = 0; i < kParamCount; ++i) {
+    const bool flexion = i == kIndexMcpFlexion || i == kMiddleMcpFlexion || i == kRingMcpFlexion;
+    const bool abduction = i == kIndexMcpAbduction || i == kRingMcpAbduction;
+    const double lo = flexion ? 0.2 : abduction ? 0.1 : 0.0;
+    const double hi = abduction ? 0.1 : 0.0;
+    if (std::isinf(active.lower[i])) {
+      EXPECT_EQ(wide.lower[i], active.lower[i]) << param_name(i);
+      EXPECT_EQ(wide.upper[i], active.upper[i]) << param_name(i);
+      continue;
+    }
+    EXPECT_NEAR(active.lower[i] - wide.lower[i], lo, 1e-15) << param_name(i);
+    EXPECT_NEAR(wide.upper[i] - active.upper[i], hi, 1e-15) << param_name(i);
+  }
+  // The defaults are the clinical low ends: 15° of hyperextension, 10° of abduction.
+  const auto def = passive_limits(active);
+  EXPECT_NEAR(def.lower[kMiddleMcpFlexion], deg_to_rad(-30.0), 1e-12);
+  EXPECT_NEAR(def.upper[kRingMcpAbduction], deg_to_rad(30.0), 1e-12);
+}
+
 TEST(JointLimits, ValidationNamesTheRange) {
   JointRanges r;
   EXPECT_TRUE(validate_joint_ranges(r).ok());

@@ -27,7 +27,8 @@ struct PressedRun {
   double mean = 0, p95 = 0, worst = 0, worst_t = 0;  ///< cap residual over the frames [m]
   int worst_h = 0;
   int quarter_turns_u = 0;
-  bool within_limits = true;
+  bool within_limits = true;  ///< in the passive ranges throughout
+  bool active_before_contact = true;  ///< in the active ranges while nothing presses (t < 1.2 s)
 };
 
 /// The script fitted to `hands` with `limit_margin_rad` (RubiksTask::fit_to_hands) played on the
@@ -54,7 +55,10 @@ PressedRun pressed_run(const std::array<hand::HandModel, 2>& hands, double limit
           if (e > r.worst) r.worst = e, r.worst_t = t, r.worst_h = static_cast<int>(h);
           e_max = std::max(e_max, e);
           r.within_limits = r.within_limits &&
-                            hand::within_limits(user->params()[h], user->models()[h].limits, 1e-9);
+                            hand::within_limits(user->params()[h], user->reach_limits(static_cast<int>(h)), 1e-9);
+          if (t < 1.2)
+            r.active_before_contact = r.active_before_contact &&
+                                      hand::within_limits(user->params()[h], user->models()[h].limits, 1e-9);
         }
         per_frame.push_back(e_max);
       },
@@ -99,16 +103,19 @@ void expect_caps_reached(const User& u, double margin, bool shaped, double bound
               1e3 * r.mean, 1e3 * r.p95, 1e3 * r.worst, r.worst_h, r.worst_t, r.quarter_turns_u);
   EXPECT_LT(r.worst, bound) << "hand " << r.worst_h << " at t = " << r.worst_t;
   EXPECT_TRUE(r.within_limits);
+  EXPECT_TRUE(r.active_before_contact) << "a finger in its passive range with nothing pushing it";
   EXPECT_EQ(r.quarter_turns_u, 2);
 }
 
-// Fitted with a margin inside the joint ranges, the script leaves the user's fingers room to
-// follow the caps where the contacts press them (the fit with no margin: worst 1.4–2.8 mm, the
-// fingers at their abduction limits), and the grip still turns the top layer twice.
+// The demo's fit (no margin: the index and ring abduction at their limits where the script asks
+// it) with isotropic fingertips: the caps pressed past the touching positions and pulled by their
+// strings push the fingers past their active ranges, and the user's hands follow them into their
+// passive ranges (UserHands; with the active ranges alone: worst 1.4–2.8 mm, 3.7–7.3 mm in the
+// demo), and the grip turns the top layer twice.
 class PressedCaps : public ::testing::TestWithParam<User> {};
 
 TEST_P(PressedCaps, UserHandsReachTheCapsAndTheLayerTurnsTwice) {
-  expect_caps_reached(GetParam(), 0.1, false, 0.001);
+  expect_caps_reached(GetParam(), 0.0, false, 0.001);
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -48,6 +48,20 @@ struct ParamLimits {
 /// The parameter box implied by the joint ranges under a coupling (see the file comment).
 ParamLimits parameter_limits(const JointRanges& ranges, Coupling coupling);
 
+/// How far past its active range an external force can push a finger's MCP joint [rad]: the
+/// passive range of motion, where the collateral ligaments and the volar plate stop the joint.
+/// Clinical goniometry gives passive MCP hyperextension 15–30° past the active and passive
+/// abduction about 10° past the active; we take the low ends. The thumb and the distal joints
+/// have none here (their passive range over the active is small).
+struct PassiveRange {
+  double mcp_extension = units::deg_to_rad(15.0);  ///< past the lower end of MCP flexion
+  double mcp_abduction = units::deg_to_rad(10.0);  ///< past both ends of MCP abduction
+};
+
+/// The parameter box widened from the active `limits` by the passive range (index, middle and ring
+/// MCP flexion and abduction): where a finger can be pushed, not where it moves by itself.
+ParamLimits passive_limits(const ParamLimits& limits, const PassiveRange& passive = {});
+
 /// Parameters clamped into the box. NaN parameters become the nearest finite bound's midpoint
 /// (or 0 for unbounded ones), so nothing downstream sees NaN.
 HandParams clamp_to_limits(const HandParams& params, const ParamLimits& limits);

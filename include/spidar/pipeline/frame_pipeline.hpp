@@ -62,6 +62,10 @@ struct FramePipelineParams {
   /// and fit with the estimate, starting from the given models; off: their sizes stay as given.
   bool personalise_shape = false;
   registration::ShapeEstimatorParams shape_estimator;
+  /// Fit the fingers within their passive ranges (hand::passive_limits of the given models' joint
+  /// ranges), not only the active: a fingertip the strings pull on can be pushed past where its
+  /// finger moves by itself, as the simulated user's are (sim::UserHands). Off: the active ranges.
+  bool passive_range = true;
   /// Hand rotations to start from on the first frame (rotation vectors, world) [rad].
   std::array<Vec3, 2> initial_r_W_hand{Vec3::Zero(), Vec3::Zero()};
   /// Device finger index of each hand's thumb, index, middle, ring (the config's order).

@@ -1,10 +1,4 @@
 #pragma once
-/// How the scripted user plays its task.
-struct ScriptedUserOptions {
-  double deadline_s = 0;        ///< > 0: the run time by which it must be done (retries must fit) [s]
-  bool shaped_fingers = false;  ///< sim::RubiksTaskParams::shaped_fingers
-};
-
 /// The scripted user's task in a scene: the Rubik's cube's turns, or a reach for the object
 /// nearest the frame centre when the scene has no cube.
 #include <array>

@@ -116,8 +116,8 @@ class RubiksTask final : public device::FingertipSource {
   /// (with a margin > 0) side contacts on their hand's layers, clear of the top/middle boundary.
   /// With 0 the fitted layout has the index and ring abduction at their limits (the script's caps
   /// are closer together than fingers are), so where the device's caps actually are (pressed past
-  /// the touching positions, pulled apart by their strings) is partly out of the user's reach:
-  /// the camera's ground truth then misses the caps by up to 3.5–4.3 mm in the demo. A margin of
+  /// the touching positions, pulled apart by their strings) is partly out of the active ranges:
+  /// the user's fingers follow them into their passive ranges (UserHands). A margin of
   /// 0.1 rad makes them reachable on the lockstep physics (tests/sim/test_user_hands_physics.cpp:
   /// within 0.6 mm, both turns made) but spreads the fingers, which changes the grasp: in the
   /// demo (threads, strings) the second turn then failed in 4 of 4 runs. Off by default until the

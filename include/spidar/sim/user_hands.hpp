@@ -12,6 +12,7 @@
 #include <span>
 
 #include "spidar/hand/hand_model.hpp"
+#include "spidar/hand/joint_limits.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 
@@ -26,6 +27,8 @@ struct UserHandsParams {
   /// Rounds an update may add while the caps' mean residual exceeds target_residual_m.
   int extra_rounds = 4;
   double target_residual_m = 0.0002;
+  /// How far past their active ranges the caps may push the fingers' MCP joints.
+  hand::PassiveRange passive{};
   /// The little finger's own posture relative to the ring finger's (MCP flexion, abduction, DIP)
   /// [rad]; it also sways with this amplitude [rad] at 0.7 Hz, as a real little finger does.
   Vec3 little_offset{0.15, 0.06, 0.12};
@@ -51,11 +54,14 @@ class UserHands {
   void update(double t_s, std::span<const Vec3> p_W_caps);
   const std::array<hand::HandParams, 2>& params() const { return q_; }
   const std::array<hand::HandModel, 2>& models() const { return truth_; }
+  /// The box the postures stay in: the hands' joint ranges widened by the passive range.
+  const hand::ParamLimits& reach_limits(int hand) const { return pushed_[hand].limits; }
   /// Mean distance of the fitted caps from the device's at the last update [m], per hand.
   const std::array<double, 2>& cap_residual_m() const { return residual_; }
 
  private:
   std::array<hand::HandModel, 2> truth_;
+  std::array<hand::HandModel, 2> pushed_;  ///< truth_ with the passive ranges
   const RubiksTask& task_;
   UserHandsParams p_;
   registration::SuccessiveAdjustment solver_;
