@@ -309,7 +309,12 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     out->fits[h] = report;
     out->models[h] = s.models[h];
     // Personalisation: this frame's evidence on the hand's sizes; the next fit uses the estimate.
-    if (p.personalise_shape) {
+    // Only a fit that agrees with the strings is evidence on the sizes: a broken one (a lost
+    // bracelet, a local minimum) would pull them toward whatever explains it.
+    int valid_tips = 0;
+    for (bool v : obs.fingertip_valid) valid_tips += v ? 1 : 0;
+    const bool trusted = valid_tips > 0 && report.terms.fingertip / valid_tips <= p.shape_max_fingertip_cost;
+    if (p.personalise_shape && trusted) {
       if (s.shape[h].add_frame(q, obs, image, p.registration)) s.models[h] = fit_model(s.shape[h].model(), p);
     }
     out->shapes[h] = s.shape[h].estimate();

@@ -227,6 +227,52 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
   ASSERT_TRUE(context_->make_current().ok());
 }
 
+// A fit that cannot agree with the strings is no evidence on the hand's sizes: with the right
+// hand's caps twice as far apart as the hand has them (past any pose of the hand), its frames are not offered to the size
+// estimator (FramePipelineParams::shape_max_fingertip_cost), while the left hand's are; with the
+// gate open, the broken fits become keyframes.
+TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  p.personalise_shape = true;
+  p.shape_estimator.min_pose_change = 0.02;  // keyframes from a short stretch of the script
+  sim::RubiksTask task({});
+  task.fit_to_hands(truth_models_);
+  const double t0 = 1.8;
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(t0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  std::array<std::array<int, 2>, 2> keyframes{};  // [gate closed, open][hand]
+  for (int open = 0; open < 2; ++open) {
+    FramePipelineParams q = p;
+    if (open == 1) q.shape_max_fingertip_cost = 1e9;
+    auto pipe = FramePipeline::create(*context_, camera_, models_, q).value();
+    sim::UserHands user(truth_models_, task);
+    sim::SyntheticFrame frame;
+    FrameResult r;
+    for (double t = t0; t < t0 + 1.0; t += 1.0 / 30) {
+      auto sample = pose_user(user, task, t);
+      const auto& truth = user.params();
+      ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+      Vec3 centre = Vec3::Zero();
+      for (int f = 4; f < 8; ++f) centre += 0.25 * Vec3(sample.p_W[f][0], sample.p_W[f][1], sample.p_W[f][2]);
+      for (int f = 4; f < 8; ++f) {  // the right caps twice as far apart as the hand has them
+        const Vec3 x(sample.p_W[f][0], sample.p_W[f][1], sample.p_W[f][2]);
+        const Vec3 y = centre + 2.0 * (x - centre);
+        sample.p_W[f] = {y.x(), y.y(), y.z()};
+      }
+      ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());
+    }
+    for (int h = 0; h < 2; ++h) keyframes[open][h] = r.shapes[h].keyframes;
+  }
+  std::printf("keyframes, left / right: gate %d / %d, open %d / %d\n", keyframes[0][0], keyframes[0][1],
+              keyframes[1][0], keyframes[1][1]);
+  EXPECT_GT(keyframes[0][0], 2);
+  EXPECT_EQ(keyframes[0][1], 0);
+  EXPECT_GT(keyframes[1][1], 2);  // the test can fail: the broken fits would be offered
+}
+
 TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {
   auto pipe = FramePipeline::create(*context_, camera_, models_, {}).value();
   FrameResult r;
