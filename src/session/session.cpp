@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/core/realtime.hpp"
 #include "spidar/device/sample_interpolation.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
 
@@ -202,6 +203,8 @@ Session::Step Session::step() {
 
 SessionSummary Session::run(const std::function<std::optional<std::string>()>& interrupted) {
   start();
+  // After start(): the threads it made keep their own niceness, not this one's.
+  if (params_.frame_nice != 0) (void)core::set_nice(params_.frame_nice);  // best effort
   std::string ended_by = "completed";
   while (servo_running()) {
     if (interrupted) {

@@ -2,7 +2,11 @@
 // history, the warm-up, and a sink that throws.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <stdexcept>
 #include <vector>
 
@@ -58,6 +62,8 @@ struct TracingSink final : FrameSink {
     indices.push_back(e.index);
     times.push_back(e.t_s);
     cold.push_back(e.cold_start);
+    errno = 0;
+    frame_thread_nice.push_back(getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())));
     truth.push_back(e.filmed != nullptr);
   }
   void on_end(const SessionSummary& s) override {
@@ -68,6 +74,7 @@ struct TracingSink final : FrameSink {
   std::vector<std::uint64_t> indices;
   std::vector<double> times;
   std::vector<bool> cold, truth;
+  std::vector<int> frame_thread_nice;  ///< the calling (frame) thread's niceness at each frame
   SessionSummary summary;
 };
 
@@ -92,6 +99,9 @@ TEST(Session, EverySinkSeesEveryProcessedFrameInOrderWithIncreasingTimes) {
     EXPECT_EQ(k->summary.frames, end.frames);
   }
   EXPECT_EQ(a.times, b.times);
+  // The frame thread runs at SessionParams::frame_nice where that is permitted (root here).
+  if (geteuid() == 0)
+    for (int n : a.frame_thread_nice) EXPECT_EQ(n, SessionParams{}.frame_nice);
   // Stopped: a second stop() returns the same summary and calls no sink again.
   EXPECT_EQ(s.session->stop().frames, end.frames);
   EXPECT_EQ(a.calls.back(), 'e');
