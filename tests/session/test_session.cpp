@@ -100,8 +100,9 @@ TEST(Session, EverySinkSeesEveryProcessedFrameInOrderWithIncreasingTimes) {
   }
   EXPECT_EQ(a.times, b.times);
   // The frame thread runs at SessionParams::frame_nice where that is permitted (root here).
-  if (geteuid() == 0)
+  if (geteuid() == 0) {
     for (int n : a.frame_thread_nice) EXPECT_EQ(n, SessionParams{}.frame_nice);
+  }
   // Stopped: a second stop() returns the same summary and calls no sink again.
   EXPECT_EQ(s.session->stop().frames, end.frames);
   EXPECT_EQ(a.calls.back(), 'e');
