@@ -66,11 +66,12 @@ struct RubiksTaskParams {
   bool has_cube = true;          ///< a Rubik's cube (false: another object; no turns are counted)
   /// The user's fingertips held with their own fingers' stiffness (sim/finger_hold.hpp) once
   /// fit_to_hands is called: the caps then yield to the displayed forces only where the fingers
-  /// can follow them, so the user's hands reach the device's caps (cap residual ≤ 0.4 mm in the
-  /// demo, against 3.7–7 mm with isotropic fingertips). The fit puts the fingertips on the faces
+  /// can follow them, so the user's hands reach the device's caps within their active ranges
+  /// (cap residual ≤ 0.4 mm in the demo; isotropic fingertips push the fingers into their passive
+  /// ranges instead, sim::UserHands). The fit puts the fingertips on the faces
   /// (they press along their compliant directions), keeps each hand on its layers, and the goals
-  /// move no faster than max_goal_speed. Off by default: with it the grip is weaker for some
-  /// hands and seeds (docs/user-model.md), so the layer turns need retries more often.
+  /// move no faster than max_goal_speed. Off by default: with it the grip is weaker for other hands
+  /// (README: the users ±10 % made 1 of 2 turns in 8 of 8 runs).
   bool shaped_fingers = false;
   /// With shaped_fingers, how fast a fingertip goal may move [m/s]: a hand moves smoothly, so where
   /// the plan changes at once (a grasp frame taken from where the cube now is) the goals follow at
