@@ -60,6 +60,14 @@ hand::HandModel fit_model(hand::HandModel model, const FramePipelineParams& p) {
   return model;
 }
 
+/// The fit's fingertip cost per measured fingertip (dimensionless: 1 = each σ from the strings);
+/// 0 when no fingertip is measured.
+double fingertip_cost_per_tip(const registration::FitReport& report, const registration::HandObservation& obs) {
+  int valid = 0;
+  for (bool v : obs.fingertip_valid) valid += v ? 1 : 0;
+  return valid > 0 ? report.terms.fingertip / valid : 0.0;
+}
+
 }  // namespace
 
 struct FramePipeline::Impl {
@@ -289,9 +297,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       // A fit that cannot bring the fingertips to the strings has lost the hand (a wrong
       // bracelet, a local minimum): start again from the fingertips, keeping the rotation, and
       // keep whichever fit is cheaper.
-      int valid = 0;
-      for (bool v : obs.fingertip_valid) valid += v ? 1 : 0;
-      if (valid > 0 && report.terms.fingertip / valid > p.restart_fingertip_cost) {
+      if (fingertip_cost_per_tip(report, obs) > p.restart_fingertip_cost) {
         registration::FitReport again;
         const hand::HandParams q2 =
             fit_from(cold_start(s.models[h], prior.r_W_hand(), obs), nullptr, p.first_frame_rounds, &again);
@@ -311,10 +317,8 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     // Personalisation: this frame's evidence on the hand's sizes; the next fit uses the estimate.
     // Only a fit that agrees with the strings is evidence on the sizes: a broken one (a lost
     // bracelet, a local minimum) would pull them toward whatever explains it.
-    int valid_tips = 0;
-    for (bool v : obs.fingertip_valid) valid_tips += v ? 1 : 0;
-    const bool trusted = valid_tips > 0 && report.terms.fingertip / valid_tips <= p.shape_max_fingertip_cost;
-    if (p.personalise_shape && trusted) {
+    // (A frame without all four fingertips makes no keyframe anyway: ShapeEstimator::add_frame.)
+    if (p.personalise_shape && fingertip_cost_per_tip(report, obs) <= p.shape_max_fingertip_cost) {
       if (s.shape[h].add_frame(q, obs, image, p.registration)) s.models[h] = fit_model(s.shape[h].model(), p);
     }
     out->shapes[h] = s.shape[h].estimate();

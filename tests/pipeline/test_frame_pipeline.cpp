@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "source_path.hpp"
+#include "spidar/device/servo_types.hpp"
 
 #include <cstdlib>
 #include <limits>
@@ -255,11 +256,10 @@ TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
       auto sample = pose_user(user, task, t);
       const auto& truth = user.params();
       ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
-      Vec3 centre = Vec3::Zero();
-      for (int f = 4; f < 8; ++f) centre += 0.25 * Vec3(sample.p_W[f][0], sample.p_W[f][1], sample.p_W[f][2]);
+      const auto p_W = device::fingertip_positions(sample);
+      const Vec3 centre = 0.25 * (p_W[4] + p_W[5] + p_W[6] + p_W[7]);
       for (int f = 4; f < 8; ++f) {  // the right caps twice as far apart as the hand has them
-        const Vec3 x(sample.p_W[f][0], sample.p_W[f][1], sample.p_W[f][2]);
-        const Vec3 y = centre + 2.0 * (x - centre);
+        const Vec3 y = centre + 2.0 * (p_W[f] - centre);
         sample.p_W[f] = {y.x(), y.y(), y.z()};
       }
       ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());

@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <stdexcept>
 #include <vector>
 
@@ -62,7 +61,6 @@ struct TracingSink final : FrameSink {
     indices.push_back(e.index);
     times.push_back(e.t_s);
     cold.push_back(e.cold_start);
-    errno = 0;
     frame_thread_nice.push_back(getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())));
     truth.push_back(e.filmed != nullptr);
   }
