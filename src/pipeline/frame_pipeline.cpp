@@ -8,6 +8,7 @@
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/coverage.hpp"
+#include "spidar/registration/fingertip_reach.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/render/hand_shapes.hpp"
 #include "spidar/vision/silhouette.hpp"
@@ -255,6 +256,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   // Successive adjustment of both hands.
   t0 = Clock::now();
   out->restarts = 0;
+  out->reaches = 0;
   for (int h = 0; h < 2; ++h) {
     registration::HandObservation obs;
     for (int f = 0; f < hand::kFingertipCount; ++f) {
@@ -311,6 +313,13 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
         ++out->restarts;
       }
     }
+    // A digit stalled short of its string: try again from it re-posed on its own (its prior mean
+    // moved along, or the prior would hold the old basin), and keep the re-fit if it explains the
+    // evidence better; the prior is left out of that comparison for the same reason.
+    if (p.reach_min_miss_m > 0 &&
+        registration::refit_reaching(s.solver, s.models[h], obs, hand_image, cold ? nullptr : &s.previous[h],
+                                     {.min_miss_m = p.reach_min_miss_m}, &q, &report))
+      ++out->reaches;
     out->hands[h] = q;
     out->fits[h] = report;
     out->models[h] = s.models[h];

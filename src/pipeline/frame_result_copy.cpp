@@ -20,6 +20,7 @@ void copy_frame_result(const FrameResult& from, FrameResult* to) {
   to->shapes = from.shapes;
   to->fits = from.fits;
   to->restarts = from.restarts;
+  to->reaches = from.reaches;
   to->bracelets = from.bracelets;
   copy_image(from.key.alpha, to->key.alpha);
   copy_image(from.key.silhouette, to->key.silhouette);

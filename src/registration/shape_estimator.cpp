@@ -6,6 +6,7 @@
 #include <string>
 
 #include "spidar/core/result.hpp"
+#include "spidar/registration/fingertip_reach.hpp"
 #include "spidar/registration/residuals.hpp"
 
 namespace spidar::registration {
@@ -123,8 +124,12 @@ bool ShapeEstimator::solve(const vision::Camera* camera, const RegistrationParam
     Eigen::Vector2d g = Eigen::Vector2d::Zero();
     for (Keyframe& kf : keyframes_) {
       // The keyframe's pose at the current sizes (warm start, weak prior toward its last pose).
-      const hand::HandParams prior = kf.q;
-      solver.fit(model_, kf.observation, skeleton_only, &prior, &kf.q);
+      hand::HandParams prior = kf.q;
+      FitReport fit = solver.fit(model_, kf.observation, skeleton_only, &prior, &kf.q);
+      if (p_.reach_min_miss_m > 0 &&
+          refit_reaching(solver, model_, kf.observation, skeleton_only, &prior,
+                         {.min_miss_m = p_.reach_min_miss_m}, &kf.q, &fit))
+        prior = kf.q;  // the re-posed digits' prior moved along (refit_reaching)
       const ResidualProblem problem{&model_, &kf.observation, &skeleton_only, &prior, &fit_params};
       FrozenTargets targets;
       freeze_targets(problem, kf.q, &targets);

@@ -354,6 +354,20 @@ int main(int argc, char** argv) {
         cap_res += (true_pts.p_W_fingertip[f] - g[4 * h + f]).norm() / 8;
       }
     }
+    if (a.verbose && t < 0.4) {
+      for (int h = 0; h < 2; ++h) {
+        const auto mt = hand::forward_kinematics(r.models[h], truth[h]);
+        std::printf("  hand %d model at truth, caps off [mm]:", h);
+        for (int f = 0; f < 4; ++f) std::printf(" %.2f", 1e3 * (mt.p_W_fingertip[f] - g[4 * h + f]).norm());
+        std::printf("  outside limits:");
+        const auto& lim = r.models[h].limits;
+        for (int k = 6; k < hand::kParamCount; ++k)
+          if (truth[h][k] < lim.lower[k] - 1e-6 || truth[h][k] > lim.upper[k] + 1e-6) std::printf(" %d (%.3f in [%.3f, %.3f])", k, truth[h][k], lim.lower[k], lim.upper[k]);
+        std::printf("  fit-truth q:");
+        for (int k = 0; k < hand::kParamCount; ++k) std::printf(" %.2f", r.hands[h][k] - truth[h][k]);
+        std::printf("\n");
+      }
+    }
     if (a.verbose && cap_res > 0.002) {
       for (int h = 0; h < 2; ++h) {
         const auto true_pts = hand::forward_kinematics(truth_models[h], truth[h]);
@@ -452,8 +466,9 @@ int main(int argc, char** argv) {
       contested_paper.push_back(m.contested_pct_paper());
     }
     if (a.verbose)
-      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f mm joints %.1f px  L %.4f/%.4f W %.4f/%.4f\n",
-                  t, m.iou, c, tip.back(), joint.back(), r.models[0].shape.dimensions.length,
+      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f/%.2f mm joints %.1f/%.1f px  L %.4f/%.4f W %.4f/%.4f\n",
+                  t, m.iou, c, m.fingertip_mm[0], m.fingertip_mm[1], m.joint_px[0], m.joint_px[1],
+                  r.models[0].shape.dimensions.length,
                   r.models[1].shape.dimensions.length, r.models[0].shape.dimensions.width,
                   r.models[1].shape.dimensions.width);
   }

@@ -10,6 +10,7 @@
 
 #include "registration_test_util.hpp"
 #include "spidar/hand/kinematics.hpp"
+#include "spidar/registration/fingertip_reach.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/registration/shape_estimator.hpp"
 
@@ -55,7 +56,8 @@ Outcome run(double length_m, double width_m, int frames, std::uint32_t seed) {
     ImageEvidence image;
     image.camera = &camera;
     const hand::HandParams prior = fit;
-    solver.fit(est.model(), obs, image, &prior, &fit);
+    FitReport report = solver.fit(est.model(), obs, image, &prior, &fit);
+    refit_reaching(solver, est.model(), obs, image, &prior, {.min_miss_m = 0.001}, &fit, &report);
     double tip = 0;
     const hand::HandPoints fp = hand::forward_kinematics(est.model(), fit);
     for (int f = 0; f < hand::kFingertipCount; ++f) tip += (fp.p_W_fingertip[f] - pts.p_W_fingertip[f]).norm() / 4;

@@ -48,6 +48,10 @@ struct FramePipelineParams {
   /// Restart a warm-started fit from the fingertips when its fingertip cost per fingertip stays
   /// above this (dimensionless: 25 = each fingertip 5 σ from the strings, ~7.5 mm at 1.5 mm).
   double restart_fingertip_cost = 25.0;
+  /// A fit whose cap misses its string by more than this [m] is tried again from each such digit
+  /// re-posed on its own (registration/fingertip_reach.hpp: the straight-finger local minimum),
+  /// and the re-fit kept if it explains the evidence better; 0 = never.
+  double reach_min_miss_m = 0.001;
   /// How the fitted hands are drawn (their depth decides occlusion; their pixels give the IoU):
   /// a skin (tapered bones, rounded palm: render/hand_skin.hpp) or the model's capsules.
   bool skinned_hands = true;
@@ -93,6 +97,7 @@ struct FrameResult {
   std::array<registration::ShapeEstimate, 2> shapes;
   std::array<registration::FitReport, 2> fits;
   int restarts = 0;  ///< hands whose fit was restarted this frame
+  int reaches = 0;   ///< hands whose fit was kept from a digit re-posed to its string this frame
   std::array<vision::BraceletObservation, 2> bracelets;
   vision::ChromaKeyResult key;
   render::RenderTargets virt;   ///< the virtual scene with the fitted hands (hidden): colour,

@@ -43,6 +43,9 @@ struct ShapeEstimatorParams {
   /// The estimate stays within this share of the starting sizes (0.15: ±15 %).
   double max_relative_change = 0.15;
   double difference_step_m = 1e-4;  ///< central-difference step of J_β [m]
+  /// A keyframe's refit re-poses each digit whose cap misses its string by more than this
+  /// (fingertip_reach.hpp) [m]: a digit stalled straight and short would bias the sizes; 0 = never.
+  double reach_min_miss_m = 0.001;
 };
 
 /// The estimate of one hand.
