@@ -11,6 +11,8 @@ namespace {
 
 /// A digit ends nearer its fingertip by at least this before it changes [m].
 constexpr double kMinGain = 1e-5;
+/// A cap this near its fingertip has reached it: no further steps or starts [m].
+constexpr double kReached = 1e-6;
 /// The distal range searched when the model has no finite limit there [rad].
 constexpr double kDefaultDistalLow = -0.2;
 constexpr double kDefaultDistalHigh = 1.8;
@@ -58,17 +60,15 @@ double descend(const hand::HandModel& model, int finger, const DigitColumns& dc,
       const int k = dc.col[static_cast<std::size_t>(i)];
       cand[k] = clamp_param(cand[k] + delta[i], model.limits, k);
     }
-    hand::HandPoints cpts;
-    hand::FingertipJacobian cJ;
-    hand::forward_kinematics(model, cand, &cpts, &cJ, nullptr);
-    const Vec3 cr = cpts.p_W_fingertip[static_cast<std::size_t>(finger)] - target;
+    hand::forward_kinematics(model, cand, &pts, nullptr, nullptr);
+    const Vec3 cr = pts.p_W_fingertip[static_cast<std::size_t>(finger)] - target;
     if (cr.norm() < miss) {
       *x = cand;
-      J = cJ;
       r = cr;
       miss = cr.norm();
       lambda = std::max(lambda / 10.0, 1e-9);
-      if (miss < 1e-7) break;
+      if (miss < kReached) break;
+      hand::forward_kinematics(model, *x, &pts, &J, nullptr);
     } else {
       lambda = std::min(lambda * 10.0, 1e9);
     }
@@ -135,8 +135,9 @@ FingertipReach reach_fingertips(const hand::HandModel& model, const HandObservat
         best_miss = m;
         best = x;
       }
+      if (best_miss < kReached) break;
     }
-    if (best_miss < out.miss_before_m[fs] - kMinGain && best_miss > 1e-7)
+    if (best_miss < out.miss_before_m[fs] - kMinGain && best_miss > kReached)
       best_miss = descend(model, f, dc, target, params.polish_iterations, &best);
     if (best_miss < out.miss_before_m[fs] - kMinGain) {
       *q = best;

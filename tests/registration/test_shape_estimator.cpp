@@ -79,8 +79,10 @@ TEST_P(KnownSizes, LengthMovesTowardTheTruthAsEvidenceAccumulates) {
               "fingertips %.2f -> %.2f mm\n",
               L, W, e.length_m, 1e3 * e.sigma_length_m, e.width_m, 1e3 * e.sigma_width_m,
               e.keyframes, o.tip_error_first_mm, o.tip_error_last_mm);
-  // Measured 2026-11-24 (400 frames, 24 keyframes): L 0.2089 for 0.209, 0.1873 for 0.171,
-  // 0.1990 for 0.1976, 0.1839 for 0.171; widths 0.4–9 mm off. The length always moves toward the
+  // Measured 2026-11-25 (400 frames, 24 keyframes; each frame's fit and the keyframe refits
+  // re-posing digits stalled short of their strings, fingertip_reach.hpp): L 0.2105 for 0.209,
+  // 0.1835 for 0.171, 0.1974 for 0.1976, 0.1803 for 0.171 (without the re-posing 0.2104, 0.1858,
+  // 0.1996, 0.1792); widths 1.5–9 mm off. The length always moves toward the
   // truth, but a small hand's stops short (issue 14 keeps the 2 % target open): what is asserted
   // is the direction and the narrowing of the evidence, not the target.
   EXPECT_LT(std::abs(e.length_m - L), std::abs(0.19 - L));

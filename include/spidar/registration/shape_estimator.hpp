@@ -45,7 +45,7 @@ struct ShapeEstimatorParams {
   double difference_step_m = 1e-4;  ///< central-difference step of J_β [m]
   /// A keyframe's refit re-poses each digit whose cap misses its string by more than this
   /// (fingertip_reach.hpp) [m]: a digit stalled straight and short would bias the sizes; 0 = never.
-  double reach_min_miss_m = 0.001;
+  double reach_min_miss_m = 0.003;
 };
 
 /// The estimate of one hand.
