@@ -257,6 +257,11 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   t0 = Clock::now();
   out->restarts = 0;
   out->reaches = 0;
+  // A size re-estimate running on its own thread takes effect here, a fixed number of frames after
+  // it started (ShapeEstimatorParams::apply_after_frames), so the fits stay reproducible.
+  if (p.personalise_shape)
+    for (int h = 0; h < 2; ++h)
+      if (s.shape[h].poll()) s.models[h] = fit_model(s.shape[h].model(), p);
   for (int h = 0; h < 2; ++h) {
     registration::HandObservation obs;
     for (int f = 0; f < hand::kFingertipCount; ++f) {
@@ -328,7 +333,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     // bracelet, a local minimum) would pull them toward whatever explains it.
     // (A frame without all four fingertips makes no keyframe anyway: ShapeEstimator::add_frame.)
     if (p.personalise_shape && fingertip_cost_per_tip(report, obs) <= p.shape_max_fingertip_cost) {
-      if (s.shape[h].add_frame(q, obs, image, p.registration)) s.models[h] = fit_model(s.shape[h].model(), p);
+      if (s.shape[h].add_frame(q, obs, hand_image, p.registration)) s.models[h] = fit_model(s.shape[h].model(), p);
     }
     out->shapes[h] = s.shape[h].estimate();
   }

@@ -81,7 +81,7 @@ TEST_P(KnownSizes, LengthMovesTowardTheTruthAsEvidenceAccumulates) {
               e.keyframes, o.tip_error_first_mm, o.tip_error_last_mm);
   // Measured 2026-11-25 (400 frames, 24 keyframes; each frame's fit and the keyframe refits
   // re-posing digits stalled short of their strings, fingertip_reach.hpp): L 0.2105 for 0.209,
-  // 0.1835 for 0.171, 0.1974 for 0.1976, 0.1803 for 0.171 (without the re-posing 0.2104, 0.1858,
+  // 0.1829 for 0.171, 0.1971 for 0.1976, 0.1799 for 0.171 (without the re-posing 0.2104, 0.1858,
   // 0.1996, 0.1792); widths 1.5–9 mm off. The length always moves toward the
   // truth, but a small hand's stops short (issue 14 keeps the 2 % target open): what is asserted
   // is the direction and the narrowing of the evidence, not the target.
@@ -125,6 +125,8 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.prior_sigma_length_m, d.prior_sigma_length_m);
   EXPECT_EQ(p.prior_sigma_width_m, d.prior_sigma_width_m);
   EXPECT_EQ(p.max_relative_change, d.max_relative_change);
+  EXPECT_EQ(p.reach_min_miss_m, d.reach_min_miss_m);
+  EXPECT_EQ(p.apply_after_frames, 2);  // the sessions re-estimate on a thread of their own
   const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
     parse_shape_estimator_params(bad["personalisation"], &enabled);
@@ -133,6 +135,21 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("min_pose_change"), std::string::npos) << e.what();
   }
+  for (const std::string key : {"apply_after_frames", "reach_min_miss_m"}) {
+    const std::string text = "personalisation:\n  " + key + (key == "apply_after_frames" ? ": -1\n" : ": 0.5\n");
+    const auto node = core::ConfigNode::Parse(text, "bad.yaml");
+    try {
+      parse_shape_estimator_params(node["personalisation"], &enabled);
+      FAIL() << "accepted " << text;
+    } catch (const core::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << key << ": " << e.what();
+    }
+  }
+  const auto on = core::ConfigNode::Parse("personalisation:\n  silhouette: true\n  reach_min_miss_m: 0\n", "on.yaml");
+  const ShapeEstimatorParams q = parse_shape_estimator_params(on["personalisation"], &enabled);
+  EXPECT_TRUE(q.silhouette);
+  EXPECT_EQ(q.reach_min_miss_m, 0.0);
 }
 
 }  // namespace

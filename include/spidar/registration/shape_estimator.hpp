@@ -22,10 +22,13 @@
 /// tissue) would bias the sizes; the strings and the bracelet measure points of the skeleton.
 
 #include <array>
+#include <future>
+#include <optional>
 #include <vector>
 
 #include "spidar/core/config.hpp"
 #include "spidar/hand/hand_model.hpp"
+#include "spidar/registration/coverage.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 
 namespace spidar::registration {
@@ -45,7 +48,18 @@ struct ShapeEstimatorParams {
   double difference_step_m = 1e-4;  ///< central-difference step of J_β [m]
   /// A keyframe's refit re-poses each digit whose cap misses its string by more than this
   /// (fingertip_reach.hpp) [m]: a digit stalled straight and short would bias the sizes; 0 = never.
-  double reach_min_miss_m = 0.003;
+  double reach_min_miss_m = 0.001;
+  /// 0: a re-estimate runs inside add_frame, on the caller's thread. N > 0: it runs on a thread of
+  /// its own (at nice 10: mostly the CPU's spare share) from a copy of the keyframes,
+  /// and its sizes take effect at the N-th poll() after it started, which waits for it then if it
+  /// has not finished: the frame thread does not carry the re-estimate (10–25 ms), and the
+  /// sequence of models stays the same from run to run.
+  int apply_after_frames = 0;
+  /// Keyframes also keep the silhouette pixels their hand owned (ImageEvidence::coverage) and the
+  /// re-estimate fits them too (the silhouette term's coverage direction): evidence on the width
+  /// that four fingertips and a wrist lack, at the price of the skin's differences from a real
+  /// hand's outline. Off: strings and bracelet only.
+  bool silhouette = false;
 };
 
 /// The estimate of one hand.
@@ -65,19 +79,45 @@ class ShapeEstimator {
   /// Starts from `start` (its length and width; side, coupling and limits are kept).
   explicit ShapeEstimator(const hand::HandModel& start, const ShapeEstimatorParams& params = {});
   /// Offers one frame: `q` the pose fitted with model(), `observation` what the fit used, `image`
-  /// its camera (only the camera is used), `fit_params` the fit's settings. Returns true when the
-  /// sizes changed (model() was rebuilt).
+  /// its camera and (ShapeEstimatorParams::silhouette) the silhouette pixels the hand owns,
+  /// `fit_params` the fit's settings. Returns true when the sizes changed (model() was rebuilt).
+  /// With apply_after_frames > 0 it starts the re-estimate and returns false; poll() applies it.
   bool add_frame(const hand::HandParams& q, const HandObservation& observation,
                  const ImageEvidence& image, const RegistrationParams& fit_params);
+  /// Call once per frame (before fitting with model()) when apply_after_frames > 0: applies a
+  /// re-estimate started apply_after_frames polls ago, waiting for it if needed. Returns true when
+  /// the sizes changed (model() was rebuilt). Without a re-estimate in flight it does nothing.
+  bool poll();
+  /// Whether a re-estimate is running on its own thread.
+  bool solving() const { return pending_.valid(); }
   const hand::HandModel& model() const { return model_; }
   const ShapeEstimate& estimate() const { return estimate_; }
 
- private:
+  ShapeEstimator(ShapeEstimator&&) = default;
+  ShapeEstimator& operator=(ShapeEstimator&&) = default;
+  ~ShapeEstimator();
+
   struct Keyframe {
     hand::HandParams q;
     HandObservation observation;
+    std::vector<OwnedPixel> owned;  ///< ShapeEstimatorParams::silhouette only
   };
-  bool solve(const vision::Camera* camera, const RegistrationParams& fit_params);
+  /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its
+  /// own thread shares nothing with the estimator).
+  struct Solve {
+    ShapeEstimatorParams params;
+    RegistrationParams fit_params;
+    std::optional<vision::Camera> camera;
+    hand::HandModel model;
+    double start_length_m = 0, start_width_m = 0;
+    std::vector<Keyframe> keyframes;
+    ShapeEstimate estimate;
+    bool changed = false;
+  };
+
+ private:
+  Solve make_solve(const vision::Camera* camera, const RegistrationParams& fit_params) const;
+  bool apply(Solve&& done);
 
   ShapeEstimatorParams p_;
   hand::HandModel model_;
@@ -86,11 +126,16 @@ class ShapeEstimator {
   std::size_t next_slot_ = 0;
   int new_since_solve_ = 0;
   ShapeEstimate estimate_;
+  std::future<Solve> pending_;
+  int polls_since_start_ = 0;
+  int keyframes_added_ = 0;            ///< ever added (a re-estimate's refits return only if none since)
+  int keyframes_added_at_start_ = 0;
 };
 
 /// Reads a `personalisation:` map (every key optional): enabled (bool, into `*enabled`),
 /// prior_sigma_length_m, prior_sigma_width_m, keyframes, min_pose_change, solve_every,
-/// min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m, max_relative_change.
+/// min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m, max_relative_change,
+/// reach_min_miss_m, apply_after_frames, silhouette.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
