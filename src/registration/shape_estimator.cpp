@@ -229,7 +229,7 @@ bool ShapeEstimator::add_frame(const hand::HandParams& q, const HandObservation&
   keyframes_added_at_start_ = keyframes_added_;
   polls_since_start_ = 0;
   pending_ = std::async(std::launch::async, [job = std::move(job)]() mutable {
-    (void)core::set_nice(10);  // best effort: the frame thread keeps its share
+    (void)core::set_nice(0);  // best effort: an ordinary share, below the frame thread's
     return solve_shape(std::move(job));
   });
   return false;

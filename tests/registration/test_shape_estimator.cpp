@@ -126,7 +126,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.prior_sigma_width_m, d.prior_sigma_width_m);
   EXPECT_EQ(p.max_relative_change, d.max_relative_change);
   EXPECT_EQ(p.reach_min_miss_m, d.reach_min_miss_m);
-  EXPECT_EQ(p.apply_after_frames, 2);  // the sessions re-estimate on a thread of their own
+  EXPECT_EQ(p.apply_after_frames, 5);  // the sessions re-estimate on a thread of their own
   const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
     parse_shape_estimator_params(bad["personalisation"], &enabled);

@@ -48,12 +48,16 @@ struct ShapeEstimatorParams {
   double difference_step_m = 1e-4;  ///< central-difference step of J_β [m]
   /// A keyframe's refit re-poses each digit whose cap misses its string by more than this
   /// (fingertip_reach.hpp) [m]: a digit stalled straight and short would bias the sizes; 0 = never.
-  double reach_min_miss_m = 0.001;
+  /// After a size step most caps move by a millimetre or so: at 1 mm every refit re-poses, which
+  /// costs CPU the other threads need on a busy machine (demo, one core busy, seeds 1–3: dropped
+  /// 3.1–13.1 % at 1 mm, 2.5–7.2 % at 3 mm); the small user's IoU gains less at 3 mm.
+  double reach_min_miss_m = 0.003;
   /// 0: a re-estimate runs inside add_frame, on the caller's thread. N > 0: it runs on a thread of
-  /// its own (at nice 10: mostly the CPU's spare share) from a copy of the keyframes,
-  /// and its sizes take effect at the N-th poll() after it started, which waits for it then if it
-  /// has not finished: the frame thread does not carry the re-estimate (10–25 ms), and the
-  /// sequence of models stays the same from run to run.
+  /// its own (at nice 0, below a frame thread at −5) from a copy of the keyframes, and its sizes
+  /// take effect at the N-th poll() after it started, which waits for it then if it has not
+  /// finished: the frame thread does not carry the re-estimate (10–25 ms), and the sequence of
+  /// models stays the same from run to run. (At nice 10 a busy machine starved it past 2 frames,
+  /// and the frame thread waited.)
   int apply_after_frames = 0;
   /// Keyframes also keep the silhouette pixels their hand owned (ImageEvidence::coverage) and the
   /// re-estimate fits them too (the silhouette term's coverage direction): evidence on the width
