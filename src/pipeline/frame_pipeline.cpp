@@ -10,6 +10,7 @@
 #include "spidar/registration/coverage.hpp"
 #include "spidar/registration/fingertip_reach.hpp"
 #include "spidar/registration/residuals.hpp"
+#include "spidar/registration/shape_estimator.hpp"
 #include "spidar/render/hand_shapes.hpp"
 #include "spidar/vision/silhouette.hpp"
 
@@ -165,6 +166,16 @@ Status FramePipeline::present(render::Context& context, const cv::Mat& bgr) {
 }
 const FramePipelineParams& FramePipeline::params() const { return impl_->params; }
 const std::array<hand::HandModel, 2>& FramePipeline::models() const { return impl_->models; }
+void FramePipeline::use_model_sizes(const std::array<hand::HandModel, 2>& models) {
+  Impl& s = *impl_;
+  for (int h = 0; h < 2; ++h) {
+    const hand::HandDimensions& want = models[h].shape.dimensions;
+    const hand::HandDimensions& have = s.models[h].shape.dimensions;
+    if (want.length == have.length && want.width == have.width) continue;
+    auto m = registration::resized(s.start[h], want.length, want.width);
+    if (m) s.models[h] = fit_model(std::move(m).value(), s.params);
+  }
+}
 
 Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample& tips,
                               const SceneSnapshot& world, FrameResult* out,

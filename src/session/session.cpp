@@ -39,6 +39,7 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
   if (params.compare) {
     pipeline::FramePipelineParams alt = params.pipeline;
     alt.registration.silhouette_term = !alt.registration.silhouette_term;
+    alt.personalise_shape = false;  // it fits with the main fit's sizes (use_model_sizes)
     auto alt_r = pipeline::FramePipeline::create(context, camera, models, alt);
     if (!alt_r) throw SpidarError(alt_r.error().message);
     s->alt_ = std::move(alt_r).value();
@@ -175,6 +176,7 @@ Session::Step Session::step() {
       const bool here = render && !params_.defer_compare_picture;
       // The same image keyed with the same params: the main pipeline's matte.
       const bool same_key = alt_->params().chroma_key == pipe_->params().chroma_key;
+      if (pipe_->params().personalise_shape) alt_->use_model_sizes(pipe_->models());
       if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !here,
                                   same_key ? &result_.key : nullptr);
           !st)

@@ -13,8 +13,10 @@
 #include <opencv2/core.hpp>
 
 #include "spidar/hand/hand_config.hpp"
+#include "spidar/hand/joint_limits.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/registration/shape_estimator.hpp"
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
@@ -275,6 +277,21 @@ TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
   EXPECT_GT(keyframes[0][0], 2);
   EXPECT_EQ(keyframes[0][1], 0);
   EXPECT_GT(keyframes[1][1], 2);  // the test can fail: the broken fits would be offered
+}
+
+// The comparison fit takes the main fit's sizes (use_model_sizes) and keeps its own joint box.
+TEST_F(FramePipelineTest, UseModelSizesTakesAnotherFitsSizesAndKeepsItsJointBox) {
+  auto pipe = FramePipeline::create(*context_, camera_, models_, {}).value();
+  std::array<hand::HandModel, 2> other = models_;
+  other[1] = registration::resized(models_[1], 0.2, 0.09).value();
+  other[1].limits = hand::ParamLimits{};  // another pipeline's box is not taken
+  pipe->use_model_sizes(other);
+  EXPECT_EQ(pipe->models()[1].shape.dimensions.length, 0.2);
+  EXPECT_EQ(pipe->models()[1].shape.dimensions.width, 0.09);
+  EXPECT_EQ(pipe->models()[1].side, hand::Side::kRight);
+  EXPECT_EQ(pipe->models()[1].limits.lower, hand::passive_limits(models_[1].limits).lower);
+  EXPECT_EQ(pipe->models()[1].limits.upper, hand::passive_limits(models_[1].limits).upper);
+  EXPECT_EQ(pipe->models()[0].shape.dimensions.length, models_[0].shape.dimensions.length);
 }
 
 TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {

@@ -149,7 +149,12 @@ class FramePipeline {
   /// True once a frame was processed since creation or reset() (the next fit starts from it).
   bool has_previous() const;
   const FramePipelineParams& params() const;
+  /// The models the next frame's fits use (the given sizes, or the estimate reached so far).
   const std::array<hand::HandModel, 2>& models() const;
+  /// Fits the next frames with these models' sizes (their joint box widened as `passive_range`
+  /// says), for a pipeline that learns no sizes itself (personalise_shape off): the comparison fit
+  /// takes the main fit's estimate, so the two methods differ in nothing else.
+  void use_model_sizes(const std::array<hand::HandModel, 2>& models);
 
  private:
   struct Impl;
