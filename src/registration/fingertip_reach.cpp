@@ -13,9 +13,9 @@ namespace {
 constexpr double kMinGain = 1e-5;
 /// A cap this near its fingertip has reached it: no further steps or starts [m].
 constexpr double kReached = 1e-6;
-/// The distal range searched when the model has no finite limit there [rad].
-constexpr double kDefaultDistalLow = -0.2;
-constexpr double kDefaultDistalHigh = 1.8;
+/// The range searched for a parameter the model leaves unlimited [rad].
+constexpr double kDefaultLow = -0.2;
+constexpr double kDefaultHigh = 1.8;
 
 /// One digit's own parameter columns (2 or 3).
 struct DigitColumns {
@@ -111,13 +111,13 @@ FingertipReach reach_fingertips(const hand::HandModel& model, const HandObservat
     const DigitColumns dc = digit_columns(f);
     const int distal = dc.col[static_cast<std::size_t>(dc.n - 1)];
     double lo = model.limits.lower[distal], hi = model.limits.upper[distal];
-    if (!std::isfinite(lo)) lo = kDefaultDistalLow;
-    if (!std::isfinite(hi)) hi = kDefaultDistalHigh;
+    if (!std::isfinite(lo)) lo = kDefaultLow;
+    if (!std::isfinite(hi)) hi = kDefaultHigh;
 
     const int flexion = dc.col[0];
     double flo = model.limits.lower[flexion], fhi = model.limits.upper[flexion];
-    if (!std::isfinite(flo)) flo = kDefaultDistalLow;
-    if (!std::isfinite(fhi)) fhi = kDefaultDistalHigh;
+    if (!std::isfinite(flo)) flo = kDefaultLow;
+    if (!std::isfinite(fhi)) fhi = kDefaultHigh;
 
     hand::HandParams best = *q;
     double best_miss = out.miss_before_m[fs];
