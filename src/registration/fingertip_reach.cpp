@@ -159,9 +159,8 @@ bool refit_reaching(const SuccessiveAdjustment& solver, const hand::HandModel& m
   hand::HandParams prior2 = prior != nullptr ? *prior : q2;
   for (int f = 0; f < hand::kFingertipCount; ++f) {
     if (!moved.changed[static_cast<std::size_t>(f)]) continue;
-    const hand::DigitParams cols = hand::digit_params(f);
-    for (int k : {cols.flexion, cols.abduction, cols.distal})
-      if (k >= 0) prior2[k] = q2[k];
+    const DigitColumns dc = digit_columns(f);
+    for (int i = 0; i < dc.n; ++i) prior2[dc.col[static_cast<std::size_t>(i)]] = q2[dc.col[static_cast<std::size_t>(i)]];
   }
   FitReport again = solver.fit(model, observation, image, prior != nullptr ? &prior2 : nullptr, &q2);
   const int iterations = report->iterations + again.iterations;

@@ -24,7 +24,8 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
   struct Field {
     const char* key;
     double ShapeEstimatorParams::*v;
-    double lo, hi;  // (lo, hi]
+    double lo, hi;            // (lo, hi], or [lo, hi] with zero_ok
+    bool zero_ok = false;     // lo itself allowed (0 = never)
   };
   static constexpr Field kFields[] = {
       {"prior_sigma_length_m", &ShapeEstimatorParams::prior_sigma_length_m, 0.0, 0.1},
@@ -33,13 +34,8 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       {"freeze_sigma_length_m", &ShapeEstimatorParams::freeze_sigma_length_m, 0.0, 0.1},
       {"freeze_sigma_width_m", &ShapeEstimatorParams::freeze_sigma_width_m, 0.0, 0.1},
       {"max_relative_change", &ShapeEstimatorParams::max_relative_change, 0.0, 0.5},
+      {"reach_min_miss_m", &ShapeEstimatorParams::reach_min_miss_m, 0.0, 0.05, true},
   };
-  if (auto child = node.find("reach_min_miss_m")) {  // 0 allowed: never
-    const double v = child->as_double();
-    if (!(std::isfinite(v) && v >= 0.0 && v <= 0.05))
-      child->fail("expected a distance in [0, 0.05] m, got " + std::to_string(v));
-    p.reach_min_miss_m = v;
-  }
   struct IntField {
     const char* key;
     int ShapeEstimatorParams::*v;
@@ -65,9 +61,9 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
     const auto child = node.find(f.key);
     if (!child) continue;
     const double v = child->as_double();
-    if (!(std::isfinite(v) && v > f.lo && v <= f.hi))
-      child->fail("expected a value in (" + std::to_string(f.lo) + ", " + std::to_string(f.hi) +
-                  "], got " + std::to_string(v));
+    if (!(std::isfinite(v) && (v > f.lo || (f.zero_ok && v == f.lo)) && v <= f.hi))
+      child->fail("expected a value in " + std::string(f.zero_ok ? "[" : "(") + std::to_string(f.lo) +
+                  ", " + std::to_string(f.hi) + "], got " + std::to_string(v));
     p.*f.v = v;
   }
   return p;
@@ -92,10 +88,7 @@ ShapeEstimator::ShapeEstimator(const hand::HandModel& start, const ShapeEstimato
   estimate_.sigma_width_m = p_.prior_sigma_width_m;
 }
 
-namespace {
-
-/// One re-estimate (the file comment's Gauss-Newton on β over the keyframes), on copies.
-ShapeEstimator::Solve solve_shape(ShapeEstimator::Solve job) {
+ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   const ShapeEstimatorParams& p = job.params;
   const RegistrationParams& fit_params = job.fit_params;
   const vision::Camera* camera = job.camera ? &*job.camera : nullptr;
@@ -117,7 +110,7 @@ ShapeEstimator::Solve solve_shape(ShapeEstimator::Solve job) {
   for (int it = 0; it < p.iterations; ++it) {
     Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
     Eigen::Vector2d g = Eigen::Vector2d::Zero();
-    for (ShapeEstimator::Keyframe& kf : job.keyframes) {
+    for (Keyframe& kf : job.keyframes) {
       // The keyframe's pose at the current sizes (warm start, weak prior toward its last pose).
       ImageEvidence evidence = skeleton_only;
       if (!kf.owned.empty()) evidence.coverage = &kf.owned;
@@ -194,8 +187,6 @@ ShapeEstimator::Solve solve_shape(ShapeEstimator::Solve job) {
   return job;
 }
 
-}  // namespace
-
 ShapeEstimator::~ShapeEstimator() {
   if (pending_.valid()) pending_.wait();
 }
@@ -219,18 +210,16 @@ bool ShapeEstimator::add_frame(const hand::HandParams& q, const HandObservation&
     keyframes_[next_slot_] = kf;
     next_slot_ = (next_slot_ + 1) % cap;
   }
-  ++keyframes_added_;
   estimate_.keyframes = static_cast<int>(keyframes_.size());
   if (++new_since_solve_ < p_.solve_every || estimate_.keyframes < p_.min_keyframes) return false;
   if (pending_.valid()) return false;  // one re-estimate at a time: the next frame's offer starts it
   new_since_solve_ = 0;
   Solve job = make_solve(image.camera, fit_params);
-  if (p_.apply_after_frames <= 0) return apply(solve_shape(std::move(job)));
-  keyframes_added_at_start_ = keyframes_added_;
+  if (p_.apply_after_frames <= 0) return apply(run_solve(std::move(job)));
   polls_since_start_ = 0;
   pending_ = std::async(std::launch::async, [job = std::move(job)]() mutable {
     (void)core::set_nice(0);  // best effort: an ordinary share, below the frame thread's
-    return solve_shape(std::move(job));
+    return run_solve(std::move(job));
   });
   return false;
 }
@@ -260,8 +249,9 @@ bool ShapeEstimator::apply(Solve&& done) {
   const int keyframes = estimate_.keyframes;
   estimate_ = done.estimate;
   estimate_.keyframes = keyframes;
-  // The keyframes' refitted poses warm-start the next re-estimate, unless keyframes came since.
-  if (p_.apply_after_frames <= 0 || keyframes_added_ == keyframes_added_at_start_) keyframes_ = std::move(done.keyframes);
+  // The keyframes' refitted poses warm-start the next re-estimate, unless keyframes came since it
+  // started (new_since_solve_ counts them from its start).
+  if (new_since_solve_ == 0) keyframes_ = std::move(done.keyframes);
   return done.changed;
 }
 

@@ -101,6 +101,7 @@ class ShapeEstimator {
   ShapeEstimator& operator=(ShapeEstimator&&) = default;
   ~ShapeEstimator();
 
+ private:
   struct Keyframe {
     hand::HandParams q;
     HandObservation observation;
@@ -118,8 +119,8 @@ class ShapeEstimator {
     ShapeEstimate estimate;
     bool changed = false;
   };
-
- private:
+  /// One re-estimate (the file comment's Gauss-Newton on β over the keyframes), on copies.
+  static Solve run_solve(Solve job);
   Solve make_solve(const vision::Camera* camera, const RegistrationParams& fit_params) const;
   bool apply(Solve&& done);
 
@@ -132,8 +133,6 @@ class ShapeEstimator {
   ShapeEstimate estimate_;
   std::future<Solve> pending_;
   int polls_since_start_ = 0;
-  int keyframes_added_ = 0;            ///< ever added (a re-estimate's refits return only if none since)
-  int keyframes_added_at_start_ = 0;
 };
 
 /// Reads a `personalisation:` map (every key optional): enabled (bool, into `*enabled`),
