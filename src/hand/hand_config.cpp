@@ -39,7 +39,8 @@ JointRanges parse_ranges(const core::ConfigNode& node) {
 }
 
 HandProfile parse_profile(const core::ConfigNode& node) {
-  node.expect_keys({"name", "length", "width", "fingertip_offset", "coupling", "joint_ranges_deg"});
+  node.expect_keys({"name", "length", "width", "thickness", "fingertip_offset", "coupling",
+                    "joint_ranges_deg"});
   HandProfile p;
   p.name = node["name"].as_string();
   if (p.name.empty()) node["name"].fail("expected a non-empty name");
@@ -52,6 +53,8 @@ HandProfile parse_profile(const core::ConfigNode& node) {
   if (ratio < 0.3 || ratio > 0.65) {
     width.fail("expected width/length in [0.3, 0.65], got " + std::to_string(ratio));
   }
+  if (auto thickness = node.find("thickness"))
+    p.dimensions.thickness = core::require_in_range(*thickness, thickness->as_double(), 0.6, 1.6, "");
   if (auto offset = node.find("fingertip_offset")) {
     p.dimensions.fingertip_offset = offset->as_vec3();
     if (p.dimensions.fingertip_offset.norm() > 0.02) {

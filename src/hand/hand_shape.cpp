@@ -58,6 +58,10 @@ Status validate_dimensions(const HandDimensions& d) {
   if (!(ratio >= 0.3 && ratio <= 0.65)) {
     return fail("width: expected width/length in 0.3..0.65, got " + std::to_string(ratio));
   }
+  if (!(d.thickness >= 0.6 && d.thickness <= 1.6)) {
+    return fail("thickness: expected 0.6..1.6 (× the proportions' digit radii), got " +
+                std::to_string(d.thickness));
+  }
   if (!d.fingertip_offset.allFinite() || d.fingertip_offset.norm() > 0.02) {
     return fail("fingertip_offset: expected a finite offset of at most 0.02 m");
   }
@@ -94,14 +98,15 @@ Result<HandShape> make_hand_shape(const HandDimensions& dims) {
     d.R_H_digit.col(0) = y_dir.cross(Vec3::UnitZ());
     for (int k = 0; k < 4; ++k) {
       d.length[k] = unit * fp.length[k];
-      d.radius[k] = W * fp.radius[k];
+      d.radius[k] = dims.thickness * W * fp.radius[k];
     }
     d.phalanges = 3;
     d.abduction_sign = fp.abduction_sign;
     d.p_H_mcp = d.p_H_base + meta * y_dir;
     min_mcp_y = std::min(min_mcp_y, d.p_H_mcp.y());
-    x_lo = std::min(x_lo, d.p_H_mcp.x() - d.radius[0]);
-    x_hi = std::max(x_hi, d.p_H_mcp.x() + d.radius[0]);
+    // The palm's breadth is the width's alone, whatever the digits' thickness.
+    x_lo = std::min(x_lo, d.p_H_mcp.x() - W * fp.radius[0]);
+    x_hi = std::max(x_hi, d.p_H_mcp.x() + W * fp.radius[0]);
   }
 
   DigitShape& t = shape.digits[kThumb];
@@ -111,7 +116,7 @@ Result<HandShape> make_hand_shape(const HandDimensions& dims) {
                     .toRotationMatrix();
   for (int k = 0; k < 3; ++k) {
     t.length[k] = unit * kThumbLength[k];
-    t.radius[k] = W * kThumbRadius[k];
+    t.radius[k] = dims.thickness * W * kThumbRadius[k];
   }
   t.length[3] = 0.0;
   t.radius[3] = 0.0;

@@ -171,8 +171,9 @@ void FramePipeline::use_model_sizes(const std::array<hand::HandModel, 2>& models
   for (int h = 0; h < 2; ++h) {
     const hand::HandDimensions& want = models[h].shape.dimensions;
     const hand::HandDimensions& have = s.models[h].shape.dimensions;
-    if (want.length == have.length && want.width == have.width) continue;
-    auto m = registration::resized(s.start[h], want.length, want.width);
+    if (want.length == have.length && want.width == have.width && want.thickness == have.thickness)
+      continue;
+    auto m = registration::resized(s.start[h], want.length, want.width, want.thickness);
     if (m) s.models[h] = fit_model(std::move(m).value(), s.params);
   }
 }

@@ -85,6 +85,14 @@ inline Vec3 bracelet_point(const PoseState& s, const RegistrationParams& p, Poin
   return rigid_point(s, Vec3(0.0, -p.bracelet_offset_m, 0.0), J);
 }
 
+/// A silhouette point's offset from its projected axis point [px], scaled with the bone's radius
+/// in `model` over the radius it was frozen with (SilhouettePoint::radius_m).
+inline Vec2 scaled_offset(const hand::HandModel& model, const SilhouettePoint& sp) {
+  if (sp.bone < 0 || !(sp.radius_m > 0)) return sp.offset_px;
+  const BoneRef b = silhouette_bone(sp.bone);
+  return sp.offset_px * (model.shape.digits[b.finger].radius[b.segment] / sp.radius_m);
+}
+
 /// A ball enters the cost only where eq. 21 moves its joint (P̃ ≠ P). One wholly inside the
 /// silhouette (or with a symmetric pattern of neighbours, or none on it) would add only
 /// J_PᵀJ_P to A with nothing in b: a spring holding the joint where the current iterate put it,
@@ -169,15 +177,16 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
     for (int k = 0; k < tg.silhouette_count; ++k) {
       const SilhouettePoint& sp = tg.silhouette[k];
       const Vec3 p = bone_point(*pr.model, s, silhouette_bone(sp.bone), sp.t, J3p);
-      add_projected(Term::kSilhouette, p, sp.offset_px, sp.target_px, w_sil);
+      add_projected(Term::kSilhouette, p, scaled_offset(*pr.model, sp), sp.target_px, w_sil);
     }
     // Owned silhouette pixels left uncovered, pulling the nearest part's edge.
     const double w_cov = 1.0 / rp.coverage_sigma_px;
     for (int k = 0; k < tg.coverage_count; ++k) {
       const SilhouettePoint& sp = tg.coverage[k];
+      const hand::PalmBox& box = pr.model->shape.palm;
       const Vec3 p = sp.bone >= 0 ? bone_point(*pr.model, s, silhouette_bone(sp.bone), sp.t, J3p)
-                                  : rigid_point(s, sp.palm_H, J3p);
-      add_projected(Term::kSilhouette, p, sp.offset_px, sp.target_px, w_cov * sp.weight);
+                                  : rigid_point(s, box.p_H_centre + sp.palm_u.cwiseProduct(box.half_extents), J3p);
+      add_projected(Term::kSilhouette, p, scaled_offset(*pr.model, sp), sp.target_px, w_cov * sp.weight);
     }
   }
 

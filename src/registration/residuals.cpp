@@ -52,7 +52,9 @@ void freeze_silhouette(const ResidualProblem& pr, const detail::PoseState& s,
         const auto nearest = dist.nearest(q);
         if (!nearest || (q - *nearest).norm() <= detail::kSilhouetteTolerancePx) continue;
         if (tg->silhouette_count >= kMaxSilhouettePoints) return;
-        tg->silhouette[tg->silhouette_count++] = SilhouettePoint{bone, t, offset, *nearest};
+        SilhouettePoint sp{bone, t, offset, *nearest};
+        sp.radius_m = radius_m;
+        tg->silhouette[tg->silhouette_count++] = sp;
       }
     }
   }
@@ -84,8 +86,11 @@ void freeze_coverage(const ResidualProblem& pr, const hand::HandParams& q,
       const ImageCapsule& c = outline.bones[near.bone];
       sp.t = near.t;
       sp.offset_px = near.edge_px - (c.a + near.t * (c.c - c.a));
+      const BoneRef b = silhouette_bone(near.bone);
+      sp.radius_m = pr.model->shape.digits[b.finger].radius[b.segment];
     } else {
-      sp.palm_H = near.palm_H;
+      const hand::PalmBox& box = pr.model->shape.palm;
+      sp.palm_u = (near.palm_H - box.p_H_centre).cwiseQuotient(box.half_extents);
     }
     tg->coverage[tg->coverage_count++] = sp;
   }

@@ -1,6 +1,7 @@
 #include "spidar/registration/shape_estimator.hpp"
 
 #include <Eigen/Cholesky>
+#include <opencv2/core.hpp>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -9,18 +10,30 @@
 #include "spidar/core/result.hpp"
 #include "spidar/registration/fingertip_reach.hpp"
 #include "spidar/registration/residuals.hpp"
+#include "spidar/vision/silhouette.hpp"
 
 namespace spidar::registration {
+namespace {
+/// The keyframes' distance transforms cover their silhouette's bounding box grown by this [px]
+/// (as the frame pipeline's, FramePipelineParams::silhouette_margin_px).
+constexpr int kSilhouetteMarginPx = 40;
+}  // namespace
 
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled) {
   if (!node.is_map()) node.fail("expected a map of personalisation settings");
-  node.expect_keys({"enabled", "prior_sigma_length_m", "prior_sigma_width_m", "keyframes",
-                    "min_pose_change", "solve_every", "min_keyframes", "iterations",
-                    "freeze_sigma_length_m", "freeze_sigma_width_m", "max_relative_change",
-                    "reach_min_miss_m", "apply_after_frames", "silhouette"});
+  node.expect_keys({"enabled", "prior_sigma_length_m", "prior_sigma_width_m", "prior_sigma_thickness",
+                    "keyframes", "min_pose_change", "solve_every", "min_keyframes", "iterations",
+                    "freeze_sigma_length_m", "freeze_sigma_width_m", "freeze_sigma_thickness",
+                    "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
-  if (auto b = node.find("silhouette")) p.silhouette = b->as_bool();
+  if (auto b = node.find("silhouette")) {
+    const std::string v = b->as_string();
+    if (v == "none" || v == "false") p.silhouette = ShapeSilhouette::kNone;
+    else if (v == "spill") p.silhouette = ShapeSilhouette::kSpill;
+    else if (v == "both" || v == "true") p.silhouette = ShapeSilhouette::kBoth;
+    else b->fail("expected none, spill or both, got '" + v + "'");
+  }
   struct Field {
     const char* key;
     double ShapeEstimatorParams::*v;
@@ -30,9 +43,11 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
   static constexpr Field kFields[] = {
       {"prior_sigma_length_m", &ShapeEstimatorParams::prior_sigma_length_m, 0.0, 0.1},
       {"prior_sigma_width_m", &ShapeEstimatorParams::prior_sigma_width_m, 0.0, 0.1},
+      {"prior_sigma_thickness", &ShapeEstimatorParams::prior_sigma_thickness, 0.0, 1.0},
       {"min_pose_change", &ShapeEstimatorParams::min_pose_change, 0.0, 10.0},
       {"freeze_sigma_length_m", &ShapeEstimatorParams::freeze_sigma_length_m, 0.0, 0.1},
       {"freeze_sigma_width_m", &ShapeEstimatorParams::freeze_sigma_width_m, 0.0, 0.1},
+      {"freeze_sigma_thickness", &ShapeEstimatorParams::freeze_sigma_thickness, 0.0, 1.0},
       {"max_relative_change", &ShapeEstimatorParams::max_relative_change, 0.0, 0.5},
       {"reach_min_miss_m", &ShapeEstimatorParams::reach_min_miss_m, 0.0, 0.05, true},
   };
@@ -70,9 +85,15 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
 }
 
 Result<hand::HandModel> resized(const hand::HandModel& m, double length_m, double width_m) {
+  return resized(m, length_m, width_m, m.shape.dimensions.thickness);
+}
+
+Result<hand::HandModel> resized(const hand::HandModel& m, double length_m, double width_m,
+                                double thickness) {
   hand::HandDimensions d = m.shape.dimensions;
   d.length = length_m;
   d.width = width_m;
+  d.thickness = thickness;
   auto shape = hand::make_hand_shape(d);
   if (!shape) return shape.error();
   hand::HandModel out = m;
@@ -84,36 +105,58 @@ ShapeEstimator::ShapeEstimator(const hand::HandModel& start, const ShapeEstimato
     : p_(params), model_(start) {
   estimate_.length_m = start_length_m_ = start.shape.dimensions.length;
   estimate_.width_m = start_width_m_ = start.shape.dimensions.width;
+  estimate_.thickness = start_thickness_ = start.shape.dimensions.thickness;
   estimate_.sigma_length_m = p_.prior_sigma_length_m;
   estimate_.sigma_width_m = p_.prior_sigma_width_m;
+  estimate_.sigma_thickness = p_.prior_sigma_thickness;
 }
 
 ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   const ShapeEstimatorParams& p = job.params;
-  const RegistrationParams& fit_params = job.fit_params;
   const vision::Camera* camera = job.camera ? &*job.camera : nullptr;
   hand::HandModel& model = job.model;
   ShapeEstimate& estimate = job.estimate;
-  const double start_length_m = job.start_length_m, start_width_m = job.start_width_m;
-  ImageEvidence skeleton_only;  // fingertips, bracelet wrist and a prior: no matte, no silhouette
+  ImageEvidence skeleton_only;  // fingertips, bracelet wrist and a prior: no matte (no joint-balls)
   skeleton_only.camera = camera;
+  // The keyframes' silhouettes (their distance transforms made once per solve).
+  std::vector<vision::SilhouetteDistance> distance(job.keyframes.size());
+  bool any_silhouette = false;
+  for (std::size_t i = 0; i < job.keyframes.size(); ++i) {
+    const cv::Mat& sil = job.keyframes[i].silhouette;
+    if (sil.empty()) continue;
+    if (!vision::silhouette_distance(sil, &distance[i], {.max_distance_px = kSilhouetteMarginPx, .downsample = 2}).ok())
+      distance[i].empty = true;
+    any_silhouette = true;
+  }
+  if (any_silhouette) {
+    job.fit_params.silhouette_term = true;
+    job.fit_params.silhouette_inward = true;
+  }
+  const RegistrationParams& fit_params = job.fit_params;
   const SuccessiveAdjustment solver(fit_params);
-  const Eigen::Vector2d beta0(start_length_m, start_width_m);
-  const Eigen::Matrix2d H0 = Eigen::Vector2d(1.0 / (p.prior_sigma_length_m * p.prior_sigma_length_m),
-                                             1.0 / (p.prior_sigma_width_m * p.prior_sigma_width_m))
-                                 .asDiagonal();
-  const double h = p.difference_step_m;
+  // β = (length [m], width [m], thickness); the thickness only where silhouettes are kept.
+  const int nb = any_silhouette ? 3 : 2;
+  const Eigen::Vector3d beta0(job.start_length_m, job.start_width_m, job.start_thickness);
+  const Eigen::Vector3d sigma0(p.prior_sigma_length_m, p.prior_sigma_width_m, p.prior_sigma_thickness);
+  const Eigen::Matrix3d H0 = sigma0.cwiseProduct(sigma0).cwiseInverse().asDiagonal();
+  const Eigen::Vector3d step_h(p.difference_step_m, p.difference_step_m,
+                               p.difference_step_m / std::max(job.start_width_m, 1e-3));
   const double k = p.max_relative_change;
-  Eigen::Vector2d beta(estimate.length_m, estimate.width_m);
-  Eigen::Matrix2d H = H0;
+  const Eigen::Vector3d lo((1 - k) * beta0.x(), (1 - k) * beta0.y(), std::max(0.6, beta0.z() - 2 * k));
+  const Eigen::Vector3d hi((1 + k) * beta0.x(), (1 + k) * beta0.y(), std::min(1.6, beta0.z() + 2 * k));
+  auto model_at = [&](const Eigen::Vector3d& b) { return resized(model, b.x(), b.y(), b.z()); };
+  Eigen::Vector3d beta(estimate.length_m, estimate.width_m, estimate.thickness);
+  Eigen::Matrix3d H = H0;
   bool changed = false;
   for (int it = 0; it < p.iterations; ++it) {
-    Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d g = Eigen::Vector2d::Zero();
-    for (Keyframe& kf : job.keyframes) {
+    Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < job.keyframes.size(); ++i) {
+      Keyframe& kf = job.keyframes[i];
       // The keyframe's pose at the current sizes (warm start, weak prior toward its last pose).
       ImageEvidence evidence = skeleton_only;
       if (!kf.owned.empty()) evidence.coverage = &kf.owned;
+      if (!distance[i].empty) evidence.distance = &distance[i];
       hand::HandParams prior = kf.q;
       FitReport fit = solver.fit(model, kf.observation, evidence, &prior, &kf.q);
       if (p.reach_min_miss_m > 0 &&
@@ -126,12 +169,14 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       VecX r;
       MatX J;
       stacked_residuals(problem, targets, kf.q, &r, &J);
-      MatX Jb(r.size(), 2);
+      MatX Jb = MatX::Zero(r.size(), 3);
       bool ok = true;
-      for (int c = 0; c < 2 && ok; ++c) {
+      for (int c = 0; c < nb && ok; ++c) {
         VecX rp, rm;
         for (int sgn : {1, -1}) {
-          auto m = resized(model, beta.x() + (c == 0 ? sgn * h : 0.0), beta.y() + (c == 1 ? sgn * h : 0.0));
+          Eigen::Vector3d b = beta;
+          b[c] += sgn * step_h[c];
+          auto m = model_at(b);
           if (!m) {
             ok = false;
             break;
@@ -141,7 +186,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
           stacked_residuals(pk, targets, kf.q, sgn > 0 ? &rp : &rm, nullptr);
         }
         ok = ok && rp.size() == r.size() && rm.size() == r.size();
-        if (ok) Jb.col(c) = (rp - rm) / (2.0 * h);
+        if (ok) Jb.col(c) = (rp - rm) / (2.0 * step_h[c]);
       }
       if (!ok || !J.allFinite() || !Jb.allFinite() || !r.allFinite()) continue;
       // Marginalise the pose (Schur complement).
@@ -154,35 +199,47 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       g -= Jb.transpose() * r - JbtJ * A_ldlt.solve(J.transpose() * r);
     }
     H = S + H0;
-    const Eigen::Vector2d rhs = g + H0 * (beta0 - beta);
-    Eigen::Vector2d step = Eigen::Vector2d::Zero();
-    const bool fl = estimate.length_frozen, fw = estimate.width_frozen;
-    if (!fl && !fw) {
-      step = H.ldlt().solve(rhs);
-    } else if (!fl) {
-      step.x() = rhs.x() / H(0, 0);
-    } else if (!fw) {
-      step.y() = rhs.y() / H(1, 1);
+    const Eigen::Vector3d rhs = g + H0 * (beta0 - beta);
+    // Solve over the sizes still free (frozen ones and, without silhouettes, the thickness stay).
+    const std::array<bool, 3> free{!estimate.length_frozen, !estimate.width_frozen,
+                                   nb == 3 && !estimate.thickness_frozen};
+    std::vector<int> idx;
+    for (int c = 0; c < 3; ++c)
+      if (free[static_cast<std::size_t>(c)]) idx.push_back(c);
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    if (!idx.empty()) {
+      const auto n = static_cast<Eigen::Index>(idx.size());
+      Eigen::MatrixXd Hf(n, n);
+      Eigen::VectorXd bf(n);
+      for (Eigen::Index a = 0; a < n; ++a) {
+        bf[a] = rhs[idx[static_cast<std::size_t>(a)]];
+        for (Eigen::Index b = 0; b < n; ++b)
+          Hf(a, b) = H(idx[static_cast<std::size_t>(a)], idx[static_cast<std::size_t>(b)]);
+      }
+      const Eigen::VectorXd sf = Hf.ldlt().solve(bf);
+      for (Eigen::Index a = 0; a < n; ++a) step[idx[static_cast<std::size_t>(a)]] = sf[a];
     }
     if (!step.allFinite()) break;
-    const double L = std::clamp(beta.x() + step.x(), (1 - k) * start_length_m, (1 + k) * start_length_m);
-    const double W = std::clamp(beta.y() + step.y(), (1 - k) * start_width_m, (1 + k) * start_width_m);
-    auto m = resized(model, L, W);
+    const Eigen::Vector3d next = (beta + step).cwiseMax(lo).cwiseMin(hi);
+    auto m = model_at(next);
     if (!m) break;  // outside the valid sizes: keep the last valid model
-    const bool moved = std::abs(L - beta.x()) > 1e-7 || std::abs(W - beta.y()) > 1e-7;
+    const bool moved = (next - beta).cwiseAbs().maxCoeff() > 1e-7;
     model = std::move(m).value();
-    beta = Eigen::Vector2d(L, W);
+    beta = next;
     changed = changed || moved;
     if (step.norm() < 1e-6) break;
   }
   ++estimate.solves;
   estimate.length_m = beta.x();
   estimate.width_m = beta.y();
-  const Eigen::Matrix2d cov = H.inverse();
+  estimate.thickness = beta.z();
+  const Eigen::Matrix3d cov = H.inverse();
   estimate.sigma_length_m = std::sqrt(std::max(cov(0, 0), 0.0));
   estimate.sigma_width_m = std::sqrt(std::max(cov(1, 1), 0.0));
+  estimate.sigma_thickness = std::sqrt(std::max(cov(2, 2), 0.0));
   if (estimate.sigma_length_m < p.freeze_sigma_length_m) estimate.length_frozen = true;
   if (estimate.sigma_width_m < p.freeze_sigma_width_m) estimate.width_frozen = true;
+  if (nb == 3 && estimate.sigma_thickness < p.freeze_sigma_thickness) estimate.thickness_frozen = true;
   job.changed = changed;
   return job;
 }
@@ -193,7 +250,9 @@ ShapeEstimator::~ShapeEstimator() {
 
 bool ShapeEstimator::add_frame(const hand::HandParams& q, const HandObservation& observation,
                                const ImageEvidence& image, const RegistrationParams& fit_params) {
-  if (estimate_.length_frozen && estimate_.width_frozen) return false;
+  if (estimate_.length_frozen && estimate_.width_frozen &&
+      (estimate_.thickness_frozen || p_.silhouette == ShapeSilhouette::kNone))
+    return false;
   if (!q.q.allFinite()) return false;
   int tips = 0;
   for (int f = 0; f < hand::kFingertipCount; ++f)
@@ -201,8 +260,10 @@ bool ShapeEstimator::add_frame(const hand::HandParams& q, const HandObservation&
   if (tips < hand::kFingertipCount) return false;  // only fully measured hands make keyframes
   for (const Keyframe& k : keyframes_)
     if ((k.q.q - q.q).norm() < p_.min_pose_change) return false;  // nothing new
-  Keyframe kf{q, observation, {}};
-  if (p_.silhouette && image.coverage != nullptr) kf.owned = *image.coverage;
+  Keyframe kf{q, observation, {}, {}};
+  if (p_.silhouette != ShapeSilhouette::kNone && !image.alpha.empty() && image.alpha.type() == CV_32FC1)
+    cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);
+  if (p_.silhouette == ShapeSilhouette::kBoth && image.coverage != nullptr) kf.owned = *image.coverage;
   const auto cap = static_cast<std::size_t>(std::max(p_.keyframes, 1));
   if (keyframes_.size() < cap) {
     keyframes_.push_back(kf);
@@ -239,6 +300,7 @@ ShapeEstimator::Solve ShapeEstimator::make_solve(const vision::Camera* camera,
   job.model = model_;
   job.start_length_m = start_length_m_;
   job.start_width_m = start_width_m_;
+  job.start_thickness = start_thickness_;
   job.keyframes = keyframes_;
   job.estimate = estimate_;
   return job;

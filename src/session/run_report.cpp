@@ -254,8 +254,11 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                                           {"width_m", e.width_m},
                                           {"sigma_length_m", e.sigma_length_m},
                                           {"sigma_width_m", e.sigma_width_m},
+                                          {"thickness", e.thickness},
+                                          {"sigma_thickness", e.sigma_thickness},
                                           {"length_frozen", e.length_frozen},
                                           {"width_frozen", e.width_frozen},
+                                          {"thickness_frozen", e.thickness_frozen},
                                           {"keyframes", e.keyframes},
                                           {"solves", e.solves}};
     }

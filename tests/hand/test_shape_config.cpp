@@ -81,6 +81,24 @@ TEST(HandShape, ValidationNamesTheField) {
   expect_error({0.19, 0.085, Vec3(0, std::numeric_limits<double>::quiet_NaN(), 0)},
                "fingertip_offset");
   EXPECT_FALSE(make_hand_model(Side::kLeft, {0.3, 0.1, Vec3::Zero()}).ok());
+  expect_error({0.19, 0.085, Vec3(0, -0.008, 0), 2.0}, "thickness");
+  expect_error({0.19, 0.085, Vec3(0, -0.008, 0), std::numeric_limits<double>::quiet_NaN()}, "thickness");
+}
+
+// The digits' thickness scales their capsule radii and nothing else: not the segment lengths, the
+// joints' places or the palm box.
+TEST(HandShape, ThicknessScalesTheDigitsRadiiOnly) {
+  const HandShape base = make_hand_shape({}).value();
+  const HandShape thick = make_hand_shape({0.19, 0.085, Vec3(0, -0.008, 0), 1.25}).value();
+  for (int f = 0; f < kFingerCount; ++f) {
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_DOUBLE_EQ(thick.digits[f].radius[k], 1.25 * base.digits[f].radius[k]) << f << " " << k;
+      EXPECT_DOUBLE_EQ(thick.digits[f].length[k], base.digits[f].length[k]);
+    }
+    EXPECT_TRUE(thick.digits[f].p_H_mcp.isApprox(base.digits[f].p_H_mcp));
+  }
+  EXPECT_TRUE(thick.palm.p_H_centre.isApprox(base.palm.p_H_centre));
+  EXPECT_TRUE(thick.palm.half_extents.isApprox(base.palm.half_extents));
 }
 
 TEST(HandConfig, LoadsTheShippedFile) {
@@ -160,6 +178,10 @@ TEST(HandConfig, ErrorsNameFileLineAndKey) {
   msg = error_of(good + "    fingertip_offset: [0, -8, 0]\n");
   EXPECT_NE(msg.find("hands.yaml:5: hands[0].fingertip_offset: expected an offset of at most"),
             std::string::npos)
+      << msg;
+
+  msg = error_of(good + "    thickness: 12\n");
+  EXPECT_NE(msg.find("hands.yaml:5: hands[0].thickness: expected a value in [0.6, 1.6]"), std::string::npos)
       << msg;
 
   msg = error_of(good + "    fingertip_offset: [0, -0.008]\n");

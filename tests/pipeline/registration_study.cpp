@@ -58,6 +58,7 @@ struct Args {
   double dump_below = 0.5;
   bool bending_wrists = false;  ///< --bending-wrists: the user's forearms point at fixed elbows (sim::user_elbows)
   double shape_w = 0, shape_dq = 0;
+  bool shape_silhouette = false;  ///< --shape-silhouette: the size estimator also fits the keyframes' spill
 };
 
 double mean(const std::vector<double>& v) {
@@ -89,6 +90,7 @@ int main(int argc, char** argv) {
     else if (k == "--personalise") a.personalise = true;
     else if (k == "--shape-w") a.shape_w = std::atof(next().c_str());
     else if (k == "--shape-dq") a.shape_dq = std::atof(next().c_str());
+    else if (k == "--shape-silhouette") a.shape_silhouette = true;
     else if (k == "--t0") a.t0 = std::atof(next().c_str());
     else if (k == "--t1") a.t1 = std::atof(next().c_str());
     else if (k == "--fps") a.fps = std::atof(next().c_str());
@@ -236,6 +238,7 @@ int main(int argc, char** argv) {
   }
   if (a.shape_w > 0) p.shape_estimator.solve_every = static_cast<int>(a.shape_w);
   if (a.shape_dq > 0) p.shape_estimator.min_pose_change = a.shape_dq;
+  if (a.shape_silhouette) p.shape_estimator.silhouette = registration::ShapeSilhouette::kSpill;
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models);
   sim::SyntheticCameraParams film_params;

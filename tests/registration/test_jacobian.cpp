@@ -4,6 +4,7 @@
 
 #include "registration_test_util.hpp"
 #include "spidar/registration/residuals.hpp"
+#include "spidar/registration/shape_estimator.hpp"
 
 namespace spidar::registration {
 namespace {
@@ -96,6 +97,50 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
     }
   }
   EXPECT_GT(palm_points, 0);
+}
+
+// A size estimate (shape_estimator.hpp) differentiates the residuals with respect to the model's
+// sizes at frozen targets: a silhouette point's edge must move with its capsule's radius. With the
+// image terms alone (no fingertips, wrist, matte or prior) the rows are the silhouette points'
+// then the coverage points', two each; with digits T times as thick, each bone point's row moves
+// by (T − 1) × its frozen offset × its weight, and a palm point's not at all.
+TEST(ResidualJacobian, SilhouetteEdgesMoveWithTheDigitsThickness) {
+  for (int side = 0; side < 2; ++side) {
+    Case c;
+    make_case(side, 5, &c);
+    ImageEvidence image = c.mask.evidence(&c.camera, true);
+    image.alpha = cv::Mat();  // no joint-balls
+    image.coverage = &c.owned;
+    const HandObservation none;
+    const ResidualProblem pr{&c.model, &none, &image, nullptr, &c.params};
+    FrozenTargets tg;
+    freeze_targets(pr, c.q, &tg);
+    ASSERT_GT(tg.silhouette_count, 5);
+    ASSERT_GT(tg.coverage_count, 5);
+    VecX r;
+    stacked_residuals(pr, tg, c.q, &r, nullptr);
+    ASSERT_EQ(r.size(), 2 * (tg.silhouette_count + tg.coverage_count));
+    const double T = 1.3;
+    const hand::HandModel thick =
+        resized(c.model, c.model.shape.dimensions.length, c.model.shape.dimensions.width, T).value();
+    const ResidualProblem pt{&thick, &none, &image, nullptr, &c.params};
+    VecX rt;
+    stacked_residuals(pt, tg, c.q, &rt, nullptr);
+    ASSERT_EQ(rt.size(), r.size());
+    int palm = 0;
+    for (int k = 0; k < tg.silhouette_count + tg.coverage_count; ++k) {
+      const bool inward = k < tg.silhouette_count;
+      const SilhouettePoint& sp = inward ? tg.silhouette[k] : tg.coverage[k - tg.silhouette_count];
+      const double w = inward ? 1.0 / c.params.silhouette_sigma_px : sp.weight / c.params.coverage_sigma_px;
+      const Vec2 expect = sp.bone >= 0 ? Vec2((T - 1) * w * sp.offset_px) : Vec2::Zero();
+      palm += sp.bone < 0 ? 1 : 0;
+      const Vec2 moved = rt.segment<2>(2 * k) - r.segment<2>(2 * k);
+      EXPECT_NEAR(moved.x(), expect.x(), 1e-9) << "side " << side << " point " << k;
+      EXPECT_NEAR(moved.y(), expect.y(), 1e-9) << "side " << side << " point " << k;
+    }
+    // The fingertips and joints did not move: the bones' axes are the same.
+    EXPECT_GT(tg.silhouette_count + tg.coverage_count - palm, 5);
+  }
 }
 
 TEST(ResidualJacobian, NonFiniteObservationsAreIgnored) {

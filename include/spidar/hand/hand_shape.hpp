@@ -32,10 +32,14 @@ struct HandDimensions {
   /// bone, in the distal bone's frame: x lateral (toward the little finger on the right hand),
   /// y along the bone (distal positive), z dorsal (nail side) [m]. Not scaled by the hand size.
   Vec3 fingertip_offset{0.0, -0.008, 0.0};
+  /// The digits' capsule radii relative to the published proportions (which scale with width):
+  /// a hand's finger thickness, apart from its palm breadth. 1 = the proportions.
+  double thickness = 1.0;
 };
 
 /// Checks measurements: length in [0.12, 0.26] m, width in [0.05, 0.13] m, width/length in
-/// [0.3, 0.65], fingertip offset finite and at most 0.02 m long. The error names the field.
+/// [0.3, 0.65], thickness in [0.6, 1.6], fingertip offset finite and at most 0.02 m long. The
+/// error names the field.
 Status validate_dimensions(const HandDimensions& dims);
 
 /// One digit of the right hand at the zero pose, in H.

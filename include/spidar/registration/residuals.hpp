@@ -47,11 +47,17 @@ BoneRef silhouette_bone(int bone);
 
 /// One silhouette sample that lies outside the real silhouette (frozen at the linearisation).
 struct SilhouettePoint {
-  int bone = 0;                  ///< 0..18 (silhouette_bone); −1: the palm box's point palm_H
+  int bone = 0;                  ///< 0..18 (silhouette_bone); −1: the palm box's point palm_u
   double t = 0;                  ///< along the bone axis: 0 proximal joint, 1 distal joint
   Vec2 offset_px = Vec2::Zero(); ///< from the projected axis point to this point [px]
   Vec2 target_px = Vec2::Zero(); ///< the nearest silhouette pixel [px]
-  Vec3 palm_H = Vec3::Zero();    ///< bone −1: the point on the palm box, right-hand H [m]
+  /// Bone −1: the point on the palm box in box units, (p_H − centre) / half_extents per axis
+  /// (right-hand H), so that it stays on the box when the model's sizes change.
+  Vec3 palm_u = Vec3::Zero();
+  /// Bones: the bone's capsule radius when frozen [m]; offset_px scales with the model's radius
+  /// over it (1 while the model is the one frozen with; a size estimate's resized models move the
+  /// edge with the capsule). 0: offset_px as is.
+  double radius_m = 0;
   double weight = 1.0;           ///< robust weight (coverage: Huber at coverage_huber_px), 0..1
 };
 

@@ -1,11 +1,12 @@
 #pragma once
-/// Online hand-shape personalisation: each hand's length and width [m] estimated while the
+/// Online hand-shape personalisation: each hand's length and width [m], and with the silhouette
+/// its digits' thickness (hand_shape.hpp's HandDimensions::thickness), estimated while the
 /// session runs, from the evidence the pose fits already use, with no calibration step.
 ///
 /// The estimator keeps a small set of keyframes: frames whose pose differs from every kept one
 /// (one pose does not separate a longer finger from a more flexed one; several do), each with its
 /// observation (the string-measured fingertips in 3D and the bracelet's projected wrist) and its
-/// pose. Every `solve_every` used frames it re-estimates the shape β = (length, width) over all
+/// pose. Every `solve_every` used frames it re-estimates the shape β = (length, width, thickness) over all
 /// keyframes, as in the batch step of Tkach et al. 2017 ("Online generative model personalization
 /// for hand tracking"), by Gauss-Newton on
 ///   Σ_k ‖r_k(θ_k, β)‖² + ‖β − β₀‖²_{Σ₀⁻¹}
@@ -17,12 +18,19 @@
 /// σ = √diag((Σ S_k + Σ₀⁻¹)⁻¹) is the estimate's uncertainty; a size whose σ falls below its
 /// freeze threshold is frozen (Monado's hand-size schedule likewise stops adapting once sure).
 ///
-/// The image's joint-ball and silhouette terms are left out on purpose: they compare the model's
-/// capsules and skin with a real hand's outline, whose systematic differences (knuckles, pads,
-/// tissue) would bias the sizes; the strings and the bracelet measure points of the skeleton.
+/// Without the silhouette (ShapeEstimatorParams::silhouette kNone) the evidence is the strings and
+/// the bracelet, which measure points of the skeleton: a model longer than the hand then bends
+/// its fingers to reach the caps, so a too-long estimate is hardly corrected, and the width and
+/// thickness are weakly seen. With it, each keyframe also keeps its silhouette: model points
+/// outside the silhouette (kSpill), and the silhouette pixels the hand owns that the model leaves
+/// uncovered (kBoth, coverage.hpp), enter the re-estimate, and the digits' thickness is estimated
+/// too. A silhouette point's offset from its bone's axis scales with the capsule's radius
+/// (SilhouettePoint::radius_m), so the image rows do see the width and thickness. The joint-balls stay out (their targets depend
+/// on the matte's soft edge, not on the shape).
 
 #include <array>
 #include <future>
+#include <opencv2/core/mat.hpp>
 #include <optional>
 #include <vector>
 
@@ -33,9 +41,17 @@
 
 namespace spidar::registration {
 
+/// Which of the keyframes' silhouette evidence a re-estimate fits (see the file comment).
+enum class ShapeSilhouette {
+  kNone,   ///< strings and bracelet only; the thickness stays
+  kSpill,  ///< also model points lying outside the silhouette (the silhouette term's inward direction)
+  kBoth,   ///< also the silhouette pixels the hand owns that the model leaves uncovered (coverage.hpp)
+};
+
 struct ShapeEstimatorParams {
   double prior_sigma_length_m = 0.015;  ///< σ₀ of the starting profile's length [m]
   double prior_sigma_width_m = 0.008;   ///< σ₀ of its width [m]
+  double prior_sigma_thickness = 0.1;   ///< σ₀ of its digits' thickness (1 = the proportions')
   int keyframes = 24;                   ///< kept (the oldest is replaced)
   double min_pose_change = 0.08;        ///< a keyframe differs from every kept one by this (‖Δθ‖, m/rad)
   int solve_every = 10;                 ///< re-estimate after this many new keyframes
@@ -43,7 +59,9 @@ struct ShapeEstimatorParams {
   int iterations = 4;                   ///< Gauss-Newton iterations per re-estimate
   double freeze_sigma_length_m = 0.0003;  ///< freeze the length once its σ is below this [m]
   double freeze_sigma_width_m = 0.0003;   ///< ... the width [m]
-  /// The estimate stays within this share of the starting sizes (0.15: ±15 %).
+  double freeze_sigma_thickness = 0.004;  ///< ... the thickness
+  /// The estimate stays within this share of the starting sizes (0.15: ±15 %; the thickness
+  /// within twice this around 1).
   double max_relative_change = 0.15;
   double difference_step_m = 1e-4;  ///< central-difference step of J_β [m]
   /// A keyframe's refit re-poses each digit whose cap misses its string by more than this
@@ -59,11 +77,18 @@ struct ShapeEstimatorParams {
   /// models stays the same from run to run. (At nice 10 a busy machine starved it past 2 frames,
   /// and the frame thread waited.)
   int apply_after_frames = 0;
-  /// Keyframes also keep the silhouette pixels their hand owned (ImageEvidence::coverage) and the
-  /// re-estimate fits them too (the silhouette term's coverage direction): evidence on the width
-  /// that four fingertips and a wrist lack, at the price of the skin's differences from a real
-  /// hand's outline. Off: strings and bracelet only.
-  bool silhouette = false;
+  /// kSpill, kBoth: keyframes also keep their silhouette (the matte ≥ matte_threshold), and with
+  /// kBoth the silhouette pixels their hand owned (ImageEvidence::coverage); the re-estimate fits
+  /// them and estimates the thickness too.
+  ///
+  /// Measured (demo, seeds 1–3, users of configs/hands.yaml and ±10 %, 2026-11-25): neither is
+  /// the default. kBoth lets the uncovered pixels (webs, pads and palm tissue that capsules lack:
+  /// about ten times the spill's pull on the width) grow a small user's hand to +12 % length and
+  /// +15 % width. kSpill, which such tissue cannot bias (a real hand holds the model's capsules,
+  /// not the reverse), brings a small user's length from +10 % to +4–7 %, but cannot grow a hand
+  /// the strings do not (a large user's width stays −10 %) and narrowed a short, wide user's to
+  /// the −15 % bound.
+  ShapeSilhouette silhouette = ShapeSilhouette::kNone;
 };
 
 /// The estimate of one hand.
@@ -72,8 +97,11 @@ struct ShapeEstimate {
   double width_m = 0;
   double sigma_length_m = 0;  ///< [m]
   double sigma_width_m = 0;
+  double thickness = 1;  ///< the digits' thickness (HandDimensions::thickness)
+  double sigma_thickness = 0;
   bool length_frozen = false;
   bool width_frozen = false;
+  bool thickness_frozen = false;
   int keyframes = 0;  ///< keyframes held
   int solves = 0;     ///< re-estimates made
 };
@@ -106,6 +134,7 @@ class ShapeEstimator {
     hand::HandParams q;
     HandObservation observation;
     std::vector<OwnedPixel> owned;  ///< ShapeEstimatorParams::silhouette only
+    cv::Mat silhouette;  ///< CV_8UC1, the matte ≥ matte_threshold (ShapeEstimatorParams::silhouette)
   };
   /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its
   /// own thread shares nothing with the estimator).
@@ -114,7 +143,7 @@ class ShapeEstimator {
     RegistrationParams fit_params;
     std::optional<vision::Camera> camera;
     hand::HandModel model;
-    double start_length_m = 0, start_width_m = 0;
+    double start_length_m = 0, start_width_m = 0, start_thickness = 1;
     std::vector<Keyframe> keyframes;
     ShapeEstimate estimate;
     bool changed = false;
@@ -126,7 +155,7 @@ class ShapeEstimator {
 
   ShapeEstimatorParams p_;
   hand::HandModel model_;
-  double start_length_m_ = 0, start_width_m_ = 0;
+  double start_length_m_ = 0, start_width_m_ = 0, start_thickness_ = 1;
   std::vector<Keyframe> keyframes_;
   std::size_t next_slot_ = 0;
   int new_since_solve_ = 0;
@@ -136,13 +165,17 @@ class ShapeEstimator {
 };
 
 /// Reads a `personalisation:` map (every key optional): enabled (bool, into `*enabled`),
-/// prior_sigma_length_m, prior_sigma_width_m, keyframes, min_pose_change, solve_every,
-/// min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m, max_relative_change,
+/// prior_sigma_length_m, prior_sigma_width_m, prior_sigma_thickness, keyframes, min_pose_change,
+/// solve_every, min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m,
+/// freeze_sigma_thickness, max_relative_change,
 /// reach_min_miss_m, apply_after_frames, silhouette.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
-/// The model `m` with other sizes (same side, coupling and limits). Fails on invalid sizes.
+/// The model `m` with other sizes (same side, coupling, limits and, in the first form,
+/// thickness). Fails on invalid sizes.
 Result<hand::HandModel> resized(const hand::HandModel& m, double length_m, double width_m);
+Result<hand::HandModel> resized(const hand::HandModel& m, double length_m, double width_m,
+                                double thickness);
 
 }  // namespace spidar::registration
