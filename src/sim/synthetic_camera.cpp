@@ -49,7 +49,14 @@ struct SyntheticCamera::Impl {
   render::RenderParams render_params;
   SceneSnapshot scene;
   render::RenderTargets targets;
-  cv::Mat accumulator, noise;
+  cv::Mat accumulator;
+  /// The sensor noise bank as its positive and negative parts (8-bit each, one of the two zero per
+  /// sample): adding one and subtracting the other, both saturating, is the saturated sum with
+  /// the signed noise, in two SIMD passes instead of a mixed-type one.
+  cv::Mat noise_plus, noise_minus;
+  /// hand_id → hand_index (0, or hand + 1) and → hand_only (255 for a hand part that is neither
+  /// bracelet nor forearm) (render::decode_hand_id).
+  cv::Mat lut_index, lut_only;
   cv::RNG rng;
 
   /// Where each forearm pointed in the last build_scene.
@@ -169,18 +176,18 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
   // Ground truth at `poses`.
   out->toward_elbow_W = s.toward_elbow;
   cv::compare(s.targets.hand_id, 0, out->mask, cv::CMP_GT);
-  out->hand_index.create(out->mask.size(), CV_8UC1);
-  out->hand_only.create(out->mask.size(), CV_8UC1);
-  for (int y = 0; y < out->mask.rows; ++y) {
-    const std::uint8_t* id = s.targets.hand_id.ptr<std::uint8_t>(y);
-    std::uint8_t* hi = out->hand_index.ptr<std::uint8_t>(y);
-    std::uint8_t* ho = out->hand_only.ptr<std::uint8_t>(y);
-    for (int x = 0; x < out->mask.cols; ++x) {
-      const render::HandId d = render::decode_hand_id(id[x]);
-      hi[x] = id[x] == 0 ? 0 : static_cast<std::uint8_t>(d.hand + 1);
-      ho[x] = id[x] != 0 && d.finger != render::kBraceletPart && d.finger != render::kForearmPart ? 255 : 0;
+  if (s.lut_index.empty()) {
+    s.lut_index.create(1, 256, CV_8UC1);
+    s.lut_only.create(1, 256, CV_8UC1);
+    for (int i = 0; i < 256; ++i) {
+      const render::HandId d = render::decode_hand_id(static_cast<std::uint8_t>(i));
+      s.lut_index.at<std::uint8_t>(i) = i == 0 ? 0 : static_cast<std::uint8_t>(d.hand + 1);
+      s.lut_only.at<std::uint8_t>(i) =
+          i != 0 && d.finger != render::kBraceletPart && d.finger != render::kForearmPart ? 255 : 0;
     }
   }
+  cv::LUT(s.targets.hand_id, s.lut_index, out->hand_index);
+  cv::LUT(s.targets.hand_id, s.lut_only, out->hand_only);
   s.targets.hand_depth.copyTo(out->depth);
 
   // Optics and sensor.
@@ -191,13 +198,17 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
     // cost more than the rendering.
     constexpr int kNoisePad = 128;
     const cv::Size bank(out->bgr.cols + kNoisePad, out->bgr.rows + kNoisePad);
-    if (s.noise.size() != bank) {
-      s.noise.create(bank, CV_16SC3);
-      s.rng.fill(s.noise, cv::RNG::NORMAL, 0.0, p.noise_sigma);
+    if (s.noise_plus.size() != bank) {
+      cv::Mat noise(bank, CV_16SC3);
+      s.rng.fill(noise, cv::RNG::NORMAL, 0.0, p.noise_sigma);
+      noise.convertTo(s.noise_plus, CV_8UC3);            // max(n, 0), saturated
+      cv::Mat negative = -noise;
+      negative.convertTo(s.noise_minus, CV_8UC3);        // max(−n, 0), saturated
     }
     const cv::Rect at(s.rng.uniform(0, kNoisePad), s.rng.uniform(0, kNoisePad), out->bgr.cols,
                       out->bgr.rows);
-    cv::add(out->bgr, s.noise(at), out->bgr, cv::noArray(), CV_8U);  // saturates to 0..255
+    cv::add(out->bgr, s.noise_plus(at), out->bgr);        // saturates at 255
+    cv::subtract(out->bgr, s.noise_minus(at), out->bgr);  // saturates at 0
   }
   return Ok{};
 }

@@ -233,6 +233,22 @@ TEST(SyntheticCamera, MotionBlurAndNoiseLeaveGroundTruthAtTheCurrentPose) {
   cv::meanStdDev(sharp.bgr(cv::Rect(0, 0, 40, 40)), mean, stddev);  // a patch of blue screen
   EXPECT_GT(stddev[0], 1.0);
   EXPECT_LT(stddev[0], 3.5);
+  // Against the same frame without noise: zero-mean with σ = noise_sigma, both signs (over the
+  // whole frame; saturation at 0 and 255 hardly occurs with σ = 2).
+  SyntheticCameraParams quiet = p;
+  quiet.noise_sigma = 0;
+  auto clean_camera = SyntheticCamera::create(*gl_context(), cam, render::test::truth_models(), quiet).value();
+  SyntheticFrame clean;
+  ASSERT_TRUE(clean_camera->film({&now[0], &now[1]}, &clean).ok());
+  cv::Mat a16, b16, noise;
+  sharp.bgr.convertTo(a16, CV_16SC3);
+  clean.bgr.convertTo(b16, CV_16SC3);
+  cv::subtract(a16, b16, noise);
+  cv::meanStdDev(noise.reshape(1), mean, stddev);
+  EXPECT_NEAR(mean[0], 0.0, 0.05);
+  EXPECT_NEAR(stddev[0], p.noise_sigma, 0.1);
+  EXPECT_GT(cv::countNonZero(noise.reshape(1) > 0), noise.total());      // of 3 × total samples
+  EXPECT_GT(cv::countNonZero(noise.reshape(1) < 0), noise.total());
 }
 
 TEST(SyntheticCamera, RejectsBadParams) {
