@@ -11,6 +11,7 @@
 
 #include "lockstep_task.hpp"
 #include "spidar/core/units.hpp"
+#include "spidar/hand/coupling.hpp"
 #include "spidar/hand/hand_config.hpp"
 
 namespace spidar::sim {
@@ -59,25 +60,40 @@ TEST(RubiksTask, LockstepPhysicsLiftsAndTurnsTheTopLayerTwice) {
   for (int f = 1; f < 6; ++f) EXPECT_LT(r.other_faces_max_rad[f], units::deg_to_rad(3)) << "UDFBRL"[f];
 }
 
-// The script fitted to users' own hands (their fingers reach the caps) still turns twice.
-class FittedTaskPhysics : public ::testing::TestWithParam<std::pair<double, double>> {};
+// The script fitted to users' own hands (their fingers reach the caps) still turns twice: the
+// default user, and users ±10 % in length and width with either coupling. (In the real-time demo
+// the short, wide user with the linear coupling (`--user-hand` with length 0.171,
+// width 0.0935, fingertip_offset [0, -0.009, 0.001]) has failed its second turn in every run so
+// far, 2026-11-25: that is the rig's timing and strings, not the script; lockstep it turns.)
+struct UserShape {
+  double length_scale, width_scale;
+  hand::Coupling coupling;
+};
+
+class FittedTaskPhysics : public ::testing::TestWithParam<UserShape> {};
 
 TEST_P(FittedTaskPhysics, LiftsAndTurnsTheTopLayerTwice) {
   hand::HandProfile profile;
-  profile.dimensions.length = 0.19 * GetParam().first;
-  profile.dimensions.width = 0.085 * GetParam().second;
+  profile.dimensions.length = 0.19 * GetParam().length_scale;
+  profile.dimensions.width = 0.085 * GetParam().width_scale;
+  profile.dimensions.fingertip_offset = Vec3(0.0, -0.009, 0.001);  // the `user` profile's caps
+  profile.coupling = GetParam().coupling;
   const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft),
                                              profile.model(hand::Side::kRight)};
   const TaskRun r = run_task(&hands);
-  std::printf("length x%.2f width x%.2f: lift %.1f mm, U %d quarter turns\n", GetParam().first,
-              GetParam().second, r.lift_max_m * 1e3, r.quarter_turns_u);
+  std::printf("length x%.2f width x%.2f %s: lift %.1f mm, U %d quarter turns\n", GetParam().length_scale,
+              GetParam().width_scale, GetParam().coupling == hand::Coupling::kLinear ? "linear" : "quadratic",
+              r.lift_max_m * 1e3, r.quarter_turns_u);
   EXPECT_GT(r.lift_max_m, 0.010);
   EXPECT_EQ(r.quarter_turns_u, 2);
 }
 
 INSTANTIATE_TEST_SUITE_P(Users, FittedTaskPhysics,
-                         ::testing::Values(std::make_pair(1.04, 0.97), std::make_pair(0.9, 1.1),
-                                           std::make_pair(1.1, 0.9)));
+                         ::testing::Values(UserShape{1.04, 0.97, hand::Coupling::kPaperQuadratic},
+                                           UserShape{0.9, 1.1, hand::Coupling::kLinear},
+                                           UserShape{1.1, 0.9, hand::Coupling::kLinear},
+                                           UserShape{0.9, 0.9, hand::Coupling::kPaperQuadratic},
+                                           UserShape{1.1, 1.1, hand::Coupling::kPaperQuadratic}));
 
 }  // namespace
 }  // namespace spidar::sim
