@@ -344,7 +344,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     // Only a fit that agrees with the strings is evidence on the sizes: a broken one (a lost
     // bracelet, a local minimum) would pull them toward whatever explains it.
     // (A frame without all four fingertips makes no keyframe anyway: ShapeEstimator::add_frame.)
-    if (p.personalise_shape && fingertip_cost_per_tip(report, obs) <= p.shape_max_fingertip_cost) {
+    if (p.personalise_shape && fingertip_cost_per_tip(report, obs) <= p.shape_estimator.max_fingertip_cost) {
       if (s.shape[h].add_frame(q, obs, hand_image, p.registration)) s.models[h] = fit_model(s.shape[h].model(), p);
     }
     out->shapes[h] = s.shape[h].estimate();

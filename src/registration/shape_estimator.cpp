@@ -24,7 +24,8 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
   node.expect_keys({"enabled", "prior_sigma_length_m", "prior_sigma_width_m", "prior_sigma_thickness",
                     "keyframes", "min_pose_change", "solve_every", "min_keyframes", "iterations",
                     "freeze_sigma_length_m", "freeze_sigma_width_m", "freeze_sigma_thickness",
-                    "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette"});
+                    "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
+                    "max_fingertip_cost"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("silhouette")) {
@@ -50,6 +51,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       {"freeze_sigma_thickness", &ShapeEstimatorParams::freeze_sigma_thickness, 0.0, 1.0},
       {"max_relative_change", &ShapeEstimatorParams::max_relative_change, 0.0, 0.5},
       {"reach_min_miss_m", &ShapeEstimatorParams::reach_min_miss_m, 0.0, 0.05, true},
+      {"max_fingertip_cost", &ShapeEstimatorParams::max_fingertip_cost, 0.0, 1e6},
   };
   struct IntField {
     const char* key;

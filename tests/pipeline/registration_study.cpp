@@ -51,6 +51,7 @@ struct Args {
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
+  double q_from = -1, q_to = 0.4;  ///< --q-from S --q-to S: print fit − truth parameters in [S, S] with --verbose
   bool ceiling_scan = false;
   double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
@@ -95,6 +96,8 @@ int main(int argc, char** argv) {
     else if (k == "--t1") a.t1 = std::atof(next().c_str());
     else if (k == "--fps") a.fps = std::atof(next().c_str());
     else if (k == "--verbose") a.verbose = true;
+    else if (k == "--q-from") a.q_from = std::atof(next().c_str());
+    else if (k == "--q-to") a.q_to = std::atof(next().c_str());
     else if (k == "--ceiling-scan") a.ceiling_scan = true;
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
@@ -227,10 +230,17 @@ int main(int argc, char** argv) {
     else if (key == "coverage_stride_px") p.registration.coverage_stride_px = static_cast<int>(v);
     else if (key == "coverage_max_px") p.registration.coverage_max_px = v;
     else if (key == "coverage_huber_px") p.registration.coverage_huber_px = v;
+    else if (key == "prior_sigma_wrist_m") p.registration.prior_sigma_wrist_m = v;
+    else if (key == "prior_sigma_rotation_rad") p.registration.prior_sigma_rotation_rad = v;
+    else if (key == "prior_sigma_joint_rad") p.registration.prior_sigma_joint_rad = v;
+    else if (key == "wrist_sigma_px") p.registration.wrist_sigma_px = v;
     else if (key == "silhouette_sigma_px") p.registration.silhouette_sigma_px = v;
     else if (key == "joint_ball_sigma_px") p.registration.joint_ball_sigma_px = v;
     else if (key == "silhouette_downsample") p.silhouette_downsample = static_cast<int>(v);
     else if (key == "max_iterations") p.registration.max_iterations = static_cast<int>(v);
+    else if (key == "shape_max_fingertip_cost") p.shape_estimator.max_fingertip_cost = v;
+    else if (key == "shape_prior_sigma_length_m") p.shape_estimator.prior_sigma_length_m = v;
+    else if (key == "shape_prior_sigma_width_m") p.shape_estimator.prior_sigma_width_m = v;
     else {
       std::fprintf(stderr, "registration_study: --set: unknown key %s\n", key.c_str());
       return 2;
@@ -357,7 +367,7 @@ int main(int argc, char** argv) {
         cap_res += (true_pts.p_W_fingertip[f] - g[4 * h + f]).norm() / 8;
       }
     }
-    if (a.verbose && t < 0.4) {
+    if (a.verbose && t >= a.q_from && t < a.q_to) {
       for (int h = 0; h < 2; ++h) {
         const auto mt = hand::forward_kinematics(r.models[h], truth[h]);
         std::printf("  hand %d model at truth, caps off [mm]:", h);
@@ -469,8 +479,9 @@ int main(int argc, char** argv) {
       contested_paper.push_back(m.contested_pct_paper());
     }
     if (a.verbose)
-      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f/%.2f mm joints %.1f/%.1f px  L %.4f/%.4f W %.4f/%.4f\n",
+      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f/%.2f mm joints %.1f/%.1f px  bracelets %c%c  L %.4f/%.4f W %.4f/%.4f\n",
                   t, m.iou, c, m.fingertip_mm[0], m.fingertip_mm[1], m.joint_px[0], m.joint_px[1],
+                  r.bracelets[0].found ? 'L' : '-', r.bracelets[1].found ? 'R' : '-',
                   r.models[0].shape.dimensions.length,
                   r.models[1].shape.dimensions.length, r.models[0].shape.dimensions.width,
                   r.models[1].shape.dimensions.width);

@@ -236,7 +236,7 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
 // hand's caps three times as far apart as the hand has them (past any pose of the hand: at twice,
 // fingers re-posed to their strings, registration/fingertip_reach.hpp, reach some of them within
 // the gate's 2 σ), its frames are not offered to the size
-// estimator (FramePipelineParams::shape_max_fingertip_cost), while the left hand's are; with the
+// estimator (ShapeEstimatorParams::max_fingertip_cost), while the left hand's are; with the
 // gate open, the broken fits become keyframes.
 TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
   const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
@@ -253,7 +253,7 @@ TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
   std::array<std::array<int, 2>, 2> keyframes{};  // [gate closed, open][hand]
   for (int open = 0; open < 2; ++open) {
     FramePipelineParams q = p;
-    if (open == 1) q.shape_max_fingertip_cost = 1e9;
+    if (open == 1) q.shape_estimator.max_fingertip_cost = 1e9;
     auto pipe = FramePipeline::create(*context_, camera_, models_, q).value();
     sim::UserHands user(truth_models_, task);
     sim::SyntheticFrame frame;

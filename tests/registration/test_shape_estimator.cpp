@@ -161,6 +161,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.prior_sigma_width_m, d.prior_sigma_width_m);
   EXPECT_EQ(p.max_relative_change, d.max_relative_change);
   EXPECT_EQ(p.reach_min_miss_m, d.reach_min_miss_m);
+  EXPECT_EQ(p.max_fingertip_cost, d.max_fingertip_cost);
   EXPECT_EQ(p.apply_after_frames, 5);  // the sessions re-estimate on a thread of their own
   const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
@@ -170,8 +171,8 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("min_pose_change"), std::string::npos) << e.what();
   }
-  for (const std::string key : {"apply_after_frames", "reach_min_miss_m"}) {
-    const std::string text = "personalisation:\n  " + key + (key == "apply_after_frames" ? ": -1\n" : ": 0.5\n");
+  for (const std::string key : {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost"}) {
+    const std::string text = "personalisation:\n  " + key + (key == "reach_min_miss_m" ? ": 0.5\n" : ": -1\n");
     const auto node = core::ConfigNode::Parse(text, "bad.yaml");
     try {
       parse_shape_estimator_params(node["personalisation"], &enabled);
@@ -182,11 +183,13 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
     }
   }
   const auto on = core::ConfigNode::Parse(
-      "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n", "on.yaml");
+      "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n"
+      "  max_fingertip_cost: 25\n", "on.yaml");
   const ShapeEstimatorParams q = parse_shape_estimator_params(on["personalisation"], &enabled);
   EXPECT_EQ(q.silhouette, ShapeSilhouette::kSpill);
   EXPECT_EQ(q.reach_min_miss_m, 0.0);
   EXPECT_EQ(q.prior_sigma_thickness, 0.2);
+  EXPECT_EQ(q.max_fingertip_cost, 25.0);
   EXPECT_EQ(p.silhouette, ShapeSilhouette::kNone);  // the shipped setting
   // An unknown choice names the file, line, key and the choices.
   const auto typo = core::ConfigNode::Parse("personalisation:\n  silhouette: inward\n", "typo.yaml");

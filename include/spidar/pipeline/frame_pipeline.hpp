@@ -66,11 +66,6 @@ struct FramePipelineParams {
   /// and fit with the estimate, starting from the given models; off: their sizes stay as given.
   bool personalise_shape = false;
   registration::ShapeEstimatorParams shape_estimator;
-  /// A frame is offered to the size estimator only when its fit's fingertip cost per fingertip is
-  /// at most this (dimensionless: 4 = each fingertip 2 σ from the strings, 3 mm at 1.5 mm). Demo,
-  /// seeds 1–2: the small user's right length ran to its +15 % bound without it (24–28 % off,
-  /// IoU 0.726), 10 % off with it (IoU 0.745–0.746); the default user's sizes are unchanged.
-  double shape_max_fingertip_cost = 4.0;
   /// Fit the fingers within their passive ranges (hand::passive_limits of the given models' joint
   /// ranges), not only the active: a fingertip the strings pull on can be pushed past where its
   /// finger moves by itself, as the simulated user's are (sim::UserHands). Off: the active ranges.

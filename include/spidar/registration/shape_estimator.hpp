@@ -89,6 +89,13 @@ struct ShapeEstimatorParams {
   /// the strings do not (a large user's width stays −10 %) and narrowed a short, wide user's to
   /// the −15 % bound.
   ShapeSilhouette silhouette = ShapeSilhouette::kNone;
+  /// The frame pipeline offers a frame to the estimator only when its fit's fingertip cost per
+  /// fingertip is at most this (dimensionless: 4 = each fingertip 2 σ from the strings, 3 mm at
+  /// 1.5 mm; FramePipeline). Demo, seeds 1–2, before digits were re-posed to their strings
+  /// (fingertip_reach.hpp): the small user's right length ran to its +15 % bound without it
+  /// (24–28 % off, IoU 0.726), 10 % off with it (IoU 0.745–0.746). A model of the wrong size
+  /// cannot bring its caps to the strings, so the gate also keeps out the frames that say so.
+  double max_fingertip_cost = 4.0;
 };
 
 /// The estimate of one hand.
