@@ -532,5 +532,11 @@ int main(int argc, char** argv) {
               r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
               r.models[1].shape.dimensions.length, r.models[1].shape.dimensions.width,
               truth_models[0].shape.dimensions.length, truth_models[0].shape.dimensions.width);
+  for (int h = 0; h < 2; ++h) {
+    const registration::ShapeEstimate& e = r.shapes[h];
+    std::printf("  %s: %d keyframes, %d solves, sigma L %.4f W %.4f m%s%s\n", h == 0 ? "left" : "right",
+                e.keyframes, e.solves, e.sigma_length_m, e.sigma_width_m, e.length_frozen ? ", length frozen" : "",
+                e.width_frozen ? ", width frozen" : "");
+  }
   return 0;
 }
