@@ -7,8 +7,11 @@
 //
 //   registration_study [--user PROFILE|--user-file FILE] [--model L,W | --model-user]
 //                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
-//                      [--t0 S] [--t1 S] [--fps F] [--verbose] [--ceiling-scan]
-//                      [--dump DIR [--dump-below IOU]] [--bending-wrists]
+//                      [--t0 S] [--t1 S] [--fps F] [--verbose [--q-from S --q-to S]] [--ceiling-scan]
+//                      [--dump DIR [--dump-below IOU]] [--bending-wrists] [--set KEY=VALUE]...
+//
+// --set: a registration setting (configs/registration.yaml's keys, e.g. coverage_max_px=15) or,
+// as shape.KEY, a personalisation one (shape.max_fingertip_cost=25), checked by the same parsers.
 //
 // --ceiling-scan: the model ceiling again with the skin's digits thicker or thinner (capsule radii
 // × 0.9 … 1.3) and its palm fuller (palm_fullness), to see which shape parameter the ceiling's
@@ -25,9 +28,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "source_path.hpp"
+#include "spidar/core/config.hpp"
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/registration/registration_params.hpp"
+#include "spidar/registration/shape_estimator.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/render/renderer.hpp"
 #include <opencv2/imgproc.hpp>
@@ -51,7 +57,7 @@ struct Args {
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
-  double q_from = -1, q_to = 0.4;  ///< --q-from S --q-to S: print fit − truth parameters in [S, S] with --verbose
+  double q_from = -1, q_to = 0.4;  ///< with --verbose, fit − truth parameters for frames in [q_from, q_to) [s]
   bool ceiling_scan = false;
   double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
@@ -217,35 +223,38 @@ int main(int argc, char** argv) {
   pipeline::FramePipelineParams p;
   p.chroma_key = vc.chroma_key;
   p.bracelet = vc.bracelet;
-  p.registration.silhouette_term = a.silhouette;
+  // --set key=value: any key of configs/registration.yaml's registration section, or of its
+  // personalisation section as shape.KEY, through the same parsers (ranges, file:line errors);
+  // silhouette_downsample is the pipeline's own.
+  std::string registration_yaml = "registration: {}\n", shape_yaml = "personalisation: {}\n";
+  std::string reg_keys, shape_keys;
+  for (const std::string& kv : a.sets) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) {
+      std::fprintf(stderr, "registration_study: --set %s: expected key=value\n", kv.c_str());
+      return 2;
+    }
+    const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+    if (key == "silhouette_downsample") p.silhouette_downsample = std::atoi(value.c_str());
+    else if (key.rfind("shape.", 0) == 0) shape_keys += "  " + key.substr(6) + ": " + value + "\n";
+    else reg_keys += "  " + key + ": " + value + "\n";
+  }
+  if (!reg_keys.empty()) registration_yaml = "registration:\n" + reg_keys;
+  if (!shape_keys.empty()) shape_yaml = "personalisation:\n" + shape_keys;
+  try {
+    p.registration = registration::parse_registration_params(
+        core::ConfigNode::Parse(registration_yaml, "--set")["registration"]);
+    p.shape_estimator = registration::parse_shape_estimator_params(
+        core::ConfigNode::Parse(shape_yaml, "--set")["personalisation"], nullptr);
+  } catch (const core::ConfigError& e) {
+    std::fprintf(stderr, "registration_study: %s\n", e.what());
+    return 2;
+  }
+  p.registration.silhouette_term = p.registration.silhouette_term || a.silhouette;
   if (a.no_balls) p.registration.joint_ball_sigma_px = 1000;
   if (a.no_wrist) p.registration.wrist_sigma_px = 1000;
   p.personalise_shape = a.personalise;
   p.model_skin = model_skin;
-  for (const std::string& kv : a.sets) {
-    const auto eq = kv.find('=');
-    const std::string key = kv.substr(0, eq);
-    const double v = std::atof(kv.substr(eq + 1).c_str());
-    if (key == "coverage_sigma_px") p.registration.coverage_sigma_px = v;
-    else if (key == "coverage_stride_px") p.registration.coverage_stride_px = static_cast<int>(v);
-    else if (key == "coverage_max_px") p.registration.coverage_max_px = v;
-    else if (key == "coverage_huber_px") p.registration.coverage_huber_px = v;
-    else if (key == "prior_sigma_wrist_m") p.registration.prior_sigma_wrist_m = v;
-    else if (key == "prior_sigma_rotation_rad") p.registration.prior_sigma_rotation_rad = v;
-    else if (key == "prior_sigma_joint_rad") p.registration.prior_sigma_joint_rad = v;
-    else if (key == "wrist_sigma_px") p.registration.wrist_sigma_px = v;
-    else if (key == "silhouette_sigma_px") p.registration.silhouette_sigma_px = v;
-    else if (key == "joint_ball_sigma_px") p.registration.joint_ball_sigma_px = v;
-    else if (key == "silhouette_downsample") p.silhouette_downsample = static_cast<int>(v);
-    else if (key == "max_iterations") p.registration.max_iterations = static_cast<int>(v);
-    else if (key == "shape_max_fingertip_cost") p.shape_estimator.max_fingertip_cost = v;
-    else if (key == "shape_prior_sigma_length_m") p.shape_estimator.prior_sigma_length_m = v;
-    else if (key == "shape_prior_sigma_width_m") p.shape_estimator.prior_sigma_width_m = v;
-    else {
-      std::fprintf(stderr, "registration_study: --set: unknown key %s\n", key.c_str());
-      return 2;
-    }
-  }
   if (a.shape_w > 0) p.shape_estimator.solve_every = static_cast<int>(a.shape_w);
   if (a.shape_dq > 0) p.shape_estimator.min_pose_change = a.shape_dq;
   if (a.shape_silhouette) p.shape_estimator.silhouette = registration::ShapeSilhouette::kSpill;
