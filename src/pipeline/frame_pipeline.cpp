@@ -96,7 +96,8 @@ struct FramePipeline::Impl {
   /// Online size estimates (personalise_shape) from the models given at creation (start), and
   /// the sizes the skins were last built with.
   std::array<hand::HandModel, 2> start;
-  std::array<registration::ShapeEstimator, 2> shape;
+  /// One estimator for both hands (ShapeEstimatorParams::shared_hands), or one per hand.
+  std::vector<registration::ShapeEstimator> shape;
   std::array<hand::HandDimensions, 2> skin_dims;
 
   Impl(const FramePipelineParams& p, vision::ChromaKeyer k,
@@ -106,13 +107,29 @@ struct FramePipeline::Impl {
         keyer(std::move(k)),
         solver(p.registration),
         main(p.compositor),
-        start(given),
-        shape{registration::ShapeEstimator(given[0], p.shape_estimator),
-              registration::ShapeEstimator(given[1], p.shape_estimator)} {
+        start(given) {
+    make_estimators();
     render::CompositorParams o = p.compositor;
     o.mode = p.compositor.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper
                                                                 : render::CompositeMode::kDepth;
     other.set_params(o);
+  }
+
+  void make_estimators() {
+    shape.clear();
+    if (params.shape_estimator.shared_hands) {
+      shape.emplace_back(start, params.shape_estimator);
+    } else {
+      for (int h = 0; h < 2; ++h) shape.emplace_back(start[h], params.shape_estimator);
+    }
+  }
+  /// The estimator of hand h, and h's index in it.
+  registration::ShapeEstimator& estimator_of(int h) { return shape[shape.size() == 1 ? 0 : static_cast<std::size_t>(h)]; }
+  int index_in_estimator(int h) const { return shape.size() == 1 ? h : 0; }
+  /// After estimator `e` changed its sizes: the fits of the hands it holds take its models.
+  void take_sizes(const registration::ShapeEstimator& e) {
+    for (int h = 0; h < 2; ++h)
+      if (&estimator_of(h) == &e) models[h] = fit_model(e.model(index_in_estimator(h)), params);
   }
 };
 
@@ -155,10 +172,8 @@ void FramePipeline::reset() {
   // A cold start forgets the sizes learnt too: a session's warm-up frame (a blank screen) must
   // not stay among the estimator's keyframes, or a replay, which has no warm-up, would not
   // reach the live run's sizes.
-  for (int h = 0; h < 2; ++h) {
-    s.models[h] = fit_model(s.start[h], s.params);
-    s.shape[h] = registration::ShapeEstimator(s.start[h], s.params.shape_estimator);
-  }
+  for (int h = 0; h < 2; ++h) s.models[h] = fit_model(s.start[h], s.params);
+  s.make_estimators();
 }
 bool FramePipeline::has_previous() const { return impl_->have_previous; }
 Status FramePipeline::present(render::Context& context, const cv::Mat& bgr) {
@@ -272,8 +287,8 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   // A size re-estimate running on its own thread takes effect here, a fixed number of frames after
   // it started (ShapeEstimatorParams::apply_after_frames), so the fits stay reproducible.
   if (p.personalise_shape)
-    for (int h = 0; h < 2; ++h)
-      if (s.shape[h].poll()) s.models[h] = fit_model(s.shape[h].model(), p);
+    for (registration::ShapeEstimator& e : s.shape)
+      if (e.poll()) s.take_sizes(e);
   for (int h = 0; h < 2; ++h) {
     registration::HandObservation obs;
     for (int f = 0; f < hand::kFingertipCount; ++f) {
@@ -345,9 +360,10 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     // bracelet, a local minimum) would pull them toward whatever explains it.
     // (A frame without all four fingertips makes no keyframe anyway: ShapeEstimator::add_frame.)
     if (p.personalise_shape && fingertip_cost_per_tip(report, obs) <= p.shape_estimator.max_fingertip_cost) {
-      if (s.shape[h].add_frame(q, obs, hand_image, p.registration)) s.models[h] = fit_model(s.shape[h].model(), p);
+      registration::ShapeEstimator& e = s.estimator_of(h);
+      if (e.add_frame(s.index_in_estimator(h), q, obs, hand_image, p.registration)) s.take_sizes(e);
     }
-    out->shapes[h] = s.shape[h].estimate();
+    out->shapes[h] = s.estimator_of(h).estimate(s.index_in_estimator(h));
   }
   s.previous = out->hands;
   s.have_previous = true;

@@ -25,9 +25,10 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "keyframes", "min_pose_change", "solve_every", "min_keyframes", "iterations",
                     "freeze_sigma_length_m", "freeze_sigma_width_m", "freeze_sigma_thickness",
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
-                    "max_fingertip_cost"});
+                    "max_fingertip_cost", "shared_hands"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
+  if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
   if (auto b = node.find("silhouette")) {
     const std::string v = b->as_string();
     if (v == "none" || v == "false") p.silhouette = ShapeSilhouette::kNone;
@@ -103,20 +104,56 @@ Result<hand::HandModel> resized(const hand::HandModel& m, double length_m, doubl
   return out;
 }
 
+namespace {
+Eigen::Vector3d sizes_of(const hand::HandModel& m) {
+  const hand::HandDimensions& d = m.shape.dimensions;
+  return {d.length, d.width, d.thickness};
+}
+/// Hand h's sizes at the shared estimate β (in hand 0's sizes): β ⊙ (start_h ⊘ start_0).
+Eigen::Vector3d hand_sizes(const Eigen::Vector3d& beta, const std::vector<Eigen::Vector3d>& starts,
+                           std::size_t h) {
+  return beta.cwiseProduct(starts[h]).cwiseQuotient(starts[0]);
+}
+}  // namespace
+
 ShapeEstimator::ShapeEstimator(const hand::HandModel& start, const ShapeEstimatorParams& params)
-    : p_(params), model_(start) {
-  estimate_.length_m = start_length_m_ = start.shape.dimensions.length;
-  estimate_.width_m = start_width_m_ = start.shape.dimensions.width;
-  estimate_.thickness = start_thickness_ = start.shape.dimensions.thickness;
+    : p_(params), models_{start}, starts_{sizes_of(start)} {
+  estimate_.length_m = starts_[0].x();
+  estimate_.width_m = starts_[0].y();
+  estimate_.thickness = starts_[0].z();
   estimate_.sigma_length_m = p_.prior_sigma_length_m;
   estimate_.sigma_width_m = p_.prior_sigma_width_m;
   estimate_.sigma_thickness = p_.prior_sigma_thickness;
 }
 
+ShapeEstimator::ShapeEstimator(const std::array<hand::HandModel, 2>& starts,
+                               const ShapeEstimatorParams& params)
+    : ShapeEstimator(starts[0], params) {
+  models_.push_back(starts[1]);
+  starts_.push_back(sizes_of(starts[1]));
+}
+
+ShapeEstimate ShapeEstimator::estimate(int hand) const {
+  const auto h = static_cast<std::size_t>(hand);
+  ShapeEstimate e = estimate_;
+  if (h >= starts_.size()) return e;
+  const Eigen::Vector3d scale = starts_[h].cwiseQuotient(starts_[0]);
+  e.length_m *= scale.x();
+  e.sigma_length_m *= scale.x();
+  e.width_m *= scale.y();
+  e.sigma_width_m *= scale.y();
+  e.thickness *= scale.z();
+  e.sigma_thickness *= scale.z();
+  e.keyframes = static_cast<int>(std::count_if(keyframes_.begin(), keyframes_.end(),
+                                               [&](const Keyframe& k) { return k.hand == hand; }));
+  return e;
+}
+
 ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   const ShapeEstimatorParams& p = job.params;
   const vision::Camera* camera = job.camera ? &*job.camera : nullptr;
-  hand::HandModel& model = job.model;
+  std::vector<hand::HandModel>& models = job.models;
+  const std::vector<Eigen::Vector3d>& starts = job.starts;
   ShapeEstimate& estimate = job.estimate;
   ImageEvidence skeleton_only;  // fingertips, bracelet wrist and a prior: no matte (no joint-balls)
   skeleton_only.camera = camera;
@@ -138,15 +175,19 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   const SuccessiveAdjustment solver(fit_params);
   // β = (length [m], width [m], thickness); the thickness only where silhouettes are kept.
   const int nb = any_silhouette ? 3 : 2;
-  const Eigen::Vector3d beta0(job.start_length_m, job.start_width_m, job.start_thickness);
+  const Eigen::Vector3d beta0 = starts[0];
   const Eigen::Vector3d sigma0(p.prior_sigma_length_m, p.prior_sigma_width_m, p.prior_sigma_thickness);
   const Eigen::Matrix3d H0 = sigma0.cwiseProduct(sigma0).cwiseInverse().asDiagonal();
   const Eigen::Vector3d step_h(p.difference_step_m, p.difference_step_m,
-                               p.difference_step_m / std::max(job.start_width_m, 1e-3));
+                               p.difference_step_m / std::max(starts[0].y(), 1e-3));
   const double k = p.max_relative_change;
   const Eigen::Vector3d lo((1 - k) * beta0.x(), (1 - k) * beta0.y(), std::max(0.6, beta0.z() - 2 * k));
   const Eigen::Vector3d hi((1 + k) * beta0.x(), (1 + k) * beta0.y(), std::min(1.6, beta0.z() + 2 * k));
-  auto model_at = [&](const Eigen::Vector3d& b) { return resized(model, b.x(), b.y(), b.z()); };
+  // Hand h's model at β.
+  auto model_at = [&](std::size_t h, const Eigen::Vector3d& b) {
+    const Eigen::Vector3d d = hand_sizes(b, starts, h);
+    return resized(models[h], d.x(), d.y(), d.z());
+  };
   Eigen::Vector3d beta(estimate.length_m, estimate.width_m, estimate.thickness);
   Eigen::Matrix3d H = H0;
   bool changed = false;
@@ -155,6 +196,9 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < job.keyframes.size(); ++i) {
       Keyframe& kf = job.keyframes[i];
+      const auto hk = static_cast<std::size_t>(kf.hand);
+      if (hk >= models.size()) continue;
+      const hand::HandModel& model = models[hk];
       // The keyframe's pose at the current sizes (warm start, weak prior toward its last pose).
       ImageEvidence evidence = skeleton_only;
       if (!kf.owned.empty()) evidence.coverage = &kf.owned;
@@ -178,7 +222,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
         for (int sgn : {1, -1}) {
           Eigen::Vector3d b = beta;
           b[c] += sgn * step_h[c];
-          auto m = model_at(b);
+          auto m = model_at(hk, b);
           if (!m) {
             ok = false;
             break;
@@ -223,10 +267,15 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     }
     if (!step.allFinite()) break;
     const Eigen::Vector3d next = (beta + step).cwiseMax(lo).cwiseMin(hi);
-    auto m = model_at(next);
-    if (!m) break;  // outside the valid sizes: keep the last valid model
+    std::vector<hand::HandModel> next_models;
+    for (std::size_t h = 0; h < models.size(); ++h) {
+      auto m = model_at(h, next);
+      if (!m) break;
+      next_models.push_back(std::move(m).value());
+    }
+    if (next_models.size() != models.size()) break;  // outside the valid sizes: keep the last valid models
     const bool moved = (next - beta).cwiseAbs().maxCoeff() > 1e-7;
-    model = std::move(m).value();
+    models = std::move(next_models);
     beta = next;
     changed = changed || moved;
     if (step.norm() < 1e-6) break;
@@ -250,8 +299,9 @@ ShapeEstimator::~ShapeEstimator() {
   if (pending_.valid()) pending_.wait();
 }
 
-bool ShapeEstimator::add_frame(const hand::HandParams& q, const HandObservation& observation,
+bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandObservation& observation,
                                const ImageEvidence& image, const RegistrationParams& fit_params) {
+  if (hand < 0 || hand >= hands()) return false;
   if (estimate_.length_frozen && estimate_.width_frozen &&
       (estimate_.thickness_frozen || p_.silhouette == ShapeSilhouette::kNone))
     return false;
@@ -260,19 +310,29 @@ bool ShapeEstimator::add_frame(const hand::HandParams& q, const HandObservation&
   for (int f = 0; f < hand::kFingertipCount; ++f)
     tips += observation.fingertip_valid[f] && observation.p_W_fingertip[f].allFinite() ? 1 : 0;
   if (tips < hand::kFingertipCount) return false;  // only fully measured hands make keyframes
-  for (const Keyframe& k : keyframes_)
+  // With a camera the bracelet's wrist is part of a full measurement: without it nothing pins the
+  // palm, four fingertips are reached by a longer or shorter hand alike, and a hand turned about
+  // its fingertips (registration_study, the left hand at 7.0–7.3 s while its bracelet is hidden:
+  // joints 14–15 px at a fingertip cost near 0) would pull the sizes wherever its pose needs.
+  if (image.camera != nullptr &&
+      !(observation.wrist_px && observation.wrist_px->allFinite() && observation.wrist_confidence > 0))
+    return false;
+  int held = 0;  // this hand's keyframes
+  const Keyframe* oldest = nullptr;
+  for (const Keyframe& k : keyframes_) {
+    if (k.hand != hand) continue;
     if ((k.q.q - q.q).norm() < p_.min_pose_change) return false;  // nothing new
-  Keyframe kf{q, observation, {}, {}};
+    ++held;
+    if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
+  }
+  Keyframe kf{hand, next_serial_++, q, observation, {}, {}};
   if (p_.silhouette != ShapeSilhouette::kNone && !image.alpha.empty() && image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);
   if (p_.silhouette == ShapeSilhouette::kBoth && image.coverage != nullptr) kf.owned = *image.coverage;
-  const auto cap = static_cast<std::size_t>(std::max(p_.keyframes, 1));
-  if (keyframes_.size() < cap) {
-    keyframes_.push_back(kf);
-  } else {
-    keyframes_[next_slot_] = kf;
-    next_slot_ = (next_slot_ + 1) % cap;
-  }
+  if (held < std::max(p_.keyframes, 1))
+    keyframes_.push_back(std::move(kf));
+  else
+    keyframes_[static_cast<std::size_t>(oldest - keyframes_.data())] = std::move(kf);
   estimate_.keyframes = static_cast<int>(keyframes_.size());
   if (++new_since_solve_ < p_.solve_every || estimate_.keyframes < p_.min_keyframes) return false;
   if (pending_.valid()) return false;  // one re-estimate at a time: the next frame's offer starts it
@@ -299,17 +359,15 @@ ShapeEstimator::Solve ShapeEstimator::make_solve(const vision::Camera* camera,
   job.params = p_;
   job.fit_params = fit_params;
   if (camera != nullptr) job.camera = *camera;
-  job.model = model_;
-  job.start_length_m = start_length_m_;
-  job.start_width_m = start_width_m_;
-  job.start_thickness = start_thickness_;
+  job.models = models_;
+  job.starts = starts_;
   job.keyframes = keyframes_;
   job.estimate = estimate_;
   return job;
 }
 
 bool ShapeEstimator::apply(Solve&& done) {
-  model_ = std::move(done.model);
+  models_ = std::move(done.models);
   const int keyframes = estimate_.keyframes;
   estimate_ = done.estimate;
   estimate_.keyframes = keyframes;

@@ -488,12 +488,13 @@ int main(int argc, char** argv) {
       contested_paper.push_back(m.contested_pct_paper());
     }
     if (a.verbose)
-      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f/%.2f mm joints %.1f/%.1f px  bracelets %c%c  L %.4f/%.4f W %.4f/%.4f\n",
+      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f/%.2f mm joints %.1f/%.1f px  bracelets %c%c  L %.4f/%.4f W %.4f/%.4f  wrist %.1f/%.1f sil %.1f/%.1f\n",
                   t, m.iou, c, m.fingertip_mm[0], m.fingertip_mm[1], m.joint_px[0], m.joint_px[1],
                   r.bracelets[0].found ? 'L' : '-', r.bracelets[1].found ? 'R' : '-',
                   r.models[0].shape.dimensions.length,
                   r.models[1].shape.dimensions.length, r.models[0].shape.dimensions.width,
-                  r.models[1].shape.dimensions.width);
+                  r.models[1].shape.dimensions.width, r.fits[0].terms.wrist, r.fits[1].terms.wrist,
+                  r.fits[0].terms.silhouette, r.fits[1].terms.silhouette);
   }
   std::printf(
       "frames %zu  IoU mean %.3f p5 %.3f  ceiling %.3f (p5 %.3f)  tip %.2f mm (p95 %.2f)  joints "

@@ -271,6 +271,18 @@ TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
       ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());
     }
     for (int h = 0; h < 2; ++h) keyframes[open][h] = r.shapes[h].keyframes;
+    if (open == 0) {
+      // One estimate for both hands (ShapeEstimatorParams::shared_hands): the right hand offered
+      // nothing, yet its model is at the sizes the left's keyframes gave.
+      std::printf("gate closed: %d solves, left L %.4f W %.4f, right L %.4f W %.4f\n", r.shapes[1].solves,
+                  r.shapes[0].length_m, r.shapes[0].width_m, r.shapes[1].length_m, r.shapes[1].width_m);
+      EXPECT_GE(r.shapes[1].solves, 1);
+      EXPECT_NE(r.shapes[1].length_m, models_[1].shape.dimensions.length);
+      for (int h = 0; h < 2; ++h) {
+        EXPECT_NEAR(pipe->models()[h].shape.dimensions.length, r.shapes[h].length_m, 1e-12) << h;
+        EXPECT_NEAR(pipe->models()[h].shape.dimensions.width, r.shapes[h].width_m, 1e-12) << h;
+      }
+    }
   }
   std::printf("keyframes, left / right: gate %d / %d, open %d / %d\n", keyframes[0][0], keyframes[0][1],
               keyframes[1][0], keyframes[1][1]);

@@ -22,24 +22,20 @@ struct Outcome {
   double tip_error_first_mm = 0, tip_error_last_mm = 0;  ///< fitted caps vs the true caps
 };
 
-/// Runs `frames` frames of one right hand of sizes (L, W) and digit thickness `thickness`
-/// moving through varied poses. With `silhouette` other than kNone the camera also sees the
-/// hand's silhouette, drawn from its own capsules and palm box (test::draw_capsule_mask): the
-/// model's geometry, so this checks the estimator's use of the image, not the model's fidelity.
-Outcome run(double length_m, double width_m, int frames, std::uint32_t seed,
-            ShapeSilhouette silhouette = ShapeSilhouette::kNone, double thickness = 1.0) {
-  const hand::HandModel truth =
-      resized(hand::default_hand_model(hand::Side::kRight), length_m, width_m, thickness).value();
-  const hand::HandModel start = hand::default_hand_model(hand::Side::kRight);
+/// Feeds `frames` frames of hand `hand` of `est` (its side's model as est.model(hand)): a hand of
+/// `truth`'s sizes moving through varied poses about `base`, the strings' fingertips (0.3 mm noise)
+/// and the bracelet's wrist pixel generated from its own skeleton, the pose fitted by the
+/// registration with the current estimate, frame after frame, as the pipeline does. With
+/// `silhouette` other than kNone the camera also sees the hand's silhouette, drawn from its own
+/// capsules and palm box (test::draw_capsule_mask): the model's geometry, so this checks the
+/// estimator's use of the image, not the model's fidelity.
+Outcome feed(ShapeEstimator& est, int hand, const hand::HandModel& truth, const hand::HandParams& base,
+             int frames, std::uint32_t seed, ShapeSilhouette silhouette = ShapeSilhouette::kNone) {
   const vision::Camera camera = vision::default_rig_camera();
   RegistrationParams rp;
-  ShapeEstimatorParams sp;
-  sp.silhouette = silhouette;
-  ShapeEstimator est(start, sp);
   SuccessiveAdjustment solver(rp);
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.0003);  // strings: 0.3 mm
-  const hand::HandParams base = test::reaching_hands(0)[1];
   hand::HandParams fit = base, truth_q = base;
   Outcome out;
   for (int k = 0; k < frames; ++k) {
@@ -57,7 +53,7 @@ Outcome run(double length_m, double width_m, int frames, std::uint32_t seed,
       obs.p_W_fingertip[f] = pts.p_W_fingertip[f] + Vec3(noise(rng), noise(rng), noise(rng));
       obs.fingertip_valid[f] = true;
     }
-    obs.wrist_px = camera.project(bracelet_visible_point(hand::hand_pose(truth_q), width_m,
+    obs.wrist_px = camera.project(bracelet_visible_point(hand::hand_pose(truth_q), truth.shape.dimensions.width,
                                                          camera.X_WC().p, rp));
     ImageEvidence image;
     image.camera = &camera;
@@ -66,19 +62,32 @@ Outcome run(double length_m, double width_m, int frames, std::uint32_t seed,
       test::draw_capsule_mask(truth, truth_q, camera, &mask);
       mask.convertTo(image.alpha, CV_32FC1, 1.0 / 255.0);
     }
+    const hand::HandModel& model = est.model(hand);
     const hand::HandParams prior = fit;
-    FitReport report = solver.fit(est.model(), obs, image, &prior, &fit);
-    refit_reaching(solver, est.model(), obs, image, &prior, {.min_miss_m = 0.001}, &fit, &report);
+    FitReport report = solver.fit(model, obs, image, &prior, &fit);
+    refit_reaching(solver, model, obs, image, &prior, {.min_miss_m = 0.001}, &fit, &report);
     double tip = 0;
-    const hand::HandPoints fp = hand::forward_kinematics(est.model(), fit);
+    const hand::HandPoints fp = hand::forward_kinematics(est.model(hand), fit);
     for (int f = 0; f < hand::kFingertipCount; ++f) tip += (fp.p_W_fingertip[f] - pts.p_W_fingertip[f]).norm() / 4;
     if (k == 0) out.tip_error_first_mm = 1e3 * tip;
     out.tip_error_last_mm = 1e3 * tip;
     // The pose fit used no matte (no joint-balls); the estimator takes the silhouette from it.
-    est.add_frame(fit, obs, image, rp);
+    est.add_frame(hand, fit, obs, image, rp);
   }
-  out.estimate = est.estimate();
+  out.estimate = est.estimate(hand);
   return out;
+}
+
+/// One right hand of sizes (L, W) and digit thickness `thickness`, estimated from the default
+/// model (feed()).
+Outcome run(double length_m, double width_m, int frames, std::uint32_t seed,
+            ShapeSilhouette silhouette = ShapeSilhouette::kNone, double thickness = 1.0) {
+  const hand::HandModel truth =
+      resized(hand::default_hand_model(hand::Side::kRight), length_m, width_m, thickness).value();
+  ShapeEstimatorParams sp;
+  sp.silhouette = silhouette;
+  ShapeEstimator est(hand::default_hand_model(hand::Side::kRight), sp);
+  return feed(est, 0, truth, test::reaching_hands(0)[1], frames, seed, silhouette);
 }
 
 class KnownSizes : public ::testing::TestWithParam<std::pair<double, double>> {};
@@ -146,6 +155,81 @@ TEST(ShapeEstimator, StaysWithinItsBoundAndFreezesNothingWithoutEvidence) {
   EXPECT_GT(o.estimate.length_m, 1.10 * 0.19);
 }
 
+// Both hands of one person share one estimate (ShapeEstimatorParams::shared_hands): the hand that
+// offers no keyframes (the pipeline's left hand holding the cube, its fingers hidden) takes the
+// sizes the other's keyframes give, in the ratio of the two starting profiles. Against an
+// independent reference: an estimator of the right hand alone, fed the same frames.
+TEST(ShapeEstimator, BothHandsShareOneEstimateInTheirProfilesRatio) {
+  const hand::HandModel left = hand::default_hand_model(hand::Side::kLeft);
+  const hand::HandModel right = hand::default_hand_model(hand::Side::kRight);
+  const hand::HandModel truth = resized(right, 0.205, 0.088).value();
+  const hand::HandParams base = test::reaching_hands(0)[1];
+  // Equal starting profiles: the shared estimate is the right hand's own, bit for bit.
+  ShapeEstimator both(std::array<hand::HandModel, 2>{left, right}, {}), alone(right, {});
+  ASSERT_EQ(both.hands(), 2);
+  const Outcome b = feed(both, 1, truth, base, 200, 5);
+  const Outcome a = feed(alone, 0, truth, base, 200, 5);
+  std::printf("right alone L %.4f W %.4f (%d solves); shared: left L %.4f W %.4f, right L %.4f W %.4f\n",
+              a.estimate.length_m, a.estimate.width_m, a.estimate.solves, both.estimate(0).length_m,
+              both.estimate(0).width_m, b.estimate.length_m, b.estimate.width_m);
+  EXPECT_GE(a.estimate.solves, 1);
+  EXPECT_EQ(b.estimate.length_m, a.estimate.length_m);
+  EXPECT_EQ(b.estimate.width_m, a.estimate.width_m);
+  EXPECT_EQ(b.estimate.solves, a.estimate.solves);
+  EXPECT_GT(a.estimate.length_m, 0.19 + 0.5 * (0.205 - 0.19));  // it learnt something
+  // The left hand offered nothing and has the same sizes; its model is rebuilt at them.
+  EXPECT_EQ(both.estimate(0).keyframes, 0);
+  EXPECT_EQ(both.estimate(1).keyframes, a.estimate.keyframes);
+  EXPECT_EQ(both.estimate(0).length_m, a.estimate.length_m);
+  EXPECT_NEAR(both.model(0).shape.dimensions.length, a.estimate.length_m, 1e-12);
+  EXPECT_EQ(both.model(0).side, hand::Side::kLeft);
+  // Different profiles (a user who measured a larger right hand): the ratio is kept.
+  const hand::HandModel right_big = resized(right, 0.2, 0.09).value();
+  ShapeEstimator both2(std::array<hand::HandModel, 2>{left, right_big}, {});
+  feed(both2, 1, resized(right, 0.215, 0.095).value(), base, 200, 5);
+  const ShapeEstimate e0 = both2.estimate(0), e1 = both2.estimate(1);
+  EXPECT_GE(e1.solves, 1);
+  EXPECT_NE(e1.length_m, 0.2);
+  EXPECT_NEAR(e0.length_m / e1.length_m, 0.19 / 0.2, 1e-12);
+  EXPECT_NEAR(e0.width_m / e1.width_m, 0.085 / 0.09, 1e-12);
+  EXPECT_NEAR(e0.sigma_length_m / e1.sigma_length_m, 0.19 / 0.2, 1e-12);
+  EXPECT_NEAR(both2.model(0).shape.dimensions.length, e0.length_m, 1e-12);
+  EXPECT_NEAR(both2.model(1).shape.dimensions.length, e1.length_m, 1e-12);
+  // A hand index outside the estimator offers nothing.
+  HandObservation obs;
+  EXPECT_FALSE(both2.add_frame(2, base, obs, ImageEvidence{}, RegistrationParams{}));
+  EXPECT_FALSE(alone.add_frame(1, base, obs, ImageEvidence{}, RegistrationParams{}));
+}
+
+// With a camera, a frame whose bracelet was not found is not a keyframe: four fingertips alone
+// are reached by a longer or shorter hand alike.
+TEST(ShapeEstimator, AFrameWithoutTheBraceletsWristIsNoKeyframe) {
+  const hand::HandModel right = hand::default_hand_model(hand::Side::kRight);
+  const vision::Camera camera = vision::default_rig_camera();
+  const hand::HandParams q = test::reaching_hands(0)[1];
+  const hand::HandPoints pts = hand::forward_kinematics(right, q);
+  HandObservation obs;
+  for (int f = 0; f < hand::kFingertipCount; ++f) {
+    obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
+    obs.fingertip_valid[f] = true;
+  }
+  ImageEvidence image;
+  image.camera = &camera;
+  ShapeEstimator est(right, {});
+  EXPECT_FALSE(est.add_frame(q, obs, image, RegistrationParams{}));
+  EXPECT_EQ(est.estimate().keyframes, 0);
+  obs.wrist_px = Vec2(std::nan(""), 240.0);
+  est.add_frame(q, obs, image, RegistrationParams{});
+  EXPECT_EQ(est.estimate().keyframes, 0);
+  obs.wrist_px = camera.project(q.p_W_wrist());
+  obs.wrist_confidence = 0;
+  est.add_frame(q, obs, image, RegistrationParams{});
+  EXPECT_EQ(est.estimate().keyframes, 0);
+  obs.wrist_confidence = 0.8;
+  est.add_frame(q, obs, image, RegistrationParams{});
+  EXPECT_EQ(est.estimate().keyframes, 1);  // the test can fail: the gate would keep every frame out
+}
+
 TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
   bool enabled = false;
@@ -163,6 +247,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.reach_min_miss_m, d.reach_min_miss_m);
   EXPECT_EQ(p.max_fingertip_cost, d.max_fingertip_cost);
   EXPECT_EQ(p.apply_after_frames, 5);  // the sessions re-estimate on a thread of their own
+  EXPECT_EQ(p.shared_hands, d.shared_hands);
   const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
     parse_shape_estimator_params(bad["personalisation"], &enabled);
@@ -184,12 +269,13 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   }
   const auto on = core::ConfigNode::Parse(
       "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n"
-      "  max_fingertip_cost: 25\n", "on.yaml");
+      "  max_fingertip_cost: 25\n  shared_hands: false\n", "on.yaml");
   const ShapeEstimatorParams q = parse_shape_estimator_params(on["personalisation"], &enabled);
   EXPECT_EQ(q.silhouette, ShapeSilhouette::kSpill);
   EXPECT_EQ(q.reach_min_miss_m, 0.0);
   EXPECT_EQ(q.prior_sigma_thickness, 0.2);
   EXPECT_EQ(q.max_fingertip_cost, 25.0);
+  EXPECT_FALSE(q.shared_hands);
   EXPECT_EQ(p.silhouette, ShapeSilhouette::kNone);  // the shipped setting
   // An unknown choice names the file, line, key and the choices.
   const auto typo = core::ConfigNode::Parse("personalisation:\n  silhouette: inward\n", "typo.yaml");
@@ -199,6 +285,14 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   } catch (const core::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("typo.yaml:2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("none, spill or both"), std::string::npos) << e.what();
+  }
+  const auto maybe = core::ConfigNode::Parse("personalisation:\n  shared_hands: sometimes\n", "maybe.yaml");
+  try {
+    parse_shape_estimator_params(maybe["personalisation"], &enabled);
+    FAIL() << "accepted shared_hands: sometimes";
+  } catch (const core::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("maybe.yaml:2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shared_hands"), std::string::npos) << e.what();
   }
 }
 

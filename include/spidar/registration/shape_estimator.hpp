@@ -28,7 +28,9 @@
 /// (SilhouettePoint::radius_m), so the image rows do see the width and thickness. The joint-balls stay out (their targets depend
 /// on the matte's soft edge, not on the shape).
 
+#include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <future>
 #include <opencv2/core/mat.hpp>
 #include <optional>
@@ -96,9 +98,16 @@ struct ShapeEstimatorParams {
   /// (24–28 % off, IoU 0.726), 10 % off with it (IoU 0.745–0.746). A model of the wrong size
   /// cannot bring its caps to the strings, so the gate also keeps out the frames that say so.
   double max_fingertip_cost = 4.0;
+  /// A session's two hands are one person's: the frame pipeline keeps one estimate for both
+  /// (their sizes stay in the ratio of their starting profiles), so either hand's keyframes are
+  /// evidence on both. The hand that holds the cube shows the camera the back of its palm, its
+  /// fingers hidden behind it, and its length stays unobserved on its own; the other hand's
+  /// keyframes measure it too. false: an estimate per hand.
+  bool shared_hands = true;
 };
 
-/// The estimate of one hand.
+/// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
+/// sizes).
 struct ShapeEstimate {
   double length_m = 0;
   double width_m = 0;
@@ -109,28 +118,43 @@ struct ShapeEstimate {
   bool length_frozen = false;
   bool width_frozen = false;
   bool thickness_frozen = false;
-  int keyframes = 0;  ///< keyframes held
+  int keyframes = 0;  ///< keyframes held (of this hand)
   int solves = 0;     ///< re-estimates made
 };
 
 class ShapeEstimator {
  public:
-  /// Starts from `start` (its length and width; side, coupling and limits are kept).
+  /// One hand: starts from `start` (its length and width; side, coupling and limits are kept).
   explicit ShapeEstimator(const hand::HandModel& start, const ShapeEstimatorParams& params = {});
-  /// Offers one frame: `q` the pose fitted with model(), `observation` what the fit used, `image`
-  /// its camera and (ShapeEstimatorParams::silhouette) the silhouette pixels the hand owns,
-  /// `fit_params` the fit's settings. Returns true when the sizes changed (model() was rebuilt).
-  /// With apply_after_frames > 0 it starts the re-estimate and returns false; poll() applies it.
-  bool add_frame(const hand::HandParams& q, const HandObservation& observation,
+  /// Both hands of one person, indexed as in `starts` ({left, right} in the frame pipeline): one
+  /// estimate β for both, hand h's sizes β ⊙ (start_h ⊘ start_0), so their profiles' ratio is kept
+  /// and every keyframe, of either hand, is evidence on β. Each hand keeps its own
+  /// ShapeEstimatorParams::keyframes.
+  explicit ShapeEstimator(const std::array<hand::HandModel, 2>& starts,
+                          const ShapeEstimatorParams& params = {});
+  /// Offers one frame of hand `hand` (0 for a one-hand estimator): `q` the pose fitted with
+  /// model(hand), `observation` what the fit used, `image` its camera and
+  /// (ShapeEstimatorParams::silhouette) the silhouette pixels the hand owns, `fit_params` the
+  /// fit's settings. Returns true when the sizes changed (every model(h) was rebuilt). With
+  /// apply_after_frames > 0 it starts the re-estimate and returns false; poll() applies it.
+  bool add_frame(int hand, const hand::HandParams& q, const HandObservation& observation,
                  const ImageEvidence& image, const RegistrationParams& fit_params);
+  bool add_frame(const hand::HandParams& q, const HandObservation& observation,
+                 const ImageEvidence& image, const RegistrationParams& fit_params) {
+    return add_frame(0, q, observation, image, fit_params);
+  }
   /// Call once per frame (before fitting with model()) when apply_after_frames > 0: applies a
   /// re-estimate started apply_after_frames polls ago, waiting for it if needed. Returns true when
-  /// the sizes changed (model() was rebuilt). Without a re-estimate in flight it does nothing.
+  /// the sizes changed (the models were rebuilt). Without a re-estimate in flight it does nothing.
   bool poll();
   /// Whether a re-estimate is running on its own thread.
   bool solving() const { return pending_.valid(); }
-  const hand::HandModel& model() const { return model_; }
-  const ShapeEstimate& estimate() const { return estimate_; }
+  /// How many hands the estimate covers (1 or 2).
+  int hands() const { return static_cast<int>(models_.size()); }
+  /// Hand `hand`'s model at the current estimate (hand in [0, hands())).
+  const hand::HandModel& model(int hand = 0) const { return models_.at(static_cast<std::size_t>(hand)); }
+  /// The estimate in hand `hand`'s sizes, with that hand's keyframe count.
+  ShapeEstimate estimate(int hand = 0) const;
 
   ShapeEstimator(ShapeEstimator&&) = default;
   ShapeEstimator& operator=(ShapeEstimator&&) = default;
@@ -138,6 +162,8 @@ class ShapeEstimator {
 
  private:
   struct Keyframe {
+    int hand = 0;
+    std::uint64_t serial = 0;  ///< order of arrival (the oldest of a hand is replaced)
     hand::HandParams q;
     HandObservation observation;
     std::vector<OwnedPixel> owned;  ///< ShapeEstimatorParams::silhouette only
@@ -149,10 +175,10 @@ class ShapeEstimator {
     ShapeEstimatorParams params;
     RegistrationParams fit_params;
     std::optional<vision::Camera> camera;
-    hand::HandModel model;
-    double start_length_m = 0, start_width_m = 0, start_thickness = 1;
+    std::vector<hand::HandModel> models;  ///< per hand
+    std::vector<Eigen::Vector3d> starts;  ///< per hand: starting (length [m], width [m], thickness)
     std::vector<Keyframe> keyframes;
-    ShapeEstimate estimate;
+    ShapeEstimate estimate;  ///< in hand 0's sizes (β)
     bool changed = false;
   };
   /// One re-estimate (the file comment's Gauss-Newton on β over the keyframes), on copies.
@@ -161,12 +187,12 @@ class ShapeEstimator {
   bool apply(Solve&& done);
 
   ShapeEstimatorParams p_;
-  hand::HandModel model_;
-  double start_length_m_ = 0, start_width_m_ = 0, start_thickness_ = 1;
+  std::vector<hand::HandModel> models_;
+  std::vector<Eigen::Vector3d> starts_;  ///< per hand: starting (length [m], width [m], thickness)
   std::vector<Keyframe> keyframes_;
-  std::size_t next_slot_ = 0;
+  std::uint64_t next_serial_ = 0;
   int new_since_solve_ = 0;
-  ShapeEstimate estimate_;
+  ShapeEstimate estimate_;  ///< in hand 0's sizes (β)
   std::future<Solve> pending_;
   int polls_since_start_ = 0;
 };
@@ -175,7 +201,7 @@ class ShapeEstimator {
 /// prior_sigma_length_m, prior_sigma_width_m, prior_sigma_thickness, keyframes, min_pose_change,
 /// solve_every, min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m,
 /// freeze_sigma_thickness, max_relative_change,
-/// reach_min_miss_m, apply_after_frames, silhouette.
+/// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, shared_hands.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
