@@ -25,7 +25,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "keyframes", "min_pose_change", "solve_every", "min_keyframes", "iterations",
                     "freeze_sigma_length_m", "freeze_sigma_width_m", "freeze_sigma_thickness",
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
-                    "max_fingertip_cost", "shared_hands"});
+                    "max_fingertip_cost", "shared_hands", "keyframe_prior_scale"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
@@ -53,6 +53,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       {"max_relative_change", &ShapeEstimatorParams::max_relative_change, 0.0, 0.5},
       {"reach_min_miss_m", &ShapeEstimatorParams::reach_min_miss_m, 0.0, 0.05, true},
       {"max_fingertip_cost", &ShapeEstimatorParams::max_fingertip_cost, 0.0, 1e6},
+      {"keyframe_prior_scale", &ShapeEstimatorParams::keyframe_prior_scale, 0.0, 1e3},
   };
   struct IntField {
     const char* key;
@@ -157,20 +158,26 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   ShapeEstimate& estimate = job.estimate;
   ImageEvidence skeleton_only;  // fingertips, bracelet wrist and a prior: no matte (no joint-balls)
   skeleton_only.camera = camera;
-  // The keyframes' silhouettes (their distance transforms made once per solve).
-  std::vector<vision::SilhouetteDistance> distance(job.keyframes.size());
+  // The keyframes' silhouettes: each one's distance transform is made by the first re-estimate
+  // that uses it and kept with the keyframe (apply() carries it back).
   bool any_silhouette = false;
-  for (std::size_t i = 0; i < job.keyframes.size(); ++i) {
-    const cv::Mat& sil = job.keyframes[i].silhouette;
-    if (sil.empty()) continue;
-    if (!vision::silhouette_distance(sil, &distance[i], {.max_distance_px = kSilhouetteMarginPx, .downsample = 2}).ok())
-      distance[i].empty = true;
+  for (Keyframe& kf : job.keyframes) {
+    if (kf.silhouette.empty()) continue;
     any_silhouette = true;
+    if (kf.distance) continue;
+    auto d = std::make_shared<vision::SilhouetteDistance>();
+    if (!vision::silhouette_distance(kf.silhouette, d.get(), {.max_distance_px = kSilhouetteMarginPx, .downsample = 2}).ok())
+      d->empty = true;
+    kf.distance = std::move(d);
   }
   if (any_silhouette) {
     job.fit_params.silhouette_term = true;
     job.fit_params.silhouette_inward = true;
   }
+  // The keyframes' pose prior (toward each keyframe's last pose), widened by keyframe_prior_scale.
+  job.fit_params.prior_sigma_wrist_m *= p.keyframe_prior_scale;
+  job.fit_params.prior_sigma_rotation_rad *= p.keyframe_prior_scale;
+  job.fit_params.prior_sigma_joint_rad *= p.keyframe_prior_scale;
   const RegistrationParams& fit_params = job.fit_params;
   const SuccessiveAdjustment solver(fit_params);
   // β = (length [m], width [m], thickness); the thickness only where silhouettes are kept.
@@ -202,7 +209,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       // The keyframe's pose at the current sizes (warm start, weak prior toward its last pose).
       ImageEvidence evidence = skeleton_only;
       if (!kf.owned.empty()) evidence.coverage = &kf.owned;
-      if (!distance[i].empty) evidence.distance = &distance[i];
+      if (kf.distance && !kf.distance->empty) evidence.distance = kf.distance.get();
       hand::HandParams prior = kf.q;
       FitReport fit = solver.fit(model, kf.observation, evidence, &prior, &kf.q);
       if (p.reach_min_miss_m > 0 &&
@@ -325,7 +332,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     ++held;
     if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
   }
-  Keyframe kf{hand, next_serial_++, q, observation, {}, {}};
+  Keyframe kf{hand, next_serial_++, q, observation, {}, {}, {}};
   if (p_.silhouette != ShapeSilhouette::kNone && !image.alpha.empty() && image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);
   if (p_.silhouette == ShapeSilhouette::kBoth && image.coverage != nullptr) kf.owned = *image.coverage;
@@ -373,7 +380,13 @@ bool ShapeEstimator::apply(Solve&& done) {
   estimate_.keyframes = keyframes;
   // The keyframes' refitted poses warm-start the next re-estimate, unless keyframes came since it
   // started (new_since_solve_ counts them from its start).
-  if (new_since_solve_ == 0) keyframes_ = std::move(done.keyframes);
+  if (new_since_solve_ == 0) {
+    keyframes_ = std::move(done.keyframes);
+  } else {  // the distance transforms it made stay with the keyframes still held
+    for (Keyframe& k : keyframes_)
+      for (const Keyframe& d : done.keyframes)
+        if (d.serial == k.serial && !k.distance) k.distance = d.distance;
+  }
   return done.changed;
 }
 

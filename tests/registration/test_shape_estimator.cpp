@@ -230,6 +230,27 @@ TEST(ShapeEstimator, AFrameWithoutTheBraceletsWristIsNoKeyframe) {
   EXPECT_EQ(est.estimate().keyframes, 1);  // the test can fail: the gate would keep every frame out
 }
 
+// Started at the true sizes, with data from the model's own skeleton (so the truth is the
+// objective's minimum), the estimate should stay there; it drifts long, because each keyframe's
+// pose is re-fitted with a prior toward where the fits made with earlier sizes put it
+// (ShapeEstimatorParams::keyframe_prior_scale). A wider prior drifts less.
+TEST(ShapeEstimator, AWiderKeyframePriorDriftsLessFromTheTruth) {
+  const hand::HandModel truth =
+      resized(hand::default_hand_model(hand::Side::kRight, hand::Coupling::kLinear), 0.1976, 0.0825).value();
+  double drift[2] = {0, 0};
+  for (int i = 0; i < 2; ++i) {
+    ShapeEstimatorParams sp;
+    sp.keyframe_prior_scale = i == 0 ? 1.0 : 10.0;
+    ShapeEstimator est(truth, sp);
+    const Outcome o = feed(est, 0, truth, test::reaching_hands(0)[1], 400, 7);
+    drift[i] = o.estimate.length_m / 0.1976 - 1;
+    std::printf("keyframe prior ×%.0f: L %.4f W %.4f from the truth 0.1976, 0.0825 (%d solves)\n",
+                sp.keyframe_prior_scale, o.estimate.length_m, o.estimate.width_m, o.estimate.solves);
+    EXPECT_GE(o.estimate.solves, 1);
+  }
+  EXPECT_LT(std::abs(drift[1]), std::abs(drift[0]));
+}
+
 TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
   bool enabled = false;
@@ -248,6 +269,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.max_fingertip_cost, d.max_fingertip_cost);
   EXPECT_EQ(p.apply_after_frames, 5);  // the sessions re-estimate on a thread of their own
   EXPECT_EQ(p.shared_hands, d.shared_hands);
+  EXPECT_EQ(p.keyframe_prior_scale, d.keyframe_prior_scale);
   const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
   try {
     parse_shape_estimator_params(bad["personalisation"], &enabled);
@@ -256,7 +278,8 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("min_pose_change"), std::string::npos) << e.what();
   }
-  for (const std::string key : {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost"}) {
+  for (const std::string key :
+       {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost", "keyframe_prior_scale"}) {
     const std::string text = "personalisation:\n  " + key + (key == "reach_min_miss_m" ? ": 0.5\n" : ": -1\n");
     const auto node = core::ConfigNode::Parse(text, "bad.yaml");
     try {
@@ -269,13 +292,14 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   }
   const auto on = core::ConfigNode::Parse(
       "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n"
-      "  max_fingertip_cost: 25\n  shared_hands: false\n", "on.yaml");
+      "  max_fingertip_cost: 25\n  shared_hands: false\n  keyframe_prior_scale: 10\n", "on.yaml");
   const ShapeEstimatorParams q = parse_shape_estimator_params(on["personalisation"], &enabled);
   EXPECT_EQ(q.silhouette, ShapeSilhouette::kSpill);
   EXPECT_EQ(q.reach_min_miss_m, 0.0);
   EXPECT_EQ(q.prior_sigma_thickness, 0.2);
   EXPECT_EQ(q.max_fingertip_cost, 25.0);
   EXPECT_FALSE(q.shared_hands);
+  EXPECT_EQ(q.keyframe_prior_scale, 10.0);
   EXPECT_EQ(p.silhouette, ShapeSilhouette::kNone);  // the shipped setting
   // An unknown choice names the file, line, key and the choices.
   const auto typo = core::ConfigNode::Parse("personalisation:\n  silhouette: inward\n", "typo.yaml");

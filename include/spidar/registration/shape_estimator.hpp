@@ -32,6 +32,7 @@
 #include <array>
 #include <cstdint>
 #include <future>
+#include <memory>
 #include <opencv2/core/mat.hpp>
 #include <optional>
 #include <vector>
@@ -40,6 +41,10 @@
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/registration/coverage.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
+
+namespace spidar::vision {
+struct SilhouetteDistance;
+}  // namespace spidar::vision
 
 namespace spidar::registration {
 
@@ -104,6 +109,17 @@ struct ShapeEstimatorParams {
   /// fingers hidden behind it, and its length stays unobserved on its own; the other hand's
   /// keyframes measure it too. false: an estimate per hand.
   bool shared_hands = true;
+  /// A re-estimate re-fits each keyframe's pose with the fit's temporal prior toward that
+  /// keyframe's last pose (fingertips and the wrist pixel alone leave a hand's pose
+  /// underdetermined), its σ (RegistrationParams::prior_sigma_*) multiplied by this.
+  ///
+  /// Measured (2026-11-25, night): the prior anchors each keyframe's pose where the fits made with
+  /// earlier sizes put it, so the sizes drift along the strings' flat direction (longer) even
+  /// where the model is exact: started at the true sizes with exact skeleton data
+  /// (test_shape_estimator's feed(), 400 frames), the estimate ends 1.8–13.6 % long at 1, 1.2–2.4 %
+  /// at 10. But in the registration study (anatomical hands) 10 stops the long-narrow user's
+  /// length from converging (0.1972 m for 0.209) and the small user's worsens: not the default.
+  double keyframe_prior_scale = 1.0;
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
@@ -168,6 +184,9 @@ class ShapeEstimator {
     HandObservation observation;
     std::vector<OwnedPixel> owned;  ///< ShapeEstimatorParams::silhouette only
     cv::Mat silhouette;  ///< CV_8UC1, the matte ≥ matte_threshold (ShapeEstimatorParams::silhouette)
+    /// The silhouette's distance transform, made by the first re-estimate that uses it (read only
+    /// from then on, so copies on a re-estimate's thread share it).
+    std::shared_ptr<const vision::SilhouetteDistance> distance;
   };
   /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its
   /// own thread shares nothing with the estimator).
@@ -201,7 +220,8 @@ class ShapeEstimator {
 /// prior_sigma_length_m, prior_sigma_width_m, prior_sigma_thickness, keyframes, min_pose_change,
 /// solve_every, min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m,
 /// freeze_sigma_thickness, max_relative_change,
-/// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, shared_hands.
+/// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, shared_hands,
+/// keyframe_prior_scale.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
