@@ -33,6 +33,7 @@ inline Run run_cli(const std::string& args, const std::string& prefix = "") {
     while (fgets(buf.data(), buf.size(), e)) r.err += buf.data();
     fclose(e);
   }
+  std::remove(err_file.c_str());
   return r;
 }
 

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "run_cli.hpp"
+#include "temp_path.hpp"
 
 #include <chrono>
 #include <cstdlib>
@@ -99,7 +100,7 @@ TEST(Cli, BadArgumentsExitWithCode2AndSayWhat) {
 }
 
 TEST(Cli, DemoWritesItsReport) {
-  const std::string dir = ::testing::TempDir() + "spidar_demo_test_" + std::to_string(getpid());
+  const std::string dir = spidar::test::scratch_path("spidar_demo_test");
   auto r = run("demo --scenario strings --seconds 0.3 --out " + dir);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("calibration"), std::string::npos);
@@ -164,7 +165,7 @@ namespace {
 
 TEST(Cli, DeviceTestOverAPtyServedByEmulateDevice) {
   // emulate-device prints its pty path first; device-test drives the serial backend through it.
-  const std::string out = ::testing::TempDir() + "spidar_emulator_" + std::to_string(getpid());
+  const std::string out = spidar::test::temp_dir("spidar_emulator") + "/emulator";
   const std::string cmd = std::string(SPIDAR_MR) + " emulate-device --pty --seconds 6 >" + out +
                           ".path 2>" + out + ".log &";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
@@ -224,7 +225,7 @@ bool exists(const std::string& path) {
 // cube (the turns come later in the script). Everything runs: simulated device, servo loop,
 // physics, synthetic camera, registration of both hands, rendering, both composites, video.
 TEST(Cli, MixedRealityDemoRunsEndToEnd) {
-  const std::string dir = ::testing::TempDir() + "spidar_mr_demo_" + std::to_string(getpid());
+  const std::string dir = spidar::test::scratch_path("spidar_mr_demo");
   auto r = run("demo --seconds 3 --width 320 --height 240 --out " + dir);
   EXPECT_NE(r.out.find("registration"), std::string::npos);
   const auto j = read_json(dir + "/report.json");
@@ -311,7 +312,7 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
 }
 
 TEST(Cli, MixedRealityDemoRejectsBadSceneAndHandFiles) {
-  const std::string dir = ::testing::TempDir() + "spidar_mr_bad_" + std::to_string(getpid());
+  const std::string dir = spidar::test::temp_dir("spidar_mr_bad") + "/bad";
   // A scene that is not MJCF.
   const std::string bad_scene = dir + "_scene.xml";
   FILE* f = fopen(bad_scene.c_str(), "w");
@@ -385,7 +386,7 @@ TEST(Cli, NonFiniteAndOutOfRangeNumbersAreRefused) {
 // fit row is damage: refused with exit 2 naming fits.csv, line and column.
 TEST(Cli, ReplayOfARecordingWithANonFiniteFitWritesNoNull) {
   namespace fs = std::filesystem;
-  const fs::path d = fs::path(::testing::TempDir()) / ("spidar_nan_fit_" + std::to_string(getpid()));
+  const fs::path d = fs::path(spidar::test::scratch_path("spidar_nan_fit"));
   fs::remove_all(d);
   auto r = run("run --config configs/lab-example.yaml --headless --seconds 1.5 --record " + d.string() +
                " --record-frames png");
@@ -464,7 +465,7 @@ std::string shifted_config(const std::string& dir) {
 // Outputs never lie: a report.json that cannot be written (here a directory stands at its
 // path) is an error naming it, exit 2, never "wrote report.json".
 TEST(Cli, DemoWhoseReportCannotBeWrittenFailsNamingIt) {
-  const std::string dir = ::testing::TempDir() + "spidar_demo_unwritable_" + std::to_string(getpid());
+  const std::string dir = spidar::test::scratch_path("spidar_demo_unwritable");
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir + "/report.json");
   auto r = run("demo --scenario haptic --seconds 0.5 --out " + dir);
@@ -475,7 +476,7 @@ TEST(Cli, DemoWhoseReportCannotBeWrittenFailsNamingIt) {
 }
 
 TEST(Cli, DemoExitsWithCode1WhenTheServoLatchesAFault) {
-  const std::string dir = ::testing::TempDir() + "spidar_demo_fault_" + std::to_string(getpid());
+  const std::string dir = spidar::test::scratch_path("spidar_demo_fault");
   const std::string cfg = shifted_config(dir);
   auto r = run("demo --scenario haptic --seconds 1.5 --config " + cfg + " --out " + dir + "/out");
   EXPECT_EQ(r.code, 1) << r.err << r.out;
@@ -489,7 +490,7 @@ TEST(Cli, DemoExitsWithCode1WhenTheServoLatchesAFault) {
 
 TEST(Cli, DemoEndsCleanlyOnSigint) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::path(::testing::TempDir()) / ("spidar_demo_sigint_" + std::to_string(getpid()));
+  const fs::path dir = fs::path(spidar::test::scratch_path("spidar_demo_sigint"));
   fs::remove_all(dir);
   int err_pipe[2];
   ASSERT_EQ(pipe(err_pipe), 0);
@@ -538,7 +539,7 @@ TEST(Cli, DemoEndsCleanlyOnSigint) {
 // the report and written to OUT/mujoco_log.txt, not to MUJOCO_LOG.TXT in the working directory.
 TEST(Cli, DemoReportsMujocoWarningsInItsOutputFolder) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::path(::testing::TempDir()) / ("spidar_demo_mjwarn_" + std::to_string(getpid()));
+  const fs::path dir = fs::path(spidar::test::scratch_path("spidar_demo_mjwarn"));
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::string scene = slurp_file("scenes/blocks.xml");

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "run_cli.hpp"
+#include "temp_path.hpp"
 
 namespace {
 
@@ -30,12 +31,7 @@ std::string slurp(const fs::path& p) {
   return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("spidar_live_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path temp_dir(const std::string& name) { return fs::path(spidar::test::temp_dir("spidar_live_" + name)); }
 
 Run run(const std::string& args, const std::string& prefix = "") { return spidar::test::run_cli(args, prefix); }
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "temp_path.hpp"
 #include "spidar/core/config.hpp"
 #include "spidar/strings/device_config.hpp"
 #include "spidar/strings/device_config_write.hpp"
@@ -88,7 +89,7 @@ TEST(ConfigWriteBack, ReplacesTheFingersChannelsAndKeepsTheRest) {
 }
 
 TEST(ConfigWriteBack, KeepsThePreviousVersionAndRefusesABrokenConfig) {
-  const fs::path d = fs::path(::testing::TempDir()) / ("spidar_wb_" + std::to_string(getpid()));
+  const fs::path d = fs::path(spidar::test::scratch_path("spidar_wb"));
   fs::remove_all(d);
   fs::create_directories(d);
   const fs::path p = d / "dev.yaml";

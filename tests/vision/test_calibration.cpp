@@ -330,7 +330,7 @@ struct Run {
 };
 
 Run run(const std::string& args) {
-  const std::string err_file = ::testing::TempDir() + "spidar_vision_cli_" + std::to_string(getpid()) + ".txt";
+  static const std::string err_file = spidar::test::temp_dir("spidar_vision_cli") + "/stderr.txt";
   Run r{-1, "", ""};
   FILE* p = popen((std::string(SPIDAR_MR) + " " + args + " 2>" + err_file).c_str(), "r");
   if (!p) return r;
@@ -348,7 +348,8 @@ TEST(CalibrateCameraCli, CalibratesFromRenderedBoardsAndMarkers) {
   const ChessboardPattern p = parse_pattern("9x6", 0.025).value();
   const std::string dir = write_board_images(cam, p, "spidar_vision_cli_boards");
   // Markers seen by the fixed rig camera (exact pixels).
-  const std::string markers = dir + "/../spidar_vision_markers_" + std::to_string(getpid()) + ".yaml";
+  const std::string files = spidar::test::temp_dir("spidar_vision_cli_files");
+  const std::string markers = files + "/markers.yaml";
   {
     std::ofstream f(markers);
     f << "markers:\n";
@@ -357,7 +358,7 @@ TEST(CalibrateCameraCli, CalibratesFromRenderedBoardsAndMarkers) {
       f << "  - {world: [" << m.x() << ", " << m.y() << ", " << m.z() << "], pixel: [" << uv.x() << ", " << uv.y() << "]}\n";
     }
   }
-  const std::string out = dir + "/../spidar_vision_camera_out_" + std::to_string(getpid()) + ".yaml";
+  const std::string out = files + "/camera_out.yaml";
   const auto r = run("calibrate-camera --images " + dir + " --pattern 9x6 --square 0.025 --markers " +
                      markers + " --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -400,7 +401,7 @@ TEST(CalibrateCameraCli, CalibratesFromRenderedBoardsAndMarkers) {
         << ", " << c.z() << "]}\n";
     }
   }
-  const std::string out3 = dir + "/../spidar_vision_camera_three_" + std::to_string(getpid()) + ".yaml";
+  const std::string out3 = files + "/camera_three.yaml";
   const auto ex = run("calibrate-camera --markers " + three + " --base " + out + " --out " + out3);
   ASSERT_EQ(ex.code, 0) << ex.err;
   EXPECT_NE(ex.out.find("\"method\":\"three-marker\""), std::string::npos) << ex.out;

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "spidar/core/units.hpp"
+#include "temp_path.hpp"
 #include "spidar/vision/camera.hpp"
 #include "spidar/vision/camera_config.hpp"
 
@@ -120,7 +121,7 @@ TEST(CameraConfig, SaveLoadRoundTripsExactly) {
   CalibrationNotes notes;
   notes.intrinsics_rms_px = 0.123;
   notes.method = "chessboard + pnp";
-  const std::string path = ::testing::TempDir() + "spidar_vision_camera_" + std::to_string(getpid()) + ".yaml";
+  const std::string path = spidar::test::temp_dir("spidar_vision_camera") + "/camera.yaml";
   ASSERT_TRUE(save_camera_file(path, cam, notes).ok());
   const auto loaded = load_camera_file(path);
   EXPECT_EQ(loaded.calibration.method, notes.method);

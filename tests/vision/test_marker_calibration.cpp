@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "spidar/core/units.hpp"
+#include "temp_path.hpp"
 #include "spidar/vision/camera_config.hpp"
 #include "spidar/vision/marker_calibration.hpp"
 #include "spidar/vision/markers.hpp"
@@ -108,8 +109,7 @@ TEST(MarkerCalibration, MarkersFileFeedsCalibrateCameraToTheSamePose) {
   rig.touch(cal, c + Vec3(-0.12, 0.05, -0.06), Vec2(0.4, -0.3));
   rig.touch(cal, c + Vec3(0.12, 0.07, -0.05), Vec2(-0.5, 0.2));
   rig.touch(cal, c + Vec3(0.0, -0.08, 0.10), Vec2(0.3, 0.5));
-  const std::string path =
-      ::testing::TempDir() + "spidar_markers_" + std::to_string(getpid()) + ".yaml";
+  const std::string path = spidar::test::temp_dir("spidar_markers") + "/markers.yaml";
   std::ofstream(path) << cal.markers_yaml();
   const MarkerSet set = load_markers(path);
   EXPECT_FALSE(set.by_pixel);
