@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "temp_path.hpp"
+#ifdef SPIDAR_MR  // the calibrate-camera CLI test (a build with the app defines it)
+#include "run_cli.hpp"
+#endif
 
 #include <algorithm>
 #include <cstdio>
@@ -324,24 +327,7 @@ TEST(Chessboard, PatternAndFolderErrors) {
 }
 
 #ifdef SPIDAR_MR
-struct Run {
-  int code;
-  std::string out, err;
-};
-
-Run run(const std::string& args) {
-  static const std::string err_file = spidar::test::temp_dir("spidar_vision_cli") + "/stderr.txt";
-  Run r{-1, "", ""};
-  FILE* p = popen((std::string(SPIDAR_MR) + " " + args + " 2>" + err_file).c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p)) r.out += buf;
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err_file);
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
-}
+spidar::test::Run run(const std::string& args) { return spidar::test::run_cli(args); }
 
 TEST(CalibrateCameraCli, CalibratesFromRenderedBoardsAndMarkers) {
   const Camera cam = true_camera();
