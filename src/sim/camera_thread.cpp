@@ -95,6 +95,10 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
       out.film_ms = core::ns_to_s(core::monotonic_ns() - t_start) * 1e3;
       frames_.publish();
       filmed_.fetch_add(1, std::memory_order_acq_rel);
+    } else {
+      // No fingertips yet at this exposure (the device's first samples come later on a busy
+      // machine): an exposure let pass too, so a frame's index gap is always filmed + skipped.
+      skipped_.fetch_add(1, std::memory_order_acq_rel);
     }
     // The next exposure; exposures already past are skipped (a stalled camera drops frames).
     ++index;

@@ -67,8 +67,10 @@ class CameraThread {
   const FilmedFrame& frame() const { return frames_.front(); }
   /// Frames filmed so far.
   std::uint64_t filmed() const { return filmed_.load(std::memory_order_acquire); }
-  /// Exposures this thread let pass without filming them because it was late (on a busy machine
-  /// the simulated camera itself falls behind its rate; a real camera would not).
+  /// Exposures this thread let pass without filming them: because it was late (on a busy machine
+  /// the simulated camera itself falls behind its rate; a real camera would not), or because the
+  /// ground truth had no fingertips yet at that time. Every exposure is filmed or skipped, so the
+  /// index of a frame is the count of both before it.
   std::uint64_t skipped() const { return skipped_.load(std::memory_order_acquire); }
   /// The error that stopped the thread, if any (read after stop()).
   const std::string& error() const { return error_; }
