@@ -25,10 +25,17 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "keyframes", "min_pose_change", "solve_every", "min_keyframes", "iterations",
                     "freeze_sigma_length_m", "freeze_sigma_width_m", "freeze_sigma_thickness",
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
-                    "max_fingertip_cost", "shared_hands", "keyframe_prior_scale"});
+                    "max_fingertip_cost", "shared_hands", "keyframe_prior_scale",
+                    "keyframe_prior"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
+  if (auto b = node.find("keyframe_prior")) {
+    const std::string v = b->as_string();
+    if (v == "taken") p.keyframe_prior = KeyframePrior::kTaken;
+    else if (v == "last") p.keyframe_prior = KeyframePrior::kLast;
+    else b->fail("expected taken or last, got '" + v + "'");
+  }
   if (auto b = node.find("silhouette")) {
     const std::string v = b->as_string();
     if (v == "none" || v == "false") p.silhouette = ShapeSilhouette::kNone;
@@ -210,7 +217,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       ImageEvidence evidence = skeleton_only;
       if (!kf.owned.empty()) evidence.coverage = &kf.owned;
       if (kf.distance && !kf.distance->empty) evidence.distance = kf.distance.get();
-      hand::HandParams prior = kf.q;
+      hand::HandParams prior = p.keyframe_prior == KeyframePrior::kTaken ? kf.q_taken : kf.q;
       FitReport fit = solver.fit(model, kf.observation, evidence, &prior, &kf.q);
       if (p.reach_min_miss_m > 0 &&
           refit_reaching(solver, model, kf.observation, evidence, &prior,
@@ -332,7 +339,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     ++held;
     if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
   }
-  Keyframe kf{hand, next_serial_++, q, observation, {}, {}, {}};
+  Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}};
   if (p_.silhouette != ShapeSilhouette::kNone && !image.alpha.empty() && image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);
   if (p_.silhouette == ShapeSilhouette::kBoth && image.coverage != nullptr) kf.owned = *image.coverage;

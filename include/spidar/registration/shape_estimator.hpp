@@ -55,6 +55,12 @@ enum class ShapeSilhouette {
   kBoth,   ///< also the silhouette pixels the hand owns that the model leaves uncovered (coverage.hpp)
 };
 
+/// Where a re-estimate's refit of a keyframe's pose is pulled (ShapeEstimatorParams::keyframe_prior).
+enum class KeyframePrior {
+  kTaken,  ///< toward the pose the frame's fit gave when the keyframe was taken
+  kLast,   ///< toward the keyframe's pose at the last re-estimate
+};
+
 struct ShapeEstimatorParams {
   double prior_sigma_length_m = 0.015;  ///< σ₀ of the starting profile's length [m]
   double prior_sigma_width_m = 0.008;   ///< σ₀ of its width [m]
@@ -120,6 +126,13 @@ struct ShapeEstimatorParams {
   /// at 10. But in the registration study (anatomical hands) 10 stops the long-narrow user's
   /// length from converging (0.1972 m for 0.209) and the small user's worsens: not the default.
   double keyframe_prior_scale = 1.0;
+  /// The mean of that prior. kLast follows each keyframe's pose from re-estimate to re-estimate,
+  /// so the poses and the sizes walk together along the strings' flat side (a longer hand bends
+  /// its fingers): started at the true sizes, exact skeleton data (test_shape_estimator's feed(),
+  /// linear coupling, 400 frames) end 13.6 % long, and the study's short-wide user (`--model-user
+  /// --personalise`) +9 % long, −14 % wide. kTaken keeps every keyframe's prior where the frame's
+  /// own fit put it: 0.25 % and +1.4 %, −0.3 %: the truth stays (nearly) a fixed point.
+  KeyframePrior keyframe_prior = KeyframePrior::kLast;
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
@@ -180,7 +193,8 @@ class ShapeEstimator {
   struct Keyframe {
     int hand = 0;
     std::uint64_t serial = 0;  ///< order of arrival (the oldest of a hand is replaced)
-    hand::HandParams q;
+    hand::HandParams q;        ///< its pose at the last re-estimate's sizes
+    hand::HandParams q_taken;  ///< the pose the frame's fit gave when it was taken
     HandObservation observation;
     std::vector<OwnedPixel> owned;  ///< ShapeEstimatorParams::silhouette only
     cv::Mat silhouette;  ///< CV_8UC1, the matte ≥ matte_threshold (ShapeEstimatorParams::silhouette)
@@ -221,7 +235,7 @@ class ShapeEstimator {
 /// solve_every, min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m,
 /// freeze_sigma_thickness, max_relative_change,
 /// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, shared_hands,
-/// keyframe_prior_scale.
+/// keyframe_prior_scale, keyframe_prior (taken or last).
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
