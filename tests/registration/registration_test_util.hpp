@@ -184,6 +184,17 @@ inline void film_and_key(sim::SyntheticCamera& camera, const std::array<hand::Ha
   ASSERT_TRUE(vision::silhouette_distance(out->key.silhouette, &out->distance, opt).ok());
 }
 
+/// Fingertips as the strings measure them, exactly: the model's caps at `q`, all valid.
+inline HandObservation exact_caps(const hand::HandModel& model, const hand::HandParams& q) {
+  const hand::HandPoints pts = hand::forward_kinematics(model, q);
+  HandObservation obs;
+  for (int f = 0; f < hand::kFingertipCount; ++f) {
+    obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
+    obs.fingertip_valid[f] = true;
+  }
+  return obs;
+}
+
 /// Fingertips as the strings measure them: the true caps plus Gaussian noise [m] per axis.
 inline HandObservation observe(const hand::HandModel& truth_model, const hand::HandParams& truth,
                                const vision::BraceletObservation& bracelet, std::mt19937& rng,

@@ -17,16 +17,6 @@
 namespace spidar::registration {
 namespace {
 
-HandObservation caps_of(const hand::HandModel& model, const hand::HandParams& q) {
-  const hand::HandPoints pts = hand::forward_kinematics(model, q);
-  HandObservation obs;
-  for (int f = 0; f < hand::kFingertipCount; ++f) {
-    obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
-    obs.fingertip_valid[f] = true;
-  }
-  return obs;
-}
-
 /// A random pose of every digit within the limits (the wrist as given).
 hand::HandParams random_digits(const hand::HandModel& model, const hand::HandParams& base, std::mt19937* rng) {
   hand::HandParams q = base;
@@ -44,7 +34,7 @@ TEST(FingertipReach, ReachesEveryReachableCapFromStraightFingers) {
   double worst_mm = 0;
   for (int trial = 0; trial < 40; ++trial) {
     const hand::HandParams truth = random_digits(model, base, &rng);
-    const HandObservation obs = caps_of(model, truth);
+    const HandObservation obs = test::exact_caps(model, truth);
     // Start: every digit straight (distal at its lower limit), flexion and abduction elsewhere.
     hand::HandParams q = random_digits(model, base, &rng);
     for (int f = 0; f < hand::kFingertipCount; ++f) {
@@ -73,7 +63,7 @@ TEST(FingertipReach, AnUnreachableCapEndsAsNearAsABruteForceGridFinds) {
   const hand::HandParams base = test::reaching_hands(0)[1];
   const hand::HandPoints pts = hand::forward_kinematics(model, base);
   for (int f = hand::kIndex; f <= hand::kRing; ++f) {
-    HandObservation obs = caps_of(model, base);
+    HandObservation obs = test::exact_caps(model, base);
     // 2 cm beyond the finger's reach along the hand's axis, and 1 cm dorsal.
     const Pose X_WH = hand::hand_pose(base);
     obs.p_W_fingertip[f] = pts.p_W_fingertip[f] + X_WH.R * Vec3(0.0, 0.02, 0.01);
@@ -105,7 +95,7 @@ TEST(FingertipReach, AnUnreachableCapEndsAsNearAsABruteForceGridFinds) {
 TEST(FingertipReach, LeavesNearCapsUnmeasuredCapsAndBrokenPosesAlone) {
   const hand::HandModel model = hand::default_hand_model(hand::Side::kRight);
   const hand::HandParams base = test::reaching_hands(0)[1];
-  HandObservation obs = caps_of(model, base);
+  HandObservation obs = test::exact_caps(model, base);
   obs.p_W_fingertip[hand::kIndex] += Vec3(0.0005, 0, 0);  // 0.5 mm off: within min_miss
   obs.fingertip_valid[hand::kMiddle] = false;
   obs.p_W_fingertip[hand::kMiddle] += Vec3(0.03, 0, 0);
@@ -116,7 +106,7 @@ TEST(FingertipReach, LeavesNearCapsUnmeasuredCapsAndBrokenPosesAlone) {
   EXPECT_EQ(q.q, base.q);
   hand::HandParams broken = base;
   broken[hand::kIndexDip] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(reach_fingertips(model, caps_of(model, base), {}, &broken).changed_count(), 0);
+  EXPECT_EQ(reach_fingertips(model, test::exact_caps(model, base), {}, &broken).changed_count(), 0);
   EXPECT_EQ(reach_fingertips(model, obs, {}, nullptr).changed_count(), 0);
 }
 
@@ -130,7 +120,7 @@ TEST(FingertipReach, TheRefitLeavesTheBasinTheTemporalPriorHolds) {
   truth[hand::kIndexMcpFlexion] = 0.2;
   truth[hand::kIndexDip] = 1.2;
   truth = hand::clamp_to_limits(truth, model.limits);
-  const HandObservation obs = caps_of(model, truth);
+  const HandObservation obs = test::exact_caps(model, truth);
   hand::HandParams held = truth;
   held[hand::kIndexDip] = model.limits.lower[hand::kIndexDip];
   double nearest = std::numeric_limits<double>::infinity();

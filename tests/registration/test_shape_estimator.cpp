@@ -90,6 +90,32 @@ Outcome run(double length_m, double width_m, int frames, std::uint32_t seed,
   return feed(est, 0, truth, test::reaching_hands(0)[1], frames, seed, silhouette);
 }
 
+/// Started at the true sizes of a default-sized hand with linear coupling, on exact skeleton data
+/// (feed(), 400 frames): the estimate's relative length error at the end, printed under `label`.
+double drift_from_the_truth(const ShapeEstimatorParams& sp, const char* label) {
+  const hand::HandModel truth =
+      resized(hand::default_hand_model(hand::Side::kRight, hand::Coupling::kLinear), 0.1976, 0.0825).value();
+  ShapeEstimator est(truth, sp);
+  const Outcome o = feed(est, 0, truth, test::reaching_hands(0)[1], 400, 7);
+  std::printf("%s: L %.4f W %.4f from the truth 0.1976, 0.0825 (%d solves)\n", label, o.estimate.length_m,
+              o.estimate.width_m, o.estimate.solves);
+  EXPECT_GE(o.estimate.solves, 1) << label;
+  return o.estimate.length_m / 0.1976 - 1;
+}
+
+/// Parsing `text` (file `file`) fails with a message naming file:2 and `want`.
+void expect_parse_error(const std::string& text, const std::string& file, const std::string& want) {
+  const auto node = core::ConfigNode::Parse(text, file);
+  bool enabled = false;
+  try {
+    parse_shape_estimator_params(node["personalisation"], &enabled);
+    ADD_FAILURE() << "accepted " << text;
+  } catch (const core::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(file + ":2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << want << ": " << e.what();
+  }
+}
+
 class KnownSizes : public ::testing::TestWithParam<std::pair<double, double>> {};
 
 TEST_P(KnownSizes, LengthMovesTowardTheTruthAsEvidenceAccumulates) {
@@ -207,12 +233,7 @@ TEST(ShapeEstimator, AFrameWithoutTheBraceletsWristIsNoKeyframe) {
   const hand::HandModel right = hand::default_hand_model(hand::Side::kRight);
   const vision::Camera camera = vision::default_rig_camera();
   const hand::HandParams q = test::reaching_hands(0)[1];
-  const hand::HandPoints pts = hand::forward_kinematics(right, q);
-  HandObservation obs;
-  for (int f = 0; f < hand::kFingertipCount; ++f) {
-    obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
-    obs.fingertip_valid[f] = true;
-  }
+  HandObservation obs = test::exact_caps(right, q);
   ImageEvidence image;
   image.camera = &camera;
   ShapeEstimator est(right, {});
@@ -235,40 +256,22 @@ TEST(ShapeEstimator, AFrameWithoutTheBraceletsWristIsNoKeyframe) {
 // pose is re-fitted with a prior toward where the fits made with earlier sizes put it
 // (ShapeEstimatorParams::keyframe_prior_scale). A wider prior drifts less.
 TEST(ShapeEstimator, AWiderKeyframePriorDriftsLessFromTheTruth) {
-  const hand::HandModel truth =
-      resized(hand::default_hand_model(hand::Side::kRight, hand::Coupling::kLinear), 0.1976, 0.0825).value();
-  double drift[2] = {0, 0};
-  for (int i = 0; i < 2; ++i) {
-    ShapeEstimatorParams sp;
-    sp.keyframe_prior_scale = i == 0 ? 1.0 : 10.0;
-    ShapeEstimator est(truth, sp);
-    const Outcome o = feed(est, 0, truth, test::reaching_hands(0)[1], 400, 7);
-    drift[i] = o.estimate.length_m / 0.1976 - 1;
-    std::printf("keyframe prior ×%.0f: L %.4f W %.4f from the truth 0.1976, 0.0825 (%d solves)\n",
-                sp.keyframe_prior_scale, o.estimate.length_m, o.estimate.width_m, o.estimate.solves);
-    EXPECT_GE(o.estimate.solves, 1);
-  }
-  EXPECT_LT(std::abs(drift[1]), std::abs(drift[0]));
+  ShapeEstimatorParams wide;
+  wide.keyframe_prior_scale = 10.0;
+  const double drift_1 = drift_from_the_truth({}, "keyframe prior ×1");
+  const double drift_10 = drift_from_the_truth(wide, "keyframe prior ×10");
+  EXPECT_LT(std::abs(drift_10), std::abs(drift_1));
 }
 
 // The same start at the truth with the keyframes' prior kept where each frame's fit put it
 // (KeyframePrior::kTaken): the truth stays a fixed point of the estimate.
 TEST(ShapeEstimator, APriorAtTheTakenPoseKeepsTheTruthAFixedPoint) {
-  const hand::HandModel truth =
-      resized(hand::default_hand_model(hand::Side::kRight, hand::Coupling::kLinear), 0.1976, 0.0825).value();
-  double drift[2] = {0, 0};
-  for (int i = 0; i < 2; ++i) {
-    ShapeEstimatorParams sp;
-    sp.keyframe_prior = i == 0 ? KeyframePrior::kLast : KeyframePrior::kTaken;
-    ShapeEstimator est(truth, sp);
-    const Outcome o = feed(est, 0, truth, test::reaching_hands(0)[1], 400, 7);
-    drift[i] = o.estimate.length_m / 0.1976 - 1;
-    std::printf("keyframe prior at the %s pose: L %.4f W %.4f from the truth 0.1976, 0.0825 (%d solves)\n",
-                i == 0 ? "last" : "taken", o.estimate.length_m, o.estimate.width_m, o.estimate.solves);
-    EXPECT_GE(o.estimate.solves, 1);
-  }
-  EXPECT_LT(std::abs(drift[1]), 0.01);  // measured 2026-11-25: +0.25 % (kLast: +13.6 %)
-  EXPECT_LT(std::abs(drift[1]), std::abs(drift[0]));
+  ShapeEstimatorParams taken;
+  taken.keyframe_prior = KeyframePrior::kTaken;
+  const double drift_last = drift_from_the_truth({}, "keyframe prior at the last pose");
+  const double drift_taken = drift_from_the_truth(taken, "keyframe prior at the taken pose");
+  EXPECT_LT(std::abs(drift_taken), 0.01);  // measured 2026-11-25: +0.25 % (kLast: +13.6 %)
+  EXPECT_LT(std::abs(drift_taken), std::abs(drift_last));
 }
 
 TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
@@ -291,26 +294,11 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.shared_hands, d.shared_hands);
   EXPECT_EQ(p.keyframe_prior_scale, d.keyframe_prior_scale);
   EXPECT_EQ(p.keyframe_prior, d.keyframe_prior);
-  const auto bad = core::ConfigNode::Parse("personalisation:\n  min_pose_change: -1\n", "bad.yaml");
-  try {
-    parse_shape_estimator_params(bad["personalisation"], &enabled);
-    FAIL() << "accepted a negative pose change";
-  } catch (const core::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("min_pose_change"), std::string::npos) << e.what();
-  }
+  expect_parse_error("personalisation:\n  min_pose_change: -1\n", "bad.yaml", "min_pose_change");
   for (const std::string key :
-       {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost", "keyframe_prior_scale"}) {
-    const std::string text = "personalisation:\n  " + key + (key == "reach_min_miss_m" ? ": 0.5\n" : ": -1\n");
-    const auto node = core::ConfigNode::Parse(text, "bad.yaml");
-    try {
-      parse_shape_estimator_params(node["personalisation"], &enabled);
-      FAIL() << "accepted " << text;
-    } catch (const core::ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find("bad.yaml:2"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << key << ": " << e.what();
-    }
-  }
+       {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost", "keyframe_prior_scale"})
+    expect_parse_error("personalisation:\n  " + key + (key == "reach_min_miss_m" ? ": 0.5\n" : ": -1\n"),
+                       "bad.yaml", key);
   const auto on = core::ConfigNode::Parse(
       "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n"
       "  max_fingertip_cost: 25\n  shared_hands: false\n  keyframe_prior_scale: 10\n"
@@ -325,30 +313,9 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(q.keyframe_prior, KeyframePrior::kTaken);
   EXPECT_EQ(p.silhouette, ShapeSilhouette::kNone);  // the shipped setting
   // An unknown choice names the file, line, key and the choices.
-  const auto typo = core::ConfigNode::Parse("personalisation:\n  silhouette: inward\n", "typo.yaml");
-  try {
-    parse_shape_estimator_params(typo["personalisation"], &enabled);
-    FAIL() << "accepted silhouette: inward";
-  } catch (const core::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("typo.yaml:2"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("none, spill or both"), std::string::npos) << e.what();
-  }
-  const auto where = core::ConfigNode::Parse("personalisation:\n  keyframe_prior: first\n", "where.yaml");
-  try {
-    parse_shape_estimator_params(where["personalisation"], &enabled);
-    FAIL() << "accepted keyframe_prior: first";
-  } catch (const core::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("where.yaml:2"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("taken or last"), std::string::npos) << e.what();
-  }
-  const auto maybe = core::ConfigNode::Parse("personalisation:\n  shared_hands: sometimes\n", "maybe.yaml");
-  try {
-    parse_shape_estimator_params(maybe["personalisation"], &enabled);
-    FAIL() << "accepted shared_hands: sometimes";
-  } catch (const core::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("maybe.yaml:2"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("shared_hands"), std::string::npos) << e.what();
-  }
+  expect_parse_error("personalisation:\n  silhouette: inward\n", "typo.yaml", "none, spill or both");
+  expect_parse_error("personalisation:\n  keyframe_prior: first\n", "where.yaml", "taken or last");
+  expect_parse_error("personalisation:\n  shared_hands: sometimes\n", "maybe.yaml", "shared_hands");
 }
 
 }  // namespace
