@@ -245,6 +245,7 @@ TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
   p.bracelet = vc.bracelet;
   p.personalise_shape = true;
   p.shape_estimator.min_pose_change = 0.02;  // keyframes from a short stretch of the script
+  p.shape_estimator.shared_hands = true;     // one estimate for both hands (checked below)
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models_);
   const double t0 = 1.8;
