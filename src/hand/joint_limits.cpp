@@ -56,8 +56,8 @@ ParamLimits parameter_limits(const JointRanges& r, Coupling coupling) {
   set(kThumbCmcFlexion, r.thumb_cmc_flexion.lo, r.thumb_cmc_flexion.hi);
   set(kThumbCmcAbduction, r.thumb_cmc_abduction.lo, r.thumb_cmc_abduction.hi);
   distal(kThumbIp, r.thumb_mcp_flexion, r.thumb_ip_flexion);
-  for (int f : {kIndex, kMiddle, kRing}) {
-    const auto d = digit_params(f);
+  for (const auto& d : {digit_params(kIndex), digit_params(kMiddle), digit_params(kRing),
+                        digit_params(kLittle, true)}) {
     set(d.flexion, r.mcp_flexion.lo, r.mcp_flexion.hi);
     if (d.abduction >= 0) set(d.abduction, r.mcp_abduction.lo, r.mcp_abduction.hi);
     distal(d.distal, r.pip_flexion, r.dip_flexion);

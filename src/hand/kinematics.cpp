@@ -108,7 +108,7 @@ DigitLocal thumb_local(const HandShape& s, double flex, double abd, double dista
   return out;
 }
 
-// Writes the 3×17 block of one point: wrist translation, wrist rotation, the digit's columns.
+// Writes the 3×20 block of one point: wrist translation, wrist rotation, the digit's columns.
 template <typename Derived>
 void write_jacobian(Eigen::MatrixBase<Derived>& J, int row, const Mat3& J_rot, const Mat3& A,
                     const Mat3& dp_H, const DigitParams& cols) {
@@ -152,11 +152,10 @@ void forward_kinematics(const HandModel& model, const HandParams& params, HandPo
   if (points) points->p_W_joint[kWristJoint] = p_W_wrist;
 
   for (int f = 0; f < kFingerCount; ++f) {
-    const DigitParams cols = digit_params(f);
-    const bool own_little = f == kLittle && params.little_independent;
-    const double flex = own_little ? params.little.x() : q[cols.flexion];
-    const double abd = own_little ? params.little.y() : (cols.abduction >= 0 ? q[cols.abduction] : 0.0);
-    const double distal = own_little ? params.little.z() : q[cols.distal];
+    const DigitParams cols = digit_params(f, params.little_independent);
+    const double flex = q[cols.flexion];
+    const double abd = cols.abduction >= 0 ? q[cols.abduction] : 0.0;
+    const double distal = q[cols.distal];
     const DigitLocal local =
         f == kThumb ? thumb_local(model.shape, flex, abd, distal, model.coupling, offset, derivs)
                     : finger_local(model.shape.digits[f], flex, abd, distal, model.coupling, offset,
@@ -177,9 +176,7 @@ void forward_kinematics(const HandModel& model, const HandParams& params, HandPo
       if (is_cap && J_fingertips) {
         write_jacobian(*J_fingertips, 3 * f, J_rot, A, local.dp[k], cols);
       } else if (!is_cap && J_joints) {
-        // An independent little finger depends on the wrist only (its own angles are not in q).
-        write_jacobian(*J_joints, 3 * joint_index(f, k), J_rot, A,
-                       own_little ? Mat3::Zero().eval() : local.dp[k], cols);
+        write_jacobian(*J_joints, 3 * joint_index(f, k), J_rot, A, local.dp[k], cols);
       }
     }
   }

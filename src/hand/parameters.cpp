@@ -19,11 +19,15 @@ std::string_view param_name(int param) {
                                                                        "middle_dip",
                                                                        "ring_mcp_flexion",
                                                                        "ring_mcp_abduction",
-                                                                       "ring_dip"};
+                                                                       "ring_dip",
+                                                                       "little_mcp_flexion",
+                                                                       "little_mcp_abduction",
+                                                                       "little_dip"};
   return (param >= 0 && param < kParamCount) ? kNames[param] : std::string_view("invalid");
 }
 
-DigitParams digit_params(int finger) {
+DigitParams digit_params(int finger, bool little_independent) {
+  if (finger == kLittle && little_independent) return {kLittleMcpFlexion, kLittleMcpAbduction, kLittleDip};
   switch (finger) {
     case kThumb:
       return {kThumbCmcFlexion, kThumbCmcAbduction, kThumbIp};

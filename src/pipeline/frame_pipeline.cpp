@@ -29,7 +29,7 @@ hand::HandParams cold_start(const hand::HandModel& model, const Vec3& r_W_hand,
   hand::HandParams q;
   q.set_wrist(Vec3::Zero(), r_W_hand);
   for (int p = hand::kThumbCmcFlexion; p < hand::kParamCount; ++p) q[p] = 0.3;
-  q[hand::kIndexMcpAbduction] = q[hand::kRingMcpAbduction] = 0.0;
+  q[hand::kIndexMcpAbduction] = q[hand::kRingMcpAbduction] = q[hand::kLittleMcpAbduction] = 0.0;
   q = hand::clamp_to_limits(q, model.limits);
   const hand::HandPoints pts = hand::forward_kinematics(model, q);
   Vec3 model_mean = Vec3::Zero(), measured_mean = Vec3::Zero();

@@ -11,7 +11,7 @@
 
 namespace spidar::registration::detail {
 
-enum class Term { kFingertip, kWrist, kJointBall, kSilhouette };
+enum class Term { kFingertip, kWrist, kJointBall, kSilhouette, kPrior };
 
 /// Points nearer the camera plane than this [m] are left out of the image terms.
 inline constexpr double kMinImageDepth = 0.01;
@@ -190,13 +190,35 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
     }
   }
 
-  // The temporal prior, per parameter.
+  // The temporal prior, per parameter: the paper's 17, and the little finger's own where it
+  // moves on its own (toward the prior's little finger, or its ring finger's angles where the
+  // prior's little finger copied them).
   if (pr.prior) {
-    for (int i = 0; i < hand::kParamCount; ++i) {
-      const double mean = (*pr.prior)[i];
+    const int n = q.little_independent ? hand::kParamCount : hand::kPaperParamCount;
+    for (int i = 0; i < n; ++i) {
+      const int from = i >= hand::kPaperParamCount && !pr.prior->little_independent
+                           ? i - hand::kLittleMcpFlexion + hand::kRingMcpFlexion
+                           : i;
+      const double mean = (*pr.prior)[from];
       if (!std::isfinite(mean)) continue;
       const double w = 1.0 / prior_sigma(rp, i);
       sink.add_prior(i, w * (q[i] - mean), w);
+    }
+  }
+  // A little finger of its own stays near the ring finger's angles (no string measures it).
+  if (q.little_independent) {
+    const double w = 1.0 / rp.little_coupling_sigma_rad;
+    for (int k = 0; k < 3; ++k) {
+      const int little = hand::kLittleMcpFlexion + k, ring = hand::kRingMcpFlexion + k;
+      const Block<1> r = Block<1>::Constant(w * (q[little] - q[ring]));
+      if constexpr (kJacobian) {
+        BlockJacobian<1> J = BlockJacobian<1>::Zero();
+        J(0, little) = w;
+        J(0, ring) = -w;
+        sink.template add<1>(Term::kPrior, r, &J);
+      } else {
+        sink.template add<1>(Term::kPrior, r, nullptr);
+      }
     }
   }
 }
@@ -208,6 +230,7 @@ inline void add_cost(TermCosts* c, Term t, double squared) {
     case Term::kWrist: c->wrist += squared; break;
     case Term::kJointBall: c->joint_ball += squared; break;
     case Term::kSilhouette: c->silhouette += squared; break;
+    case Term::kPrior: c->prior += squared; break;
   }
 }
 

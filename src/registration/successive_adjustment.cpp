@@ -10,7 +10,7 @@
 namespace spidar::registration {
 namespace {
 
-using Mat17 = Eigen::Matrix<double, hand::kParamCount, hand::kParamCount>;
+using MatParams = Eigen::Matrix<double, hand::kParamCount, hand::kParamCount>;
 
 /// λ never drops below / rises above these (a rejected step at λ = 0 must still grow it).
 constexpr double kLambdaMin = 1e-9;
@@ -18,8 +18,8 @@ constexpr double kLambdaMax = 1e9;
 
 /// Solves (A + λ diag(A) + ε I) Δ = b. The tiny ridge ε keeps directions no term observes (e.g.
 /// all image terms off and no prior) at Δ = 0, which is what A⁺b gives there.
-hand::ParamVec damped_step(const Mat17& A, const hand::ParamVec& b, double lambda) {
-  Mat17 M = A;
+hand::ParamVec damped_step(const MatParams& A, const hand::ParamVec& b, double lambda) {
+  MatParams M = A;
   const double ridge = 1e-12 * std::max(1.0, A.diagonal().maxCoeff());
   M.diagonal().array() += lambda * A.diagonal().array() + ridge;
   return M.ldlt().solve(b);
@@ -39,7 +39,13 @@ FitReport SuccessiveAdjustment::fit(const hand::HandModel& model,
   const RegistrationParams& rp = params_;
   const ResidualProblem problem{&model, &observation, &image, prior, &rp};
 
-  hand::HandParams q = hand::clamp_to_limits(*params, model.limits);
+  hand::HandParams q = *params;
+  // The little finger moves on its own with our method (little_free and the silhouette term that
+  // observes it), starting from the ring finger's angles if it copied them; else it copies them.
+  const bool free_little = little_moves_freely(rp);
+  if (free_little && !q.little_independent) q.set_little(q.ring());
+  q.little_independent = free_little;
+  q = hand::clamp_to_limits(q, model.limits);
   FrozenTargets targets;
   detail::PoseState state;
   detail::NormalEquationsSink eq;
@@ -67,8 +73,8 @@ FitReport SuccessiveAdjustment::fit(const hand::HandModel& model,
       lambda = std::min(std::max(lambda, kLambdaMin) * 10.0, kLambdaMax);
       continue;
     }
-    hand::HandParams candidate;
-    candidate.q = q.q + delta;
+    hand::HandParams candidate = q;
+    candidate.q += delta;
     candidate = hand::clamp_to_limits(candidate, model.limits);
     const double step = (candidate.q - q.q).norm();
     const double candidate_cost = term_costs(problem, targets, candidate).total();

@@ -41,7 +41,7 @@ std::vector<std::string> scene_columns() { return {"frame", "shape", "px", "py",
 std::vector<std::string> fit_columns() {
   std::vector<std::string> c = {"frame",      "hand",       "iterations", "converged", "finite", "cost_initial",
                                 "cost_final", "fingertip",  "wrist",      "joint_ball", "silhouette", "prior"};
-  for (int i = 0; i < hand::kParamCount; ++i) c.push_back("q" + std::to_string(i));
+  for (int i = 0; i < hand::kPaperParamCount; ++i) c.push_back("q" + std::to_string(i));
   return c;
 }
 

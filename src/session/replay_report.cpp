@@ -68,8 +68,10 @@ void ReplayScorer::on_frame(const FrameEvent& e) {
       ++f_.broken_fits;
       continue;
     }
-    const hand::ParamVec q = Eigen::Map<const hand::ParamVec>(fit.q.data());
-    const double dq = finite_or_zero((result.hands[h].q - q).cwiseAbs().maxCoeff());
+    // The paper's 17 parameters (a recording does not store a little finger of its own).
+    const auto q = Eigen::Map<const Eigen::Matrix<double, hand::kPaperParamCount, 1>>(fit.q.data());
+    const double dq =
+        finite_or_zero((result.hands[h].q.head<hand::kPaperParamCount>() - q).cwiseAbs().maxCoeff());
     f_.max_dq = std::max(f_.max_dq, dq);
     f_.sum_dq += dq;
     ++f_.compared_hands;

@@ -33,7 +33,7 @@ FitRow fit_row(std::int64_t frame, int hand, const registration::FitReport& r, c
   row.cost_initial = r.cost_initial;
   row.cost_final = r.cost_final;
   row.terms = {r.terms.fingertip, r.terms.wrist, r.terms.joint_ball, r.terms.silhouette, r.terms.prior};
-  for (int i = 0; i < hand::kParamCount; ++i) row.q[static_cast<std::size_t>(i)] = p.q[i];
+  for (int i = 0; i < hand::kPaperParamCount; ++i) row.q[static_cast<std::size_t>(i)] = p.q[i];
   row.length_m = sizes.length;
   row.width_m = sizes.width;
   return row;  // the writer marks a row with a NaN or infinity as not finite

@@ -55,9 +55,8 @@ HandBoneFrames hand_bone_frames(const hand::HandModel& model, const hand::HandPa
   // Fingers: abduction turns the digit about ±z_H; flexion then bends it about −v, v = u × z_H.
   for (int f = hand::kIndex; f <= hand::kLittle; ++f) {
     const hand::DigitShape& d = s.digits[f];
-    const hand::DigitParams cols = hand::digit_params(f);
-    const bool own = f == hand::kLittle && params.little_independent;
-    const double abd = own ? params.little.y() : (cols.abduction >= 0 ? params[cols.abduction] : 0.0);
+    const hand::DigitParams cols = hand::digit_params(f, params.little_independent);
+    const double abd = cols.abduction >= 0 ? params[cols.abduction] : 0.0;
     const double beta = d.abduction_sign * abd;
     const Vec3 z = Vec3::UnitZ();
     const Vec3 u0 = d.R_H_digit.col(1);

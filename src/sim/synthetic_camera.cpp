@@ -152,10 +152,10 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
       const double t = static_cast<double>(k) / samples;
       for (int h = 0; h < 2; ++h) {
         if (!poses[h] || !(*previous)[h]) continue;
-        blended[h] = *poses[h];  // the little finger's own angles too
-        blended[h].q = (1 - t) * (*previous)[h]->q + t * poses[h]->q;
-        if ((*previous)[h]->little_independent == poses[h]->little_independent)
-          blended[h].little = (1 - t) * (*previous)[h]->little + t * poses[h]->little;
+        blended[h] = *poses[h];
+        blended[h].q = (1 - t) * (*previous)[h]->q + t * poses[h]->q;  // the little's own angles too
+        if ((*previous)[h]->little_independent != poses[h]->little_independent)
+          blended[h].set_little(poses[h]->little());  // unused before: no motion to blend
         at[h] = &blended[h];
       }
     }

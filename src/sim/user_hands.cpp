@@ -76,13 +76,11 @@ void UserHands::update(double t, std::span<const Vec3> caps) {
     for (int r = 0; r < p_.extra_rounds && mean_cap_distance(truth_[h], q_[h], obs) > p_.target_residual_m; ++r)
       solver_.fit(pushed_[h], obs, registration::ImageEvidence{}, &nominal, &q_[h]);
     q_[h].little_independent = true;
-    q_[h].little = Vec3(q_[h][hand::kRingMcpFlexion], q_[h][hand::kRingMcpAbduction],
-                        q_[h][hand::kRingDip]) +
-                   p_.little_offset + Vec3(p_.little_sway * std::sin(2 * units::kPi * 0.7 * t), 0, 0);
     const auto& lim = truth_[h].limits;
-    q_[h].little.x() = std::clamp(q_[h].little.x(), lim.lower[hand::kRingMcpFlexion], lim.upper[hand::kRingMcpFlexion]);
-    q_[h].little.y() = std::clamp(q_[h].little.y(), lim.lower[hand::kRingMcpAbduction], lim.upper[hand::kRingMcpAbduction]);
-    q_[h].little.z() = std::clamp(q_[h].little.z(), lim.lower[hand::kRingDip], lim.upper[hand::kRingDip]);
+    Vec3 little = q_[h].ring() + p_.little_offset + Vec3(p_.little_sway * std::sin(2 * units::kPi * 0.7 * t), 0, 0);
+    for (int i = 0; i < 3; ++i)
+      little[i] = std::clamp(little[i], lim.lower[hand::kLittleMcpFlexion + i], lim.upper[hand::kLittleMcpFlexion + i]);
+    q_[h].set_little(little);
     residual_[h] = mean_cap_distance(truth_[h], q_[h], obs);
   }
   first_ = false;

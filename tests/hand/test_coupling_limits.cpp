@@ -166,7 +166,8 @@ TEST(JointLimits, ValidationNamesTheRange) {
 TEST(Parameters, NamesAndDigits) {
   EXPECT_EQ(param_name(kIndexMcpAbduction), "index_mcp_abduction");
   EXPECT_EQ(param_name(kRingDip), "ring_dip");
-  EXPECT_EQ(param_name(17), "invalid");
+  EXPECT_EQ(param_name(kLittleDip), "little_dip");
+  EXPECT_EQ(param_name(kParamCount), "invalid");
   EXPECT_EQ(joint_name(joint_index(kThumb, 0)), "thumb_cmc");
   EXPECT_EQ(joint_name(joint_index(kIndex, 1)), "index_pip");
   EXPECT_EQ(joint_name(joint_index(kLittle, 3)), "little_tip");
@@ -174,11 +175,14 @@ TEST(Parameters, NamesAndDigits) {
   EXPECT_EQ(digit_params(kMiddle).abduction, -1);
   EXPECT_EQ(digit_params(kLittle).flexion, kRingMcpFlexion);
   EXPECT_EQ(digit_params(kLittle).distal, kRingDip);
-  // Every parameter belongs to exactly one of the wrist and the four measured digits.
+  EXPECT_EQ(digit_params(kLittle, true).flexion, kLittleMcpFlexion);
+  EXPECT_EQ(digit_params(kRing, true).flexion, kRingMcpFlexion);
+  // Every parameter belongs to exactly one of the wrist and the five digits with a little finger
+  // of its own; the paper's 17 to the wrist and the four measured digits.
   int count[kParamCount] = {};
   for (int i = kWristX; i <= kWristRotZ; ++i) ++count[i];
-  for (int f = kThumb; f <= kRing; ++f) {
-    const auto d = digit_params(f);
+  for (int f = kThumb; f <= kLittle; ++f) {
+    const auto d = digit_params(f, true);
     ++count[d.flexion];
     ++count[d.distal];
     if (d.abduction >= 0) ++count[d.abduction];

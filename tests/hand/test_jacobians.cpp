@@ -247,8 +247,8 @@ TEST(RotationVector, ExpAndLeftJacobian) {
 namespace spidar::hand {
 namespace {
 
-// A ground-truth hand's own little finger: its joints follow `little`, not the ring's parameters,
-// and the Jacobians (which have no column for it) still match central differences.
+// A little finger of its own: its joints follow q[17..19], not the ring's parameters; the
+// Jacobians' columns for them (and the ring's, which no longer move it) match central differences.
 TEST(JacobianStructure, IndependentLittleFingerMatchesCentralDifferences) {
   std::mt19937 rng(7);
   for (auto side : {Side::kLeft, Side::kRight}) {
@@ -256,8 +256,15 @@ TEST(JacobianStructure, IndependentLittleFingerMatchesCentralDifferences) {
     for (int trial = 0; trial < 5; ++trial) {
       HandParams q = testing::random_params(m, rng);
       q.little_independent = true;
-      q.little = Vec3(0.9, -0.1, 0.4);
+      q.set_little(Vec3(0.9, -0.1, 0.4));
       check_3d(m, q);
+      JointJacobian Jj;
+      forward_kinematics(m, q, nullptr, nullptr, &Jj);
+      for (int k = 1; k < 4; ++k) {
+        const int row = 3 * joint_index(kLittle, k);
+        EXPECT_TRUE((Jj.block<3, 3>(row, kRingMcpFlexion).isZero(0.0))) << "little joint " << k;
+        EXPECT_FALSE((Jj.block<3, 1>(row, kLittleMcpFlexion).isZero(1e-9))) << "little joint " << k;
+      }
       HandParams copy = q;
       copy.little_independent = false;
       const HandPoints a = forward_kinematics(m, q);

@@ -50,9 +50,20 @@ void make_case(int side, std::uint32_t seed, Case* c) {
 TEST(ResidualJacobian, MatchesCentralDifferences) {
   int palm_points = 0;  // coverage points held by the palm box, over all cases
   for (int side = 0; side < 2; ++side) {
-    for (std::uint32_t seed : {1u, 2u, 3u}) {
+    for (std::uint32_t seed : {1u, 2u, 3u, 4u}) {
       Case c;
       make_case(side, seed, &c);
+      if (seed >= 3) {
+        // A little finger of its own (registration's little_free): its columns, its prior (seed
+        // 3: from a prior whose little finger copied the ring; 4: its own) and the coupling rows.
+        c.params.little_free = true;
+        c.q.little_independent = true;
+        c.q.set_little(c.q.ring() + Vec3(0.2, -0.05, 0.1));
+        if (seed == 4) {
+          c.prior.little_independent = true;
+          c.prior.set_little(c.prior.ring() + Vec3(-0.1, 0.05, 0.15));
+        }
+      }
       ImageEvidence image = c.mask.evidence(&c.camera, true);
       image.coverage = &c.owned;
       const ResidualProblem pr{&c.model, &c.obs, &image, &c.prior, &c.params};

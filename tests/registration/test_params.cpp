@@ -58,6 +58,8 @@ TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
   EXPECT_EQ(p.coverage_stride_px, d.coverage_stride_px);
   EXPECT_EQ(p.coverage_max_px, d.coverage_max_px);
   EXPECT_EQ(p.coverage_huber_px, d.coverage_huber_px);
+  EXPECT_EQ(p.little_free, d.little_free);
+  EXPECT_EQ(p.little_coupling_sigma_rad, d.little_coupling_sigma_rad);
   EXPECT_EQ(p.prior_sigma_wrist_m, d.prior_sigma_wrist_m);
   EXPECT_EQ(p.prior_sigma_rotation_rad, d.prior_sigma_rotation_rad);
   EXPECT_EQ(p.prior_sigma_joint_rad, d.prior_sigma_joint_rad);
@@ -103,6 +105,13 @@ TEST(RegistrationParams, ParseErrorsNameFileLineAndKey) {
   // A typo is rejected, naming the key.
   e = parse_error("registration:\n  fingertip_sigma: 0.002\n");
   EXPECT_NE(e.find("fingertip_sigma"), std::string::npos) << e;
+  // The little finger's settings.
+  e = parse_error("registration:\n  little_free: sometimes\n");
+  EXPECT_NE(e.find("reg.yaml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("little_free"), std::string::npos) << e;
+  e = parse_error("registration:\n  little_coupling_sigma_rad: 0\n");
+  EXPECT_NE(e.find("registration.little_coupling_sigma_rad"), std::string::npos) << e;
+  EXPECT_NE(e.find("(0, 100] rad"), std::string::npos) << e;
   // Not a map.
   e = parse_error("registration: 3\n");
   EXPECT_NE(e.find("registration"), std::string::npos) << e;

@@ -63,7 +63,7 @@ hand::HandParams some_pose(std::mt19937& rng, const hand::HandModel& m) {
   }
   q.set_wrist(Vec3(0.1 * u(rng), 0.1 * u(rng), 0.05), Vec3(0.3 * u(rng), -0.2, 1.0 + u(rng)));
   q.little_independent = true;
-  q.little = Vec3(q[hand::kRingMcpFlexion] + 0.1, q[hand::kRingMcpAbduction], q[hand::kRingDip] + 0.1);
+  q.set_little(Vec3(q[hand::kRingMcpFlexion] + 0.1, q[hand::kRingMcpAbduction], q[hand::kRingDip] + 0.1));
   return q;
 }
 
@@ -200,7 +200,7 @@ TEST(AnatomicalHand, AJointMovesOnlyItsDigit) {
     // The independent little finger: only the little finger, its nail and its web move.
     bent = rest;
     bent.little_independent = true;
-    bent.little = Vec3(0.8, 0.1, 0.6);
+    bent.set_little(Vec3(0.8, 0.1, 0.6));
     m = motion(h, rest, bent);
     for (std::size_t i = 0; i < h.parts.size(); ++i) {
       const std::string& n = h.parts[i].name;

@@ -184,7 +184,7 @@ TEST(UserHands, LittleFingerMovesOnItsOwn) {
   user.update(1.5, g);
   const auto& q = user.params()[1];
   EXPECT_TRUE(q.little_independent);
-  EXPECT_GT(std::abs(q.little.x() - q[hand::kRingMcpFlexion]), 0.01);
+  EXPECT_GT(std::abs(q.little().x() - q[hand::kRingMcpFlexion]), 0.01);
 }
 
 }  // namespace

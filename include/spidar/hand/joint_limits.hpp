@@ -45,7 +45,8 @@ struct ParamLimits {
   ParamVec upper = ParamVec::Constant(std::numeric_limits<double>::infinity());
 };
 
-/// The parameter box implied by the joint ranges under a coupling (see the file comment).
+/// The parameter box implied by the joint ranges under a coupling (see the file comment). The
+/// little finger's own parameters (17..19) take the fingers' ranges.
 ParamLimits parameter_limits(const JointRanges& ranges, Coupling coupling);
 
 /// How far past its active range an external force can push a finger's MCP joint [rad]: the

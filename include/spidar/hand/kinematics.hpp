@@ -1,5 +1,5 @@
 #pragma once
-/// Forward kinematics of the 17-parameter hand and its analytic Jacobians.
+/// Forward kinematics of the hand (the paper's 17 parameters and the little finger's own 3) and its analytic Jacobians.
 ///
 /// p_W = p_W_wrist + R_WH · M · p_H(fingers), with R_WH = exp([r_W_hand]×) and M = diag(−1, 1, 1)
 /// for the left hand, I for the right (hand_shape.hpp). Each digit is a chain of revolute joints:
@@ -8,7 +8,7 @@
 ///   thumb:   CMC flexion (about −z_H), CMC abduction (about z_H × y_thumb, turned by flexion),
 ///            MCP and IP flexion (about −x of the thumb's metacarpal frame).
 /// The PIP (thumb: MCP) angle is coupling(distal parameter) (coupling.hpp); the little finger uses
-/// the ring finger's parameters. Parameters are used as given: clamp them first if they may be
+/// the ring finger's parameters, or its own (17..19) with HandParams::little_independent. Parameters are used as given: clamp them first if they may be
 /// out of range (joint_limits.hpp).
 ///
 /// Jacobian columns: a revolute joint with world axis a through t moves p by a × (p − t); the

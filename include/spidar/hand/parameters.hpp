@@ -1,6 +1,8 @@
 #pragma once
 /// The paper's reduced hand model: 17 parameters per hand (26 anatomical DOF reduced by
-/// coupling the last two joints of each digit and by letting the little finger copy the ring).
+/// coupling the last two joints of each digit and by letting the little finger copy the ring),
+/// followed by the little finger's own three, used only where it moves on its own
+/// (HandParams::little_independent; registration's `little_finger: free`).
 ///
 ///   index  parameter                              unit
 ///   0..2   p_W_wrist: wrist centre in world       m
@@ -16,6 +18,9 @@
 ///   14     ring MCP flexion                       rad   (little finger copies 14..16)
 ///   15     ring MCP abduction                     rad
 ///   16     ring DIP flexion (PIP = coupling)      rad
+///   17     little MCP flexion                     rad   (only with little_independent)
+///   18     little MCP abduction                   rad   (ditto)
+///   19     little DIP flexion (PIP = coupling)    rad   (ditto)
 ///
 /// The coupled parameter of each digit is its distal angle (see coupling.hpp). Positive flexion
 /// curls a digit toward the palm; positive finger abduction spreads a finger away from the
@@ -28,7 +33,9 @@
 
 namespace spidar::hand {
 
-inline constexpr int kParamCount = 17;
+inline constexpr int kParamCount = 20;
+/// The paper's parameters: 0..16 (what a recording stores and what the paper's fit moves).
+inline constexpr int kPaperParamCount = 17;
 using ParamVec = Eigen::Matrix<double, kParamCount, 1>;
 
 /// Index 0 = left, 1 = right (everywhere in spidar).
@@ -52,6 +59,9 @@ enum Param : int {
   kRingMcpFlexion = 14,
   kRingMcpAbduction = 15,
   kRingDip = 16,
+  kLittleMcpFlexion = 17,
+  kLittleMcpAbduction = 18,
+  kLittleDip = 19,
 };
 
 /// Short name of a parameter for messages and plots, e.g. "index_mcp_abduction".
@@ -64,13 +74,14 @@ inline constexpr int kFingerCount = 5;
 inline constexpr int kFingertipCount = 4;
 
 /// Parameters of one digit: flexion, abduction (-1 if the digit has none) and the coupled
-/// distal parameter. The little finger returns the ring finger's parameters.
+/// distal parameter. The little finger returns the ring finger's parameters (the paper's model),
+/// or its own (17..19) when `little_independent`.
 struct DigitParams {
   int flexion;
   int abduction;
   int distal;
 };
-DigitParams digit_params(int finger);
+DigitParams digit_params(int finger, bool little_independent = false);
 
 /// Joint positions in a fixed order: the wrist, then for each digit four points from proximal
 /// to distal. Fingers: MCP, PIP, DIP, tip (end of the distal bone). Thumb: CMC, MCP, IP, tip.
@@ -83,15 +94,20 @@ constexpr int joint_index(int finger, int k) {
 /// Short name of a joint, e.g. "index_pip", "thumb_cmc".
 std::string_view joint_name(int joint);
 
-/// The 17 parameters of one hand with named access. A plain value type; no invariants.
+/// The parameters of one hand with named access. A plain value type; no invariants.
 struct HandParams {
   ParamVec q = ParamVec::Zero();
-  /// The model's little finger copies the ring finger's parameters. A real hand's does not: with
-  /// `little_independent` the little finger takes `little` = (MCP flexion, MCP abduction, DIP)
-  /// [rad] instead (ground-truth users of the simulated rig). Not a fitted parameter: Jacobians
-  /// have no column for it.
+  /// The paper's little finger copies the ring finger's parameters (14..16), and q[17..19] are
+  /// unused. A real hand's does not: with `little_independent` the little finger takes its own
+  /// q[17..19] = (MCP flexion, MCP abduction, DIP) [rad] (the simulated users' hands, and the
+  /// registration with `little_finger: free`), and the Jacobians have columns for them.
   bool little_independent = false;
-  Vec3 little = Vec3::Zero();
+
+  /// The little finger's own parameters, q[17..19] [rad].
+  Vec3 little() const { return q.segment<3>(kLittleMcpFlexion); }
+  void set_little(const Vec3& v) { q.segment<3>(kLittleMcpFlexion) = v; }
+  /// The ring finger's parameters, q[14..16] [rad] (what a coupled little finger copies).
+  Vec3 ring() const { return q.segment<3>(kRingMcpFlexion); }
 
   Vec3 p_W_wrist() const { return q.segment<3>(kWristX); }
   Vec3 r_W_hand() const { return q.segment<3>(kWristRotX); }

@@ -4,6 +4,7 @@
 /// Units on one scale: every residual is divided by its standard deviation σ, so the cost
 ///   J = Σ (fingertip error / σ_tip)² + conf · (wrist error / σ_wrist)² + Σ (joint-ball error / σ_ball)²
 ///       [+ Σ (silhouette error / σ_sil)²] + Σ ((θ − θ_prev) / σ_prior)²
+///       [+ Σ ((θ_little − θ_ring) / σ_little)², with little_free]
 /// is dimensionless. The paper's J = ‖ΔQ‖² + c‖ΔP‖² (eq. 22) is the special case
 /// c = σ_tip² / σ_ball² with ΔQ's wrist entry weighted by σ_tip / σ_wrist [m/px].
 ///
@@ -57,6 +58,13 @@ struct RegistrationParams {
   /// Uncovered pixels farther than this from the model count with a Huber weight (huber / d):
   /// far pixels are as likely a shape the model lacks as a pose error [px].
   double coverage_huber_px = 10.0;
+  /// The little finger's own parameters (hand/parameters.hpp, 17..19): free (the default), the
+  /// little finger moves on its own, observed by the image terms alone (no string measures it), held near the
+  /// ring finger's angles by a coupling prior of σ little_coupling_sigma_rad per angle. Off: the
+  /// paper's little finger, which copies the ring finger. Only with silhouette_term
+  /// (little_moves_freely): the paper's method keeps the paper's little finger.
+  bool little_free = true;
+  double little_coupling_sigma_rad = 0.25;  ///< σ of (little − ring) per angle [rad]
   // --- temporal prior (toward the previous frame's parameters) ---
   double prior_sigma_wrist_m = 0.02;     ///< [m]
   double prior_sigma_rotation_rad = 0.2; ///< [rad]
@@ -70,6 +78,10 @@ struct RegistrationParams {
   /// cost_epsilon; this ends the fit once it no longer pays). 0 = off.
   double relative_epsilon = 1e-3;
 };
+
+/// Whether a fit's little finger moves on its own: little_free with the silhouette term (the
+/// image is all that observes it). The paper's method (no silhouette term) always copies the ring.
+inline bool little_moves_freely(const RegistrationParams& p) { return p.little_free && p.silhouette_term; }
 
 /// Upper bound of silhouette_samples_per_bone (fixed-size storage, no allocation per frame).
 inline constexpr int kMaxSilhouetteSamplesPerBone = 8;

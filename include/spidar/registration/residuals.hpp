@@ -14,7 +14,10 @@
 ///              the real silhouette by more than 0.5 px when frozen)                      [px / px]
 ///   coverage   (uv(edge point)(θ) − owned pixel) / σ_cov (2 rows per silhouette pixel this hand
 ///              owns and leaves uncovered by more than 0.5 px when frozen; coverage.hpp)  [px / px]
-///   prior      (θ_i − θ_prior,i) / σ_group (1 row per parameter with a finite prior)
+///   prior      (θ_i − θ_prior,i) / σ_group (1 row per parameter with a finite prior: the
+///              paper's 17, and the little finger's own 3 where q.little_independent)
+///   coupling   (θ_little,k − θ_ring,k) / σ_little (3 rows, only where q.little_independent;
+///              counted with the prior's cost)
 /// Frozen with the targets: the joint-ball targets P̃, each silhouette point's nearest silhouette
 /// pixel and its offset from the projected axis point (± the projected radius across the bone),
 /// whether the wrist term is active (bracelet point in front of the camera) and the bracelet's
@@ -108,7 +111,7 @@ void freeze_targets(const ResidualProblem& problem, const hand::HandParams& q,
 TermCosts term_costs(const ResidualProblem& problem, const FrozenTargets& targets,
                      const hand::HandParams& q);
 
-/// The stacked residual vector and, if `J` is non-null, its Jacobian (rows × 17) at `q` with
+/// The stacked residual vector and, if `J` is non-null, its Jacobian (rows × 20) at `q` with
 /// frozen targets. Allocates: for tests and diagnostics only.
 void stacked_residuals(const ResidualProblem& problem, const FrozenTargets& targets,
                        const hand::HandParams& q, VecX* r, MatX* J);

@@ -1,7 +1,8 @@
 #pragma once
 /// Successive adjustment of the 17-parameter hand (paper, eqs 22–39) with the improvements a
-/// real-time tracker needs: Levenberg-Marquardt damping, joint limits, a temporal prior and an
-/// optional silhouette (distance-transform) term.
+/// real-time tracker needs: Levenberg-Marquardt damping, joint limits, a temporal prior, an
+/// optional silhouette term and, with it, optionally a little finger of its own (3 more
+/// parameters, RegistrationParams::little_free).
 ///
 /// Each iteration linearises every residual r(θ + Δθ) ≈ r(θ) + J Δθ (fingertips from the strings
 /// in 3D, the projected wrist from the bracelet, the joint-ball targets of eq. 21 recomputed at
@@ -85,7 +86,9 @@ class SuccessiveAdjustment {
   /// result; null = no prior). Never produces NaN: non-finite observations (fingertips, wrist
   /// pixel, confidence, prior entries) are ignored, a NaN start is clamped to finite values, and
   /// a matte that is not CV_32FC1 counts as no matte. The report's cost_final and terms are at
-  /// the final pose with the image targets recomputed there.
+  /// the final pose with the image targets recomputed there. The result's little_independent is
+  /// little_moves_freely(params()); a start whose little finger copied the ring starts its own
+  /// little finger at the ring's angles.
   FitReport fit(const hand::HandModel& model, const HandObservation& observation,
                 const ImageEvidence& image, const hand::HandParams* prior,
                 hand::HandParams* params) const;

@@ -107,7 +107,9 @@ struct FitRow {
   double cost_initial = 0, cost_final = 0;
   /// Final cost per term: fingertip, wrist, joint_ball, silhouette, prior.
   std::array<double, 5> terms{};
-  std::array<double, hand::kParamCount> q{};  ///< hand parameters (include/spidar/hand/parameters.hpp)
+  /// The paper's 17 hand parameters (include/spidar/hand/parameters.hpp); a little finger of its
+  /// own (registration's little_free) is not recorded: a replay fits it again.
+  std::array<double, hand::kPaperParamCount> q{};
   /// The hand model's length and width the fit used [m] (they change while the shape is
   /// personalised: registration/shape_estimator.hpp); 0: not recorded (a recording made before
   /// fit_size_columns were written, or a writer that did not know them).

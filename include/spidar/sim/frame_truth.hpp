@@ -17,9 +17,10 @@ struct FrameTruthMetrics {
   double iou = 0;                     ///< fitted hands' pixels vs the real hands' (no bracelet/arm)
   std::array<double, 2> fingertip_mm{};  ///< mean fingertip cap error per hand [mm]
   std::array<double, 2> joint_px{};      ///< mean projected joint error per hand [px]
-  /// The joint error's floor per hand [px]: the model's skeleton with the user's true sizes at the
-  /// true pose, whose little finger can only follow the ring finger's (the model has no
-  /// parameters of its own for it); 0 for a user whose little finger follows the ring too.
+  /// The paper's model's joint error floor per hand [px]: its skeleton with the user's true sizes
+  /// at the true pose, with the little finger following the ring finger's (the paper's model has
+  /// no parameters of their own for it; registration's little_free fits them, and can go below
+  /// this); 0 for a user whose little finger follows the ring too.
   std::array<double, 2> joint_px_floor{};
   /// Hand region: the real hands (without forearm and bracelet) and wherever either composite
   /// shows the real image, except on the real forearm and bracelet.

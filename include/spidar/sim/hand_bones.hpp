@@ -42,7 +42,7 @@ struct HandBoneFrames {
 
 /// The bone frames of `model` posed by `params` (wrist pose ignored: frames are in H). Joint
 /// positions come from hand::forward_kinematics, so the bones end exactly on the model's joints;
-/// the little finger follows HandParams::little when little_independent. Allocates nothing.
+/// the little finger follows its own parameters (17..19) when little_independent. Allocates nothing.
 HandBoneFrames hand_bone_frames(const hand::HandModel& model, const hand::HandParams& params);
 
 }  // namespace spidar::sim
