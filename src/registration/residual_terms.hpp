@@ -11,7 +11,9 @@
 
 namespace spidar::registration::detail {
 
+/// The residual terms, in ResidualTerm's order (residuals.hpp).
 enum class Term { kFingertip, kWrist, kJointBall, kSilhouette, kPrior };
+static_assert(static_cast<int>(Term::kPrior) == static_cast<int>(ResidualTerm::kPrior));
 
 /// Points nearer the camera plane than this [m] are left out of the image terms.
 inline constexpr double kMinImageDepth = 0.01;

@@ -100,15 +100,18 @@ void freeze_coverage(const ResidualProblem& pr, const hand::HandParams& q,
 struct StackSink {
   std::vector<double> r;
   std::vector<Eigen::Matrix<double, 1, hand::kParamCount>> J;
+  std::vector<ResidualTerm> terms;
   template <int R>
-  void add(detail::Term, const detail::Block<R>& res, const detail::BlockJacobian<R>* Jb) {
+  void add(detail::Term t, const detail::Block<R>& res, const detail::BlockJacobian<R>* Jb) {
     for (int k = 0; k < R; ++k) {
       r.push_back(res[k]);
+      terms.push_back(static_cast<ResidualTerm>(t));
       if (Jb) J.push_back(Jb->row(k));
     }
   }
   void add_prior(int i, double res, double j) {
     r.push_back(res);
+    terms.push_back(ResidualTerm::kPrior);
     Eigen::Matrix<double, 1, hand::kParamCount> row = Eigen::Matrix<double, 1, hand::kParamCount>::Zero();
     row[i] = j;
     J.push_back(row);
@@ -168,7 +171,7 @@ TermCosts term_costs(const ResidualProblem& pr, const FrozenTargets& tg, const h
 }
 
 void stacked_residuals(const ResidualProblem& pr, const FrozenTargets& tg,
-                       const hand::HandParams& q, VecX* r, MatX* J) {
+                       const hand::HandParams& q, VecX* r, MatX* J, std::vector<ResidualTerm>* terms) {
   detail::PoseState s;
   detail::pose_state(*pr.model, q, J != nullptr, &s);
   StackSink sink;
@@ -184,6 +187,7 @@ void stacked_residuals(const ResidualProblem& pr, const FrozenTargets& tg,
     J->resize(rows, hand::kParamCount);
     for (Eigen::Index i = 0; i < rows; ++i) J->row(i) = sink.J[static_cast<std::size_t>(i)];
   }
+  if (terms) *terms = std::move(sink.terms);
 }
 
 }  // namespace spidar::registration

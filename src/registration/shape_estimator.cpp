@@ -26,10 +26,11 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "freeze_sigma_length_m", "freeze_sigma_width_m", "freeze_sigma_thickness",
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
                     "max_fingertip_cost", "shared_hands", "keyframe_prior_scale",
-                    "keyframe_prior"});
+                    "keyframe_prior", "joint_balls"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
+  if (auto b = node.find("joint_balls")) p.joint_balls = b->as_bool();
   if (auto b = node.find("keyframe_prior")) {
     const std::string v = b->as_string();
     if (v == "taken") p.keyframe_prior = KeyframePrior::kTaken;
@@ -170,6 +171,12 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   bool any_silhouette = false;
   for (Keyframe& kf : job.keyframes) {
     if (kf.silhouette.empty()) continue;
+    if (p.joint_balls && !kf.alpha) {
+      auto a = std::make_shared<cv::Mat>();
+      kf.silhouette.convertTo(*a, CV_32FC1, 1.0 / 255.0);
+      kf.alpha = std::move(a);
+    }
+    if (p.silhouette == ShapeSilhouette::kNone) continue;
     any_silhouette = true;
     if (kf.distance) continue;
     auto d = std::make_shared<vision::SilhouetteDistance>();
@@ -217,6 +224,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       ImageEvidence evidence = skeleton_only;
       if (!kf.owned.empty()) evidence.coverage = &kf.owned;
       if (kf.distance && !kf.distance->empty) evidence.distance = kf.distance.get();
+      if (kf.alpha) evidence.alpha = *kf.alpha;
       hand::HandParams prior = p.keyframe_prior == KeyframePrior::kTaken ? kf.q_taken : kf.q;
       FitReport fit = solver.fit(model, kf.observation, evidence, &prior, &kf.q);
       if (p.reach_min_miss_m > 0 &&
@@ -228,7 +236,8 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       freeze_targets(problem, kf.q, &targets);
       VecX r;
       MatX J;
-      stacked_residuals(problem, targets, kf.q, &r, &J);
+      std::vector<ResidualTerm> terms;
+      stacked_residuals(problem, targets, kf.q, &r, &J, &terms);
       MatX Jb = MatX::Zero(r.size(), 3);
       bool ok = true;
       for (int c = 0; c < nb && ok; ++c) {
@@ -248,6 +257,11 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
         ok = ok && rp.size() == r.size() && rm.size() == r.size();
         if (ok) Jb.col(c) = (rp - rm) / (2.0 * step_h[c]);
       }
+      // The joint-balls inform the length only: their targets sit a ball's radius in from the
+      // silhouette's edge, and that radius is the capsule's, which the width scales.
+      if (ok)
+        for (Eigen::Index row = 0; row < Jb.rows(); ++row)
+          if (terms[static_cast<std::size_t>(row)] == ResidualTerm::kJointBall) Jb(row, 1) = 0.0;
       if (!ok || !J.allFinite() || !Jb.allFinite() || !r.allFinite()) continue;
       // Marginalise the pose (Schur complement).
       MatX A = J.transpose() * J;
@@ -339,8 +353,9 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     ++held;
     if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
   }
-  Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}};
-  if (p_.silhouette != ShapeSilhouette::kNone && !image.alpha.empty() && image.alpha.type() == CV_32FC1)
+  Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}};
+  if ((p_.silhouette != ShapeSilhouette::kNone || p_.joint_balls) && !image.alpha.empty() &&
+      image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);
   if (p_.silhouette == ShapeSilhouette::kBoth && image.coverage != nullptr) kf.owned = *image.coverage;
   if (held < std::max(p_.keyframes, 1))
@@ -392,7 +407,10 @@ bool ShapeEstimator::apply(Solve&& done) {
   } else {  // the distance transforms it made stay with the keyframes still held
     for (Keyframe& k : keyframes_)
       for (const Keyframe& d : done.keyframes)
-        if (d.serial == k.serial && !k.distance) k.distance = d.distance;
+        if (d.serial == k.serial) {
+          if (!k.distance) k.distance = d.distance;
+          if (!k.alpha) k.alpha = d.alpha;
+        }
   }
   return done.changed;
 }

@@ -30,7 +30,8 @@ struct Outcome {
 /// capsules and palm box (test::draw_capsule_mask): the model's geometry, so this checks the
 /// estimator's use of the image, not the model's fidelity.
 Outcome feed(ShapeEstimator& est, int hand, const hand::HandModel& truth, const hand::HandParams& base,
-             int frames, std::uint32_t seed, ShapeSilhouette silhouette = ShapeSilhouette::kNone) {
+             int frames, std::uint32_t seed, ShapeSilhouette silhouette = ShapeSilhouette::kNone,
+             bool matte = false) {
   const vision::Camera camera = vision::default_rig_camera();
   RegistrationParams rp;
   SuccessiveAdjustment solver(rp);
@@ -58,7 +59,7 @@ Outcome feed(ShapeEstimator& est, int hand, const hand::HandModel& truth, const 
     ImageEvidence image;
     image.camera = &camera;
     cv::Mat mask;
-    if (silhouette != ShapeSilhouette::kNone) {
+    if (silhouette != ShapeSilhouette::kNone || matte) {
       test::draw_capsule_mask(truth, truth_q, camera, &mask);
       mask.convertTo(image.alpha, CV_32FC1, 1.0 / 255.0);
     }
@@ -81,13 +82,15 @@ Outcome feed(ShapeEstimator& est, int hand, const hand::HandModel& truth, const 
 /// One right hand of sizes (L, W) and digit thickness `thickness`, estimated from the default
 /// model (feed()).
 Outcome run(double length_m, double width_m, int frames, std::uint32_t seed,
-            ShapeSilhouette silhouette = ShapeSilhouette::kNone, double thickness = 1.0) {
+            ShapeSilhouette silhouette = ShapeSilhouette::kNone, double thickness = 1.0,
+            bool joint_balls = false) {
   const hand::HandModel truth =
       resized(hand::default_hand_model(hand::Side::kRight), length_m, width_m, thickness).value();
   ShapeEstimatorParams sp;
   sp.silhouette = silhouette;
+  sp.joint_balls = joint_balls;
   ShapeEstimator est(hand::default_hand_model(hand::Side::kRight), sp);
-  return feed(est, 0, truth, test::reaching_hands(0)[1], frames, seed, silhouette);
+  return feed(est, 0, truth, test::reaching_hands(0)[1], frames, seed, silhouette, joint_balls);
 }
 
 /// Started at the true sizes of a default-sized hand with linear coupling, on exact skeleton data
@@ -164,6 +167,24 @@ TEST(ShapeEstimator, TheSilhouettesSpillShortensAndThinsAnOversizedModel) {
   EXPECT_LT(b.sigma_thickness, ShapeEstimatorParams{}.prior_sigma_thickness);
   EXPECT_LT(std::abs(b.length_m - L), std::abs(a.length_m - L));
   EXPECT_LT(std::abs(b.length_m - L), std::abs(0.19 - L));
+}
+
+// The same with the joint-balls (the paper's image term) in the re-estimates: a model too long
+// for the hand bends its fingers to reach the caps, and their joints leave the real fingers'
+// silhouettes, which the balls see.
+TEST(ShapeEstimator, TheJointBallsShortenALongModel) {
+  for (const auto& [L, W] : {std::pair{0.171, 0.0765}, std::pair{0.175, 0.0935}}) {
+    const Outcome strings = run(L, W, 240, 11);
+    const Outcome balls = run(L, W, 240, 11, ShapeSilhouette::kNone, 1.0, true);
+    const ShapeEstimate& a = strings.estimate;
+    const ShapeEstimate& b = balls.estimate;
+    std::printf("truth L %.4f W %.4f: strings L %.4f W %.4f; with the joint-balls L %.4f W %.4f (σ L %.2f mm), "
+                "%d solves\n",
+                L, W, a.length_m, a.width_m, b.length_m, b.width_m, 1e3 * b.sigma_length_m, b.solves);
+    EXPECT_EQ(b.thickness, 1.0);  // the balls do not estimate it
+    EXPECT_LT(std::abs(b.length_m - L), std::abs(a.length_m - L)) << L << ", " << W;
+    EXPECT_LT(std::abs(b.length_m - L), 0.5 * std::abs(0.19 - L)) << L << ", " << W;
+  }
 }
 
 TEST(ShapeEstimator, StaysWithinItsBoundAndFreezesNothingWithoutEvidence) {
@@ -294,6 +315,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.shared_hands, d.shared_hands);
   EXPECT_EQ(p.keyframe_prior_scale, d.keyframe_prior_scale);
   EXPECT_EQ(p.keyframe_prior, d.keyframe_prior);
+  EXPECT_EQ(p.joint_balls, d.joint_balls);
   expect_parse_error("personalisation:\n  min_pose_change: -1\n", "bad.yaml", "min_pose_change");
   for (const std::string key :
        {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost", "keyframe_prior_scale"})
@@ -302,7 +324,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto on = core::ConfigNode::Parse(
       "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n"
       "  max_fingertip_cost: 25\n  shared_hands: false\n  keyframe_prior_scale: 10\n"
-      "  keyframe_prior: taken\n", "on.yaml");
+      "  keyframe_prior: taken\n  joint_balls: true\n", "on.yaml");
   const ShapeEstimatorParams q = parse_shape_estimator_params(on["personalisation"], &enabled);
   EXPECT_EQ(q.silhouette, ShapeSilhouette::kSpill);
   EXPECT_EQ(q.reach_min_miss_m, 0.0);
@@ -311,11 +333,13 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_FALSE(q.shared_hands);
   EXPECT_EQ(q.keyframe_prior_scale, 10.0);
   EXPECT_EQ(q.keyframe_prior, KeyframePrior::kTaken);
+  EXPECT_TRUE(q.joint_balls);
   EXPECT_EQ(p.silhouette, ShapeSilhouette::kNone);  // the shipped setting
   // An unknown choice names the file, line, key and the choices.
   expect_parse_error("personalisation:\n  silhouette: inward\n", "typo.yaml", "none, spill or both");
   expect_parse_error("personalisation:\n  keyframe_prior: first\n", "where.yaml", "taken or last");
   expect_parse_error("personalisation:\n  shared_hands: sometimes\n", "maybe.yaml", "shared_hands");
+  expect_parse_error("personalisation:\n  joint_balls: 3\n", "balls.yaml", "joint_balls");
 }
 
 }  // namespace

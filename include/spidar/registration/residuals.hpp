@@ -23,6 +23,8 @@
 /// whether the wrist term is active (bracelet point in front of the camera) and the bracelet's
 /// visible-surface shift.
 #include <array>
+#include <cstdint>
+#include <vector>
 
 #include "spidar/core/types.hpp"
 #include "spidar/hand/hand_model.hpp"
@@ -111,9 +113,15 @@ void freeze_targets(const ResidualProblem& problem, const hand::HandParams& q,
 TermCosts term_costs(const ResidualProblem& problem, const FrozenTargets& targets,
                      const hand::HandParams& q);
 
+/// Which term a stacked residual row belongs to (the blocks above; coverage rows count as
+/// silhouette, coupling rows as prior).
+enum class ResidualTerm : std::uint8_t { kFingertip, kWrist, kJointBall, kSilhouette, kPrior };
+
 /// The stacked residual vector and, if `J` is non-null, its Jacobian (rows × 20) at `q` with
-/// frozen targets. Allocates: for tests and diagnostics only.
+/// frozen targets; if `terms` is non-null, each row's term. Allocates: for tests, diagnostics and
+/// the size estimator.
 void stacked_residuals(const ResidualProblem& problem, const FrozenTargets& targets,
-                       const hand::HandParams& q, VecX* r, MatX* J);
+                       const hand::HandParams& q, VecX* r, MatX* J,
+                       std::vector<ResidualTerm>* terms = nullptr);
 
 }  // namespace spidar::registration

@@ -25,8 +25,8 @@
 /// outside the silhouette (kSpill), and the silhouette pixels the hand owns that the model leaves
 /// uncovered (kBoth, coverage.hpp), enter the re-estimate, and the digits' thickness is estimated
 /// too. A silhouette point's offset from its bone's axis scales with the capsule's radius
-/// (SilhouettePoint::radius_m), so the image rows do see the width and thickness. The joint-balls stay out (their targets depend
-/// on the matte's soft edge, not on the shape).
+/// (SilhouettePoint::radius_m), so the image rows do see the width and thickness. The joint-balls
+/// enter only with ShapeEstimatorParams::joint_balls.
 
 #include <Eigen/Core>
 #include <array>
@@ -137,6 +137,18 @@ struct ShapeEstimatorParams {
   /// --personalise`) +9 % long, −14 % wide. kTaken keeps every keyframe's prior where the frame's
   /// own fit put it: 0.25 % and +1.4 %, −0.3 %: the truth stays (nearly) a fixed point.
   KeyframePrior keyframe_prior = KeyframePrior::kLast;
+  /// Keyframes also keep their silhouette (the matte ≥ matte_threshold), and a re-estimate's refits
+  /// take the paper's joint-balls from it (eq. 21, recomputed at each refit's pose): they see
+  /// where a finger bent to reach its cap with a too-long model leaves the real finger's
+  /// silhouette, which bounds the length from above where the strings do not. The balls inform
+  /// the length only (their rows are left out of the width's derivative: a ball's neighbours sit
+  /// the capsule's radius from the joint, and the width scales the capsules; with them the
+  /// registration study's default user's width went 7–12 % narrow), and the thickness stays.
+  ///
+  /// Measured (demo, seeds 1–2, five users, 2026-11-26): the small user's length error 10–11 % →
+  /// 1.6–2.9 %, IoU 0.713–0.740 → 0.797–0.838; the short-wide user's 11–12 % → 0.3–1.6 %, IoU
+  /// 0.598–0.656 → 0.752–0.770; the default user's IoU 0.861–0.862 → 0.854–0.856.
+  bool joint_balls = true;
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
@@ -205,6 +217,9 @@ class ShapeEstimator {
     /// The silhouette's distance transform, made by the first re-estimate that uses it (read only
     /// from then on, so copies on a re-estimate's thread share it).
     std::shared_ptr<const vision::SilhouetteDistance> distance;
+    /// The silhouette as a matte (CV_32FC1, 0 or 1) for the joint-balls (joint_balls), made and
+    /// shared like `distance`.
+    std::shared_ptr<const cv::Mat> alpha;
   };
   /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its
   /// own thread shares nothing with the estimator).
