@@ -108,6 +108,7 @@ void RegistrationBothHands(benchmark::State& state) {
   if (!f.ok) return state.SkipWithError("no headless GL or synthetic frame");
   registration::RegistrationParams params;
   params.silhouette_term = state.range(0) != 0;
+  params.little_free = state.range(1) != 0;  // with the silhouette term: 20 parameters, else 17
   const registration::SuccessiveAdjustment solver(params);
   registration::ImageEvidence image;
   image.camera = &f.camera;
@@ -129,7 +130,12 @@ void RegistrationBothHands(benchmark::State& state) {
   state.counters["iterations_per_hand"] =
       fits ? static_cast<double>(iterations) / static_cast<double>(fits) : 0.0;
 }
-BENCHMARK(RegistrationBothHands)->ArgName("silhouette")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(RegistrationBothHands)
+    ->ArgNames({"silhouette", "little_free"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
