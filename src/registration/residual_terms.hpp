@@ -196,12 +196,11 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
   // moves on its own (toward the prior's little finger, or its ring finger's angles where the
   // prior's little finger copied them).
   if (pr.prior) {
+    hand::HandParams prior = *pr.prior;
+    if (!prior.little_independent) prior.set_little(prior.ring());
     const int n = q.little_independent ? hand::kParamCount : hand::kPaperParamCount;
     for (int i = 0; i < n; ++i) {
-      const int from = i >= hand::kPaperParamCount && !pr.prior->little_independent
-                           ? i - hand::kLittleMcpFlexion + hand::kRingMcpFlexion
-                           : i;
-      const double mean = (*pr.prior)[from];
+      const double mean = prior[i];
       if (!std::isfinite(mean)) continue;
       const double w = 1.0 / prior_sigma(rp, i);
       sink.add_prior(i, w * (q[i] - mean), w);
