@@ -304,6 +304,22 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
         (gate <= 0 || !s.have_previous || (out->bracelets[h].wrist_px - predicted[h]).norm() <= gate)) {
       obs.wrist_px = out->bracelets[h].wrist_px;
       obs.wrist_confidence = out->bracelets[h].confidence;
+      // A whole band's length says how far along its ray the wrist is (residuals.hpp, the band
+      // term): used where both its ends are inside the image, it is not ragged, and it is within
+      // bracelet_length_gate of the length the band term's model predicts at the previous fit.
+      const vision::BraceletObservation& band = out->bracelets[h];
+      const auto inside = [&](const Vec2& e) {
+        return e.x() >= 2.0 && e.y() >= 2.0 && e.x() <= s.camera.width() - 3.0 && e.y() <= s.camera.height() - 3.0;
+      };
+      const double expected =
+          s.have_previous ? registration::bracelet_length_px(hand::hand_pose(s.previous[h]),
+                                                             s.models[h].shape.dimensions.width, s.camera,
+                                                             p.registration)
+                          : 0.0;
+      if (p.registration.bracelet_length_sigma > 0 && band.fill >= p.registration.bracelet_length_min_fill &&
+          inside(band.end_a_px) && inside(band.end_b_px) &&
+          (expected <= 0 || std::abs(band.length_px / expected - 1.0) <= p.registration.bracelet_length_gate))
+        obs.wrist_length_px = band.length_px;
     }
     const bool cold = !s.have_previous;
     registration::ImageEvidence hand_image = image;

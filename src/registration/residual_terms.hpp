@@ -12,7 +12,7 @@
 namespace spidar::registration::detail {
 
 /// The residual terms, in ResidualTerm's order (residuals.hpp).
-enum class Term { kFingertip, kWrist, kJointBall, kSilhouette, kPrior };
+enum class Term { kFingertip, kWrist, kBand, kJointBall, kSilhouette, kPrior };
 static_assert(static_cast<int>(Term::kPrior) == static_cast<int>(ResidualTerm::kPrior));
 
 /// Points nearer the camera plane than this [m] are left out of the image terms.
@@ -163,6 +163,31 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
       const Vec3 p = bracelet_point(s, rp, J3p) + tg.bracelet_shift_W;
       add_projected(Term::kWrist, p, Vec2::Zero(), *obs.wrist_px, w);
     }
+    // The band's projected length across the forearm: how far along its ray the wrist is. No
+    // cost while within bracelet_length_tolerance of the detected length (a dead zone: the model
+    // only assumes the user's forearm size), linear in the excess beyond it.
+    if (tg.wrist_active && tg.band_active && wrist_observed(obs)) {
+      const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / rp.bracelet_length_sigma;
+      const double tol = rp.bracelet_length_tolerance;
+      PointJacobian J0, J1;
+      const Vec3 e0 = rigid_point(s, tg.band_end_H[0], kJacobian ? &J0 : nullptr);
+      const Vec3 e1 = rigid_point(s, tg.band_end_H[1], kJacobian ? &J1 : nullptr);
+      vision::ProjectionJacobian Jp0, Jp1;
+      const Vec2 d = kJacobian ? Vec2(camera->project(e1, &Jp1) - camera->project(e0, &Jp0))
+                               : Vec2(camera->project(e1) - camera->project(e0));
+      const double length = d.norm();
+      const double excess = length / obs.wrist_length_px - 1.0;  // relative
+      const double beyond = excess > tol ? excess - tol : (excess < -tol ? excess + tol : 0.0);
+      const Block<1> r = Block<1>::Constant(w * beyond);
+      if constexpr (kJacobian) {
+        BlockJacobian<1> J = BlockJacobian<1>::Zero();
+        if (beyond != 0.0 && length > 1e-9)
+          J = (w / (obs.wrist_length_px * length)) * d.transpose() * (Jp1 * J1 - Jp0 * J0);
+        sink.template add<1>(Term::kBand, r, &J);
+      } else {
+        sink.template add<1>(Term::kBand, r, nullptr);
+      }
+    }
 
     // Joint-balls (eq. 21): the projected joint toward its frozen target P̃; the P of the paper,
     // linearised P(θ+Δθ) ≈ P(θ) + J_P Δθ (paper eqs 23–38).
@@ -228,7 +253,8 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
 inline void add_cost(TermCosts* c, Term t, double squared) {
   switch (t) {
     case Term::kFingertip: c->fingertip += squared; break;
-    case Term::kWrist: c->wrist += squared; break;
+    case Term::kWrist:
+    case Term::kBand: c->wrist += squared; break;
     case Term::kJointBall: c->joint_ball += squared; break;
     case Term::kSilhouette: c->silhouette += squared; break;
     case Term::kPrior: c->prior += squared; break;

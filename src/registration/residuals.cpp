@@ -136,8 +136,36 @@ Vec3 bracelet_visible_point(const Pose& X_WH, double hand_width_m, const Vec3& p
   return centre + shift;
 }
 
+std::array<Vec3, 2> bracelet_band_ends(const Pose& X_WH, double hand_width_m, const Vec3& p_W_camera,
+                                       const RegistrationParams& params) {
+  const Vec3 centre = X_WH * Vec3(0.0, -params.bracelet_offset_m, 0.0);
+  const Mat3 R = X_WH.R.toRotationMatrix();
+  const Vec3 x = R.col(0), y = R.col(1), z = R.col(2);
+  const double a = bracelet_radius_m(params, hand_width_m);
+  const double b = params.bracelet_depth_ratio * params.bracelet_radius_per_width * hand_width_m +
+                   params.bracelet_standoff_m;
+  Vec3 w = y.cross(centre - p_W_camera);  // across the forearm and the line of sight
+  const double n = w.norm();
+  if (!(n > 1e-12)) w = x;                // seen end-on: any direction across is as good
+  else w /= n;
+  const double wx = w.dot(x), wz = w.dot(z);
+  const double support = std::sqrt(a * a * wx * wx + b * b * wz * wz);
+  const Vec3 e = support > 1e-12 ? Vec3((a * a * wx / support) * x + (b * b * wz / support) * z)
+                                 : Vec3(a * x);
+  return {centre - e, centre + e};
+}
+
+double bracelet_length_px(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                          const RegistrationParams& params) {
+  const auto ends = bracelet_band_ends(X_WH, hand_width_m, camera.X_WC().p, params);
+  if (camera.depth(ends[0]) < detail::kMinImageDepth || camera.depth(ends[1]) < detail::kMinImageDepth)
+    return 0.0;
+  return (camera.project(ends[1]) - camera.project(ends[0])).norm();
+}
+
 void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, FrozenTargets* tg) {
   tg->wrist_active = false;
+  tg->band_active = false;
   for (JointBall& b : tg->balls) b = JointBall{};
   tg->silhouette_count = 0;
   tg->coverage_count = 0;
@@ -151,6 +179,16 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
     const Vec3 p = bracelet_visible_point(hand::hand_pose(q), pr.model->shape.dimensions.width,
                                           camera.X_WC().p, *pr.params, &tg->bracelet_shift_W);
     tg->wrist_active = camera.depth(p) >= detail::kMinImageDepth;
+    const HandObservation& obs = *pr.observation;
+    if (tg->wrist_active && pr.params->bracelet_length_sigma > 0 && std::isfinite(obs.wrist_length_px) &&
+        obs.wrist_length_px > 0) {
+      const auto ends = bracelet_band_ends(hand::hand_pose(q), pr.model->shape.dimensions.width,
+                                           camera.X_WC().p, *pr.params);
+      tg->band_active = camera.depth(ends[0]) >= detail::kMinImageDepth &&
+                        camera.depth(ends[1]) >= detail::kMinImageDepth;
+      // Right-hand H coordinates (PoseState::A maps them to world), so that rigid_point moves them.
+      for (int k = 0; k < 2; ++k) tg->band_end_H[static_cast<std::size_t>(k)] = s.A.transpose() * (ends[static_cast<std::size_t>(k)] - s.p_W_wrist);
+    }
   }
   if (!image->alpha.empty() && image->alpha.type() == CV_32FC1) {
     joint_ball_targets(*pr.model, s.points, camera, image->alpha, *pr.params, &tg->balls);

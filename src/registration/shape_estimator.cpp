@@ -258,10 +258,14 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
         if (ok) Jb.col(c) = (rp - rm) / (2.0 * step_h[c]);
       }
       // The joint-balls inform the length only: their targets sit a ball's radius in from the
-      // silhouette's edge, and that radius is the capsule's, which the width scales.
+      // silhouette's edge, and that radius is the capsule's, which the width scales. Nor does the
+      // band's length inform the width: it measures the forearm, whose breadth the model only
+      // assumes in proportion to the palm's (bracelet_radius_per_width).
       if (ok)
-        for (Eigen::Index row = 0; row < Jb.rows(); ++row)
-          if (terms[static_cast<std::size_t>(row)] == ResidualTerm::kJointBall) Jb(row, 1) = 0.0;
+        for (Eigen::Index row = 0; row < Jb.rows(); ++row) {
+          const ResidualTerm t = terms[static_cast<std::size_t>(row)];
+          if (t == ResidualTerm::kJointBall || t == ResidualTerm::kBand) Jb(row, 1) = 0.0;
+        }
       if (!ok || !J.allFinite() || !Jb.allFinite() || !r.allFinite()) continue;
       // Marginalise the pose (Schur complement).
       MatX A = J.transpose() * J;
@@ -354,6 +358,10 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
   }
   Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}};
+  // The band's length is left out of the size estimate's refits: with it the default user's width
+  // went 18 % narrow (demo, seeds 1–2), without it 4–8 % (the band measures the forearm, whose
+  // breadth the model only assumes in proportion to the palm's).
+  kf.observation.wrist_length_px = 0.0;
   if ((p_.silhouette != ShapeSilhouette::kNone || p_.joint_balls) && !image.alpha.empty() &&
       image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);

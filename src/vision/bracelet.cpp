@@ -280,6 +280,7 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
     o.pieces = static_cast<int>(members.size());
     cand.centroid_px = c;
     cand.fill = area / (o.length_px * o.thickness_px);
+    o.fill = cand.fill;
     cand.touches_border = border;
     o.confidence = bracelet_confidence(cand, p, expected_length_px);
     ws->candidates.push_back(cand);

@@ -78,6 +78,18 @@ TEST(RegistrationParams, ParsesValues) {
   EXPECT_EQ(p.wrist_sigma_px, 6.0);
   EXPECT_EQ(p.max_iterations, 4);
   EXPECT_EQ(p.fingertip_sigma_m, RegistrationParams{}.fingertip_sigma_m);
+  // The band's length.
+  const auto band = core::ConfigNode::Parse(
+      "registration:\n  bracelet_length_sigma: 0.03\n  bracelet_length_tolerance: 0.15\n"
+      "  bracelet_depth_ratio: 0.7\n  bracelet_length_min_fill: 0.5\n  bracelet_length_gate: 0.3\n",
+      "reg.yaml");
+  const RegistrationParams b = parse_registration_params(band["registration"]);
+  EXPECT_EQ(b.bracelet_length_sigma, 0.03);
+  EXPECT_EQ(b.bracelet_length_tolerance, 0.15);
+  EXPECT_EQ(b.bracelet_depth_ratio, 0.7);
+  EXPECT_EQ(b.bracelet_length_min_fill, 0.5);
+  EXPECT_EQ(b.bracelet_length_gate, 0.3);
+  EXPECT_EQ(RegistrationParams{}.bracelet_length_sigma, 0.0);  // off unless asked for
 }
 
 std::string parse_error(const std::string& yaml) {
@@ -105,6 +117,12 @@ TEST(RegistrationParams, ParseErrorsNameFileLineAndKey) {
   // A typo is rejected, naming the key.
   e = parse_error("registration:\n  fingertip_sigma: 0.002\n");
   EXPECT_NE(e.find("fingertip_sigma"), std::string::npos) << e;
+  // The band's settings.
+  e = parse_error("registration:\n  bracelet_depth_ratio: 0.1\n");
+  EXPECT_NE(e.find("reg.yaml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("bracelet_depth_ratio"), std::string::npos) << e;
+  e = parse_error("registration:\n  bracelet_length_gate: 0\n");
+  EXPECT_NE(e.find("bracelet_length_gate"), std::string::npos) << e;
   // The little finger's settings.
   e = parse_error("registration:\n  little_free: sometimes\n");
   EXPECT_NE(e.find("reg.yaml:2"), std::string::npos) << e;

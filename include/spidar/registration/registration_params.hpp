@@ -33,6 +33,40 @@ struct RegistrationParams {
   double bracelet_surface_shift = 0.5;
   double bracelet_radius_per_width = 0.31;  ///< forearm radius at the band / palm width
   double bracelet_standoff_m = 0.002;        ///< how far the band stands off the skin [m]
+  /// The forearm at the band is an ellipse, not a circle: its depth (back of the wrist to its
+  /// palmar side) over its breadth (bracelet_radius_per_width is the half breadth). Adult wrists
+  /// are about 0.6–0.7 as deep as broad (anthropometric surveys: breadth ≈ 5.5–6.5 cm, depth ≈
+  /// 3.5–4.5 cm). The band's projected length depends on which side the camera sees.
+  double bracelet_depth_ratio = 0.65;
+  /// σ of the band's length across the forearm in the image, relative to the detected length
+  /// (the bracelet term's second part, residuals.hpp): the band's apparent size says how far the
+  /// wrist is along its ray, which the projected midpoint cannot (a hand turned about its
+  /// fingertips can put its wrist on that ray at two depths). Covers the user's wrist differing
+  /// from the model's proportions. 0 = not used (the paper's midpoint only), the default:
+  ///
+  /// Measured (demo, 2026-11-26): on scenes/blocks.xml the left wrist, after its band was hidden
+  /// for 1.5 s, came back on the band's ray 55–70 mm too deep and turned 22–29° (the silhouette
+  /// fits either depth as well), in 3 of 6 seeds: the contested pixels 14–15 % wrong there, 2.5–
+  /// 3.6 % otherwise. At 0.06 all 6 seeds stayed right (1.6–3.2 %), at 0.12 one of 6 did not. But
+  /// the band's predicted size scales with the estimated hand width: the large user (width 10 %
+  /// above the model's, estimated 9–23 % off) then got wrists pulled toward the camera, the
+  /// contested pixels 9.2–10.4 % wrong against 1.4–1.7 % without (rubiks, seeds 1–2). Not the
+  /// default until the width is estimated well (or the band's size with it).
+  double bracelet_length_sigma = 0.0;
+  /// No band cost while the predicted length is within this share of the detected one (the
+  /// user's forearm is not the model's; the band tells the two depths of a ray apart, it does
+  /// not measure the depth finely).
+  double bracelet_length_tolerance = 0.1;
+  /// The band's length is used only where both its ends lie inside the image and its pixels fill
+  /// at least this share of its oriented box (a band partly hidden or cut looks short, i.e. far;
+  /// its confidence is no guide: it is judged against the length the last fit predicts, and a
+  /// band merely touching the image border along its side is scaled down to 0.3).
+  double bracelet_length_min_fill = 0.6;
+  /// ... and only where it is within this share of the length the previous fit predicts (a band
+  /// merged with the other hand's, or the other hand's band taken for this one, would otherwise
+  /// pull the wrist toward the camera; a wrist at the wrong one of the two depths its ray allows
+  /// predicts a band about 20–35 % shorter, which the gate still lets through).
+  double bracelet_length_gate = 0.4;
   double joint_ball_sigma_px = 4.0;   ///< σ of a joint-ball target [px]
   double joint_ball_alpha = 0.5;      ///< α of eq. 21 (dimensionless, 0..1)
   double ball_radius_scale = 1.0;     ///< ball radius = scale × the bone's projected radius

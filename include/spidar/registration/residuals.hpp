@@ -9,6 +9,11 @@
 ///   wrist      √conf · (uv(p_W_bracelet(θ)) − wrist_px) / σ_wrist (2 rows)              [px / px]
 ///              p_W_bracelet = p_W_wrist + R_WH·(0, −bracelet_offset_m, 0) + s_W, with s_W the
 ///              frozen shift to the band's visible surface (bracelet_visible_point)
+///   band       √conf · dz(‖uv(e₁(θ)) − uv(e₀(θ))‖ / wrist_length_px − 1) / σ_band, dz(x) =
+///              sign(x)·max(|x| − tolerance, 0) (1 row, where the band's length is measured and
+///              bracelet_length_sigma > 0): the band's projected length across the forearm, from
+///              its two ends e₀, e₁ frozen in the hand frame (bracelet_band_ends), relative to
+///              the detected one, with a dead zone of bracelet_length_tolerance          [1 / 1]
 ///   joint-ball (uv(joint j)(θ) − P̃_j) / σ_ball (2 rows per ball with on_count ≥ 1)       [px / px]
 ///   silhouette (uv(axis point)(θ) + offset − nearest) / σ_sil (2 rows per point found outside
 ///              the real silhouette by more than 0.5 px when frozen)                      [px / px]
@@ -20,8 +25,8 @@
 ///              counted with the prior's cost)
 /// Frozen with the targets: the joint-ball targets P̃, each silhouette point's nearest silhouette
 /// pixel and its offset from the projected axis point (± the projected radius across the bone),
-/// whether the wrist term is active (bracelet point in front of the camera) and the bracelet's
-/// visible-surface shift.
+/// whether the wrist term is active (bracelet point in front of the camera), the bracelet's
+/// visible-surface shift and the band's two ends.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -72,6 +77,10 @@ struct FrozenTargets {
   /// From the band centre to its visible surface's centre, toward the camera (world) [m]
   /// (bracelet_visible_shift at the linearisation).
   Vec3 bracelet_shift_W = Vec3::Zero();
+  /// The band term (bracelet_band_ends at the linearisation): whether it acts, and the band's
+  /// two ends in right-hand H coordinates [m] (rigid with the hand until the next freeze).
+  bool band_active = false;
+  std::array<Vec3, 2> band_end_H{Vec3::Zero(), Vec3::Zero()};
   JointBalls balls{};
   std::array<SilhouettePoint, kMaxSilhouettePoints> silhouette{};
   int silhouette_count = 0;  ///< entries of `silhouette` in use
@@ -105,6 +114,20 @@ inline double bracelet_radius_m(const RegistrationParams& params, double hand_wi
 Vec3 bracelet_visible_point(const Pose& X_WH, double hand_width_m, const Vec3& p_W_camera,
                             const RegistrationParams& params, Vec3* shift_W = nullptr);
 
+/// The band's two ends across the forearm as seen from `p_W_camera` (world, m), for a hand at
+/// pose `X_WH` (the x axis's sign does not matter): the forearm's section at the band is an
+/// ellipse centred bracelet_offset_m from the wrist toward the elbow, with half axes
+/// bracelet_radius_m across the hand (x_H) and bracelet_depth_ratio × the forearm's half breadth
+/// + standoff dorsal-palmar (z_H); its ends are the ellipse's support points in the direction
+/// across the forearm and the line of sight, w = y_H × (centre − camera). [m]
+std::array<Vec3, 2> bracelet_band_ends(const Pose& X_WH, double hand_width_m, const Vec3& p_W_camera,
+                                       const RegistrationParams& params);
+
+/// The band's projected length across the forearm [px]: the distance between its two ends'
+/// projections (bracelet_band_ends). 0 when an end is behind the camera.
+double bracelet_length_px(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                          const RegistrationParams& params);
+
 /// Recomputes the image targets at pose `q` (joint-balls, silhouette points, wrist activity).
 void freeze_targets(const ResidualProblem& problem, const hand::HandParams& q,
                     FrozenTargets* targets);
@@ -114,8 +137,8 @@ TermCosts term_costs(const ResidualProblem& problem, const FrozenTargets& target
                      const hand::HandParams& q);
 
 /// Which term a stacked residual row belongs to (the blocks above; coverage rows count as
-/// silhouette, coupling rows as prior).
-enum class ResidualTerm : std::uint8_t { kFingertip, kWrist, kJointBall, kSilhouette, kPrior };
+/// silhouette, coupling rows as prior; the band's cost counts with the wrist's in TermCosts).
+enum class ResidualTerm : std::uint8_t { kFingertip, kWrist, kBand, kJointBall, kSilhouette, kPrior };
 
 /// The stacked residual vector and, if `J` is non-null, its Jacobian (rows × 20) at `q` with
 /// frozen targets; if `terms` is non-null, each row's term. Allocates: for tests, diagnostics and

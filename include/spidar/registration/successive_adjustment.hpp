@@ -49,6 +49,9 @@ struct HandObservation {
   std::array<bool, hand::kFingertipCount> fingertip_valid{};
   std::optional<Vec2> wrist_px;  ///< projected wrist from the bracelet [px]
   double wrist_confidence = 1.0; ///< 0..1, multiplies the wrist term's weight
+  /// The band's length across the forearm in the image (vision::BraceletObservation::length_px)
+  /// [px], where the detection is whole enough to be measured; 0 = not measured.
+  double wrist_length_px = 0.0;
 };
 
 /// The image evidence shared by both hands. Without a camera only the 3D terms and the prior act.

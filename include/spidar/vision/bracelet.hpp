@@ -65,6 +65,7 @@ struct BraceletObservation {
   Vec2 end_b_px = Vec2::Zero();
   double length_px = 0;          ///< extent along the principal axis [px]
   double thickness_px = 0;       ///< extent across it [px]
+  double fill = 0;               ///< share of its oriented box (length × thickness) that is red, 0..1
   int area_px = 0;
   int pieces = 0;                ///< connected red pieces merged into this bracelet
   double confidence = 0;         ///< 0..1
