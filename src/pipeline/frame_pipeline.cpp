@@ -311,15 +311,16 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       const auto inside = [&](const Vec2& e) {
         return e.x() >= 2.0 && e.y() >= 2.0 && e.x() <= s.camera.width() - 3.0 && e.y() <= s.camera.height() - 3.0;
       };
-      const double expected =
-          s.have_previous ? registration::bracelet_length_px(hand::hand_pose(s.previous[h]),
-                                                             s.models[h].shape.dimensions.width, s.camera,
-                                                             p.registration)
-                          : 0.0;
       if (p.registration.bracelet_length_sigma > 0 && band.fill >= p.registration.bracelet_length_min_fill &&
-          inside(band.end_a_px) && inside(band.end_b_px) &&
-          (expected <= 0 || std::abs(band.length_px / expected - 1.0) <= p.registration.bracelet_length_gate))
-        obs.wrist_length_px = band.length_px;
+          inside(band.end_a_px) && inside(band.end_b_px)) {
+        const double expected =
+            s.have_previous ? registration::bracelet_length_px(hand::hand_pose(s.previous[h]),
+                                                               s.models[h].shape.dimensions.width, s.camera,
+                                                               p.registration)
+                            : 0.0;
+        if (expected <= 0 || std::abs(band.length_px / expected - 1.0) <= p.registration.bracelet_length_gate)
+          obs.wrist_length_px = band.length_px;
+      }
     }
     const bool cold = !s.have_previous;
     registration::ImageEvidence hand_image = image;
