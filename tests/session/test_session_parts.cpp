@@ -12,6 +12,17 @@
 namespace spidar::session {
 namespace {
 
+TEST(CubeMonitor, ASceneWithoutACubeIsNotReportedSolved) {
+  physics::WorldParams wp;
+  auto world = physics::World::Load("scenes/blocks.xml", wp).value();
+  std::optional<physics::RubiksCube> none;
+  CubeMonitor monitor(&none, Pose{});
+  monitor.before_step(*world);
+  ASSERT_TRUE(monitor.status().read());
+  EXPECT_FALSE(monitor.status().read()->solved);
+  EXPECT_EQ(monitor.status().read()->turns, 0);
+}
+
 TEST(CubeMonitor, ScrambleAndResetRunInThePhysicsStepAndAreNotCountedAsTurns) {
   physics::WorldParams wp;
   auto world = physics::World::Load("scenes/rubiks_cube.xml", wp).value();
