@@ -166,7 +166,7 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
     // The band's projected length across the forearm: how far along its ray the wrist is. No
     // cost while within bracelet_length_tolerance of the detected length (a dead zone: the model
     // only assumes the user's forearm size), linear in the excess beyond it.
-    if (tg.wrist_active && tg.band_active && wrist_observed(obs)) {
+    if (tg.band_active) {  // frozen only with the wrist term active (freeze_targets)
       const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / rp.bracelet_length_sigma;
       const double tol = rp.bracelet_length_tolerance;
       PointJacobian J0, J1;

@@ -187,7 +187,7 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
       tg->band_active = camera.depth(ends[0]) >= detail::kMinImageDepth &&
                         camera.depth(ends[1]) >= detail::kMinImageDepth;
       // Right-hand H coordinates (PoseState::A maps them to world), so that rigid_point moves them.
-      for (int k = 0; k < 2; ++k) tg->band_end_H[static_cast<std::size_t>(k)] = s.A.transpose() * (ends[static_cast<std::size_t>(k)] - s.p_W_wrist);
+      for (std::size_t k = 0; k < 2; ++k) tg->band_end_H[k] = s.A.transpose() * (ends[k] - s.p_W_wrist);
     }
   }
   if (!image->alpha.empty() && image->alpha.type() == CV_32FC1) {

@@ -258,14 +258,11 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
         if (ok) Jb.col(c) = (rp - rm) / (2.0 * step_h[c]);
       }
       // The joint-balls inform the length only: their targets sit a ball's radius in from the
-      // silhouette's edge, and that radius is the capsule's, which the width scales. Nor does the
-      // band's length inform the width: it measures the forearm, whose breadth the model only
-      // assumes in proportion to the palm's (bracelet_radius_per_width).
+      // silhouette's edge, and that radius is the capsule's, which the width scales. (The band's
+      // length never enters: add_frame leaves it out of the keyframes.)
       if (ok)
-        for (Eigen::Index row = 0; row < Jb.rows(); ++row) {
-          const ResidualTerm t = terms[static_cast<std::size_t>(row)];
-          if (t == ResidualTerm::kJointBall || t == ResidualTerm::kBand) Jb(row, 1) = 0.0;
-        }
+        for (Eigen::Index row = 0; row < Jb.rows(); ++row)
+          if (terms[static_cast<std::size_t>(row)] == ResidualTerm::kJointBall) Jb(row, 1) = 0.0;
       if (!ok || !J.allFinite() || !Jb.allFinite() || !r.allFinite()) continue;
       // Marginalise the pose (Schur complement).
       MatX A = J.transpose() * J;

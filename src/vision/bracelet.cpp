@@ -128,7 +128,7 @@ double bracelet_confidence(const BraceletCandidate& c, const BraceletParams& p,
   // Within [0.85, 1.25] of the expectation: whole (perspective and wrist sizes vary a little).
   if (ratio < 0.85) c_len = std::pow(ratio / 0.85, 4.0);     // partly hidden: ends are wrong
   if (ratio > 1.25) c_len = std::pow(1.25 / ratio, 3.0);     // longer than a band: not one
-  const double c_fill = std::clamp(c.fill / 0.75, 0.0, 1.0);
+  const double c_fill = std::clamp(o.fill / 0.75, 0.0, 1.0);
   const double c_border = c.touches_border ? 0.3 : 1.0;
   return std::clamp(c_len * c_fill * c_border, 0.0, 1.0);
 }
@@ -279,8 +279,7 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
     o.area_px = area;
     o.pieces = static_cast<int>(members.size());
     cand.centroid_px = c;
-    cand.fill = area / (o.length_px * o.thickness_px);
-    o.fill = cand.fill;
+    o.fill = area / (o.length_px * o.thickness_px);
     cand.touches_border = border;
     o.confidence = bracelet_confidence(cand, p, expected_length_px);
     ws->candidates.push_back(cand);

@@ -75,7 +75,6 @@ struct BraceletObservation {
 struct BraceletCandidate {
   BraceletObservation observation;  ///< confidence judged against params' expected length
   Vec2 centroid_px = Vec2::Zero();
-  double fill = 0;             ///< area / (length · thickness)
   bool touches_border = false;
 };
 
