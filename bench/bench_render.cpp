@@ -8,6 +8,7 @@
 #include "../tests/render/synthetic_hands.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/physics/world.hpp"
+#include "spidar/render/composite_metrics.hpp"
 #include "spidar/render/compositor.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/render/hand_shapes.hpp"
@@ -177,6 +178,24 @@ void Composite(benchmark::State& state) {
   state.SetLabel(render::composite_mode_name(p.mode));
 }
 BENCHMARK(Composite)->Args({640, 0})->Args({640, 1})->Args({1280, 0})->Unit(benchmark::kMillisecond);
+
+/// The ground truth's occlusion count at 640×480 (render/composite_metrics.hpp): one call over the
+/// whole frame, as the truth scorer makes four per frame (whole hand and contested pixels, both
+/// compositors).
+void RegionDisagreement640(benchmark::State& state) {
+  if (!context()) return state.SkipWithError("no headless GL");
+  const CompositeFixture f = make_composite_inputs(640);
+  cv::Mat truth;
+  (void)render::truth_composite_mask(f.frame.mask, f.frame.depth, f.targets.depth, &truth);
+  long wrong = 0;
+  for (auto _ : state) {
+    auto d = render::region_disagreement(f.key.alpha, truth, f.frame.mask);
+    if (!d) state.SkipWithError("region_disagreement failed");
+    else wrong += d->wrong;
+    benchmark::DoNotOptimize(wrong);
+  }
+}
+BENCHMARK(RegionDisagreement640)->Unit(benchmark::kMicrosecond);
 
 void SyntheticCameraFrame(benchmark::State& state) {
   if (!context()) return state.SkipWithError("no headless GL");

@@ -132,5 +132,31 @@ TEST(CompositeMetrics, ContestedPixelsAreTheHandOverAnObjectOnly) {
   EXPECT_EQ(RegionDisagreement{}.pct(), 0.0);
 }
 
+TEST(CompositeMetrics, RegionDisagreementCountsAsAPixelByPixelReference) {
+  // Random images (any non-zero byte counts as set, alpha with NaN and exact 0.5 values) against
+  // a plain count pixel by pixel; a width that is not a multiple of any vector length.
+  cv::RNG rng(7);
+  for (const cv::Size size : {cv::Size(1, 1), cv::Size(37, 5), cv::Size(640, 48)}) {
+    cv::Mat alpha(size, CV_32FC1), truth(size, CV_8UC1), region(size, CV_8UC1);
+    rng.fill(alpha, cv::RNG::UNIFORM, 0.0, 1.0);
+    rng.fill(truth, cv::RNG::UNIFORM, 0, 3);
+    rng.fill(region, cv::RNG::UNIFORM, 0, 4);
+    alpha.at<float>(0, 0) = std::numeric_limits<float>::quiet_NaN();
+    if (size.width > 1) alpha.at<float>(0, 1) = 0.5f;
+    long pixels = 0, wrong = 0;
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        if (region.at<std::uint8_t>(y, x) == 0) continue;
+        ++pixels;
+        const bool real_shown = alpha.at<float>(y, x) >= 0.5f;
+        if (real_shown != (truth.at<std::uint8_t>(y, x) != 0)) ++wrong;
+      }
+    auto d = region_disagreement(alpha, truth, region);
+    ASSERT_TRUE(d.ok());
+    EXPECT_EQ(d->pixels, pixels) << size;
+    EXPECT_EQ(d->wrong, wrong) << size;
+  }
+}
+
 }  // namespace
 }  // namespace spidar::render
