@@ -51,9 +51,14 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
   const auto jp = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].joint_px[0] + m.truth[k].joint_px[1]); });
   const auto tip = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].fingertip_mm[0] + m.truth[k].fingertip_mm[1]); });
   const auto occ = column(t, [k](const MrFrame& m) { return m.truth[k].occlusion_pct; });
+  std::vector<double> depth;  // both hands' wrists, |fit − truth| along the optical axis
+  for (const MrFrame& m : t.frames)
+    for (double d : m.truth[k].wrist_depth_mm) depth.push_back(std::abs(d));
   return {{"iou_mean", mean(iou)},
           {"iou_p5", quantile(iou, 0.05)},
           {"joint_px_mean", mean(jp)},
+          {"wrist_depth_mm_mean", mean(depth)},
+          {"wrist_depth_mm_p95", quantile(depth, 0.95)},
           {"fingertip_mm_mean", mean(tip)},
           {"fingertip_mm_p95", quantile(tip, 0.95)},
           {"occlusion_error_pct", mean(occ)},
@@ -68,7 +73,8 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
        "contested_error_pct,contested_error_pct_paper,iterations_left,"
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
        "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou,"
-       "length_mm_left,width_mm_left,length_mm_right,width_mm_right,dropped_before,joint_px_floor\n";
+       "length_mm_left,width_mm_left,length_mm_right,width_mm_right,dropped_before,joint_px_floor,"
+       "wrist_depth_mm_left,wrist_depth_mm_right\n";
   f << std::setprecision(6);
   for (const MrFrame& m : t.frames) {
     const auto& a = m.truth[0];
@@ -84,7 +90,8 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
       << m.truth_cap_residual_mm[1] << ',';
     if (m.ceiling_measured) f << m.ceiling_iou;
     for (int h = 0; h < 2; ++h) f << ',' << 1e3 * m.shape[h].length_m << ',' << 1e3 * m.shape[h].width_m;
-    f << ',' << m.dropped_before << ',' << 0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1]) << '\n';
+    f << ',' << m.dropped_before << ',' << 0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1]) << ','
+      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << '\n';
   }
   core::write_file_atomic(path, f.str());
 }
@@ -378,7 +385,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << "  registration   IoU mean " << reg["iou_mean"].get<double>() << " (p5 "
      << reg["iou_p5"].get<double>() << "), fingertip " << std::setprecision(2)
      << reg["fingertip_mm_mean"].get<double>() << " mm, joints " << reg["joint_px_mean"].get<double>()
-     << " px, " << reg["ms_per_frame_median"].get<double>() << " ms/frame (both hands), "
+     << " px, wrist depth " << std::setprecision(1) << reg["wrist_depth_mm_mean"].get<double>() << " mm, "
+     << std::setprecision(2) << reg["ms_per_frame_median"].get<double>() << " ms/frame (both hands), "
      << reg["iterations_mean"].get<double>() << " iterations\n"
      << "  model ceiling  IoU " << std::setprecision(3) << mean(ceiling)
      << " (the model's skin at the true pose with the user's sizes)\n"

@@ -28,6 +28,8 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     const hand::HandPoints f = hand::forward_kinematics(models[h], result.hands[h]);
     m.fingertip_mm[h] = registration::fingertip_error_m(f, t) * 1e3;
     m.joint_px[h] = registration::joint_px_error(f, t, camera);
+    m.wrist_depth_mm[h] = 1e3 * (camera.depth(hand::hand_pose(result.hands[h]).p) -
+                                 camera.depth(hand::hand_pose(truth[h]).p));
     hand::HandParams coupled = truth[h];
     coupled.little_independent = false;
     m.joint_px_floor[h] =

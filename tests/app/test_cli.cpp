@@ -258,6 +258,9 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_GT(reg["iou_mean"].get<double>(), 0.5);
   EXPECT_LT(reg["fingertip_mm_mean"].get<double>(), 5.0);
   EXPECT_LT(reg["joint_px_mean"].get<double>(), 12.0);
+  EXPECT_GE(reg["wrist_depth_mm_mean"].get<double>(), 0.0);  // |fit − truth| along the optical axis
+  EXPECT_GE(reg["wrist_depth_mm_p95"].get<double>(), 0.0);
+  EXPECT_GE(reg["comparison"]["wrist_depth_mm_mean"].get<double>(), 0.0);
   EXPECT_GT(reg["iterations_mean"].get<double>(), 0.0);
   EXPECT_TRUE(reg["comparison"].is_object());
   // The default: joint-balls with the hand-aware silhouette term, the paper's as the comparison.

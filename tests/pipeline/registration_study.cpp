@@ -285,6 +285,7 @@ int main(int argc, char** argv) {
   std::array<double, 6> joint_part_sum{}, joint_floor_sum{}, joint_part_n{};  // wrist, thumb … little
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
+  std::array<std::vector<double>, 2> wrist_depth_mm;  // fit − truth along the camera's axis, per hand
   std::array<Vec3, 8> g;
   for (double t = a.t0; t < a.t1 && !task.finished(t); t += 1.0 / a.fps) {
     // The device's caps: at the face, pressed a fifth of the squeeze in (the displayed force
@@ -456,6 +457,11 @@ int main(int argc, char** argv) {
       std::snprintf(name, sizeof name, "/t%05.2f.png", t);
       cv::imwrite(a.dump_dir + name, row);
     }
+    // How far along the camera's axis the fitted wrist is from the true one (the direction the
+    // strings and the bracelet's point observe least).
+    for (int h = 0; h < 2; ++h)
+      wrist_depth_mm[h].push_back(1e3 * (camera.depth(hand::hand_pose(r.hands[h]).p) -
+                                         camera.depth(hand::hand_pose(truth[h]).p)));
     // The joint error by part (the wrist, then each digit's four joints), and its floor: the
     // model's skeleton with the user's true sizes at the true pose, whose little finger can only
     // follow the ring finger's (the model has no parameters of its own for it).
@@ -488,13 +494,14 @@ int main(int argc, char** argv) {
       contested_paper.push_back(m.contested_pct_paper());
     }
     if (a.verbose)
-      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f/%.2f mm joints %.1f/%.1f px  bracelets %c%c  L %.4f/%.4f W %.4f/%.4f  wrist %.1f/%.1f sil %.1f/%.1f\n",
+      std::printf("t %5.2f IoU %.3f (ceiling %.3f) tip %.2f/%.2f mm joints %.1f/%.1f px  bracelets %c%c  L %.4f/%.4f W %.4f/%.4f  wrist %.1f/%.1f sil %.1f/%.1f  depth %+.0f/%+.0f mm\n",
                   t, m.iou, c, m.fingertip_mm[0], m.fingertip_mm[1], m.joint_px[0], m.joint_px[1],
                   r.bracelets[0].found ? 'L' : '-', r.bracelets[1].found ? 'R' : '-',
                   r.models[0].shape.dimensions.length,
                   r.models[1].shape.dimensions.length, r.models[0].shape.dimensions.width,
                   r.models[1].shape.dimensions.width, r.fits[0].terms.wrist, r.fits[1].terms.wrist,
-                  r.fits[0].terms.silhouette, r.fits[1].terms.silhouette);
+                  r.fits[0].terms.silhouette, r.fits[1].terms.silhouette, wrist_depth_mm[0].back(),
+                  wrist_depth_mm[1].back());
   }
   std::printf(
       "frames %zu  IoU mean %.3f p5 %.3f  ceiling %.3f (p5 %.3f)  tip %.2f mm (p95 %.2f)  joints "
@@ -530,6 +537,13 @@ int main(int argc, char** argv) {
                 floor_all / std::max(n_all, 1.0),
                 (fit_all - joint_part_sum[5] + joint_part_n[5] * (joint_part_sum[5] / little_n - joint_floor_sum[5] / little_n)) /
                     std::max(n_all, 1.0));
+  }
+  for (int h = 0; h < 2; ++h) {
+    const auto& d = wrist_depth_mm[h];
+    std::vector<double> magnitude(d.size());
+    for (std::size_t i = 0; i < d.size(); ++i) magnitude[i] = std::abs(d[i]);
+    std::printf("%s wrist depth, fit − truth [mm]: median %+.1f (p10 %+.1f, p90 %+.1f), |·| mean %.1f\n",
+                h == 0 ? "left" : "right", quantile(d, 0.5), quantile(d, 0.1), quantile(d, 0.9), mean(magnitude));
   }
   std::printf("fitted caps to the strings %.2f mm (p95 %.2f), truth caps to the strings %.2f mm (max %.2f)\n",
               mean(obs), quantile(obs, 0.95), mean(caps), quantile(caps, 1.0));

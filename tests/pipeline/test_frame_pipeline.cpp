@@ -116,6 +116,22 @@ TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) 
   EXPECT_LT(floor_sum / n, joint_sum / n);
   std::printf("fingertips %.2f mm, IoU %.3f, occlusion %.2f %% (paper %.2f %%), bracelets %d/%d, joints %.2f px (floor %.2f)\n",
               tip_sum / n, iou_sum / n, occ / n, occ_paper / n, bracelets, 2 * n, joint_sum / n, floor_sum / n);
+
+  // The wrists' depth error: the fitted hands replaced by the true ones moved 20 mm along the
+  // camera's optical axis (left, away) and 20 mm across it (right), with the true sizes.
+  const Vec3 axis_W = camera_.X_WC().R * Vec3::UnitZ();
+  const Vec3 across_W = camera_.X_WC().R * Vec3::UnitX();
+  const auto& truth = user.params();
+  r.hands = truth;
+  r.models = truth_models_;
+  for (int k = 0; k < 3; ++k) {
+    r.hands[0][hand::kWristX + k] += 0.020 * axis_W[k];
+    r.hands[1][hand::kWristX + k] += 0.020 * across_W[k];
+  }
+  const auto moved = sim::measure_frame(frame, r, p.compositor.mode, truth_models_, truth_models_, truth,
+                                        camera_, &ws).value();
+  EXPECT_NEAR(moved.wrist_depth_mm[0], 20.0, 1e-6);
+  EXPECT_NEAR(moved.wrist_depth_mm[1], 0.0, 1e-6);
 }
 
 // The hand-aware silhouette term against the paper's joint-balls alone, on the same frames of the

@@ -17,6 +17,9 @@ struct FrameTruthMetrics {
   double iou = 0;                     ///< fitted hands' pixels vs the real hands' (no bracelet/arm)
   std::array<double, 2> fingertip_mm{};  ///< mean fingertip cap error per hand [mm]
   std::array<double, 2> joint_px{};      ///< mean projected joint error per hand [px]
+  /// The fitted wrist's depth (along the camera's optical axis) minus the true one per hand [mm]:
+  /// the direction the image and the bracelet's midpoint observe least; it decides occlusion.
+  std::array<double, 2> wrist_depth_mm{};
   /// The paper's model's joint error floor per hand [px]: its skeleton with the user's true sizes
   /// at the true pose, with the little finger following the ring finger's (the paper's model has
   /// no parameters of their own for it; registration's little_free fits them, and can go below
