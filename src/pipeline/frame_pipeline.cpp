@@ -311,15 +311,33 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       const auto inside = [&](const Vec2& e) {
         return e.x() >= 2.0 && e.y() >= 2.0 && e.x() <= s.camera.width() - 3.0 && e.y() <= s.camera.height() - 3.0;
       };
-      if (p.registration.bracelet_length_sigma > 0 && band.fill >= p.registration.bracelet_length_min_fill &&
-          inside(band.end_a_px) && inside(band.end_b_px)) {
+      const bool solid = band.fill >= p.registration.bracelet_length_min_fill && inside(band.end_a_px) &&
+                         inside(band.end_b_px);
+      const double gate_share = p.registration.bracelet_length_gate;
+      auto within_gate = [&](double measured, double expected) {
+        return expected <= 0 || std::abs(measured / expected - 1.0) <= gate_share;
+      };
+      if (p.registration.bracelet_length_sigma > 0 && solid) {
         const double expected =
             s.have_previous ? registration::bracelet_length_px(hand::hand_pose(s.previous[h]),
                                                                s.models[h].shape.dimensions.width, s.camera,
                                                                p.registration)
                             : 0.0;
-        if (expected <= 0 || std::abs(band.length_px / expected - 1.0) <= p.registration.bracelet_length_gate)
-          obs.wrist_length_px = band.length_px;
+        if (within_gate(band.length_px, expected)) obs.wrist_length_px = band.length_px;
+      }
+      // Its thickness across its long axis, likewise (registration_params.hpp).
+      const Vec2 axis = band.end_b_px - band.end_a_px;
+      if (p.registration.bracelet_thickness_sigma > 0 && solid && axis.norm() > 1e-6) {
+        const Vec2 unit = axis.normalized();
+        const double expected =
+            s.have_previous ? registration::bracelet_band_thickness(hand::hand_pose(s.previous[h]),
+                                                                    s.models[h].shape.dimensions.width, s.camera,
+                                                                    p.registration, Vec2(-unit.y(), unit.x()))
+                            : 0.0;
+        if (within_gate(band.thickness_px, expected)) {
+          obs.wrist_thickness_px = band.thickness_px;
+          obs.wrist_axis_px = unit;
+        }
       }
     }
     const bool cold = !s.have_previous;

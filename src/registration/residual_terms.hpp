@@ -188,6 +188,29 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
         sink.template add<1>(Term::kBand, r, nullptr);
       }
     }
+    // The band's thickness across its image axis: how obliquely the camera sees the forearm
+    // (the same dead zone and weight as the band's length).
+    if (tg.thickness_active) {  // frozen only with the wrist term active (freeze_targets)
+      const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / rp.bracelet_thickness_sigma;
+      const double tol = rp.bracelet_thickness_tolerance;
+      PointJacobian J0, J1;
+      const Vec3 e0 = rigid_point(s, tg.thickness_end_H[0], kJacobian ? &J0 : nullptr);
+      const Vec3 e1 = rigid_point(s, tg.thickness_end_H[1], kJacobian ? &J1 : nullptr);
+      vision::ProjectionJacobian Jp0, Jp1;
+      const Vec2 d = kJacobian ? Vec2(camera->project(e1, &Jp1) - camera->project(e0, &Jp0))
+                               : Vec2(camera->project(e1) - camera->project(e0));
+      const Vec2& n = tg.thickness_dir_px;
+      const double excess = d.dot(n) / obs.wrist_thickness_px - 1.0;  // relative
+      const double beyond = excess > tol ? excess - tol : (excess < -tol ? excess + tol : 0.0);
+      const Block<1> r = Block<1>::Constant(w * beyond);
+      if constexpr (kJacobian) {
+        BlockJacobian<1> J = BlockJacobian<1>::Zero();
+        if (beyond != 0.0) J = (w / obs.wrist_thickness_px) * n.transpose() * (Jp1 * J1 - Jp0 * J0);
+        sink.template add<1>(Term::kBand, r, &J);
+      } else {
+        sink.template add<1>(Term::kBand, r, nullptr);
+      }
+    }
 
     // Joint-balls (eq. 21): the projected joint toward its frozen target P̃; the P of the paper,
     // linearised P(θ+Δθ) ≈ P(θ) + J_P Δθ (paper eqs 23–38).

@@ -1,8 +1,10 @@
 #include "spidar/registration/residuals.hpp"
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
+#include "spidar/core/units.hpp"
 #include "spidar/registration/coverage.hpp"
 
 #include "residual_terms.hpp"
@@ -163,9 +165,42 @@ double bracelet_length_px(const Pose& X_WH, double hand_width_m, const vision::C
   return (camera.project(ends[1]) - camera.project(ends[0])).norm();
 }
 
+double bracelet_band_thickness(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                               const RegistrationParams& params, const Vec2& across_px,
+                               std::array<Vec3, 2>* ends) {
+  const Mat3 R = X_WH.R.toRotationMatrix();
+  const Vec3 x = R.col(0), z = R.col(2);  // across the forearm; y_H runs along it
+  const double a = bracelet_radius_m(params, hand_width_m);
+  const double b = params.bracelet_depth_ratio * params.bracelet_radius_per_width * hand_width_m +
+                   params.bracelet_standoff_m;
+  const Vec3 p_W_camera = camera.X_WC().p;
+  constexpr int kSamples = 48;  // around each rim
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  Vec3 p_lo = Vec3::Zero(), p_hi = Vec3::Zero();
+  for (const double along : {params.bracelet_offset_m - 0.5 * params.bracelet_width_m,
+                             params.bracelet_offset_m + 0.5 * params.bracelet_width_m}) {
+    const Vec3 rim_centre = X_WH * Vec3(0.0, -along, 0.0);
+    for (int k = 0; k < kSamples; ++k) {
+      const double phi = 2.0 * units::kPi * k / kSamples;
+      const double c = std::cos(phi), sn = std::sin(phi);
+      const Vec3 p = rim_centre + a * c * x + b * sn * z;
+      const Vec3 outward = (c / a) * x + (sn / b) * z;  // the ellipse's normal (unnormalised)
+      if (outward.dot(p_W_camera - p) <= 0.0) continue;  // the far side
+      if (camera.depth(p) < detail::kMinImageDepth) return 0.0;
+      const double u = camera.project(p).dot(across_px);
+      if (u < lo) lo = u, p_lo = p;
+      if (u > hi) hi = u, p_hi = p;
+    }
+  }
+  if (!(hi > lo)) return 0.0;
+  if (ends) *ends = {p_lo, p_hi};
+  return hi - lo;
+}
+
 void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, FrozenTargets* tg) {
   tg->wrist_active = false;
   tg->band_active = false;
+  tg->thickness_active = false;
   for (JointBall& b : tg->balls) b = JointBall{};
   tg->silhouette_count = 0;
   tg->coverage_count = 0;
@@ -188,6 +223,20 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
                         camera.depth(ends[1]) >= detail::kMinImageDepth;
       // Right-hand H coordinates (PoseState::A maps them to world), so that rigid_point moves them.
       for (std::size_t k = 0; k < 2; ++k) tg->band_end_H[k] = s.A.transpose() * (ends[k] - s.p_W_wrist);
+    }
+    const Vec2& axis = obs.wrist_axis_px;
+    if (tg->wrist_active && pr.params->bracelet_thickness_sigma > 0 &&
+        std::isfinite(obs.wrist_thickness_px) && obs.wrist_thickness_px > 0 && axis.allFinite() &&
+        std::abs(axis.squaredNorm() - 1.0) < 1e-6) {
+      const Vec2 across(-axis.y(), axis.x());
+      std::array<Vec3, 2> ends;
+      if (bracelet_band_thickness(hand::hand_pose(q), pr.model->shape.dimensions.width, camera, *pr.params,
+                                  across, &ends) > 0) {
+        tg->thickness_active = true;
+        tg->thickness_dir_px = across;
+        for (std::size_t k = 0; k < 2; ++k)
+          tg->thickness_end_H[k] = s.A.transpose() * (ends[k] - s.p_W_wrist);
+      }
     }
   }
   if (!image->alpha.empty() && image->alpha.type() == CV_32FC1) {

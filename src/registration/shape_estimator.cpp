@@ -359,6 +359,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
   // went 18 % narrow (demo, seeds 1–2), without it 4–8 % (the band measures the forearm, whose
   // breadth the model only assumes in proportion to the palm's).
   kf.observation.wrist_length_px = 0.0;
+  kf.observation.wrist_thickness_px = 0.0;
   if ((p_.silhouette != ShapeSilhouette::kNone || p_.joint_balls) && !image.alpha.empty() &&
       image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);

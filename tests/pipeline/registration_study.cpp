@@ -428,6 +428,43 @@ int main(int argc, char** argv) {
         brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
       ++brace_n;
     }
+    if (std::getenv("THICK_DBG")) {
+      // Predicted band extents at a pose: the band's near-side surface sampled (ellipse section,
+      // 18 mm along the forearm), projected; extent along the detected long axis and across it.
+      auto extents = [&](const hand::HandParams& q, double width, const vision::BraceletObservation& b) {
+        const Pose X = hand::hand_pose(q);
+        const Mat3 R = X.R.toRotationMatrix();
+        const Vec3 x = R.col(0), y = R.col(1), z = R.col(2);
+        const double ra = p.registration.bracelet_radius_per_width * width + p.registration.bracelet_standoff_m;
+        const double rb = p.registration.bracelet_depth_ratio * p.registration.bracelet_radius_per_width * width + p.registration.bracelet_standoff_m;
+        Vec2 ax = (b.end_b_px - b.end_a_px).normalized();
+        Vec2 n(-ax.y(), ax.x());
+        double lo_a = 1e9, hi_a = -1e9, lo_n = 1e9, hi_n = -1e9;
+        const Vec3 cam = camera.X_WC().p;
+        for (int i = 0; i < 72; ++i) {
+          const double phi = 2 * 3.14159265 * i / 72;
+          const Vec3 radial = ra * std::cos(phi) * x + rb * std::sin(phi) * z;
+          const Vec3 normal = (std::cos(phi) / ra) * x + (std::sin(phi) / rb) * z;
+          for (double sl : {0.012 - 0.009, 0.012 + 0.009}) {
+            const Vec3 pt = X.p - sl * y + radial;
+            if (normal.dot(cam - pt) <= 0) continue;  // the far side
+            const Vec2 uv = camera.project(pt);
+            lo_a = std::min(lo_a, uv.dot(ax)); hi_a = std::max(hi_a, uv.dot(ax));
+            lo_n = std::min(lo_n, uv.dot(n)); hi_n = std::max(hi_n, uv.dot(n));
+          }
+        }
+        return Vec2(hi_a - lo_a, hi_n - lo_n);
+      };
+      for (int h = 0; h < 2; ++h) {
+        const auto& b = r.bracelets[h];
+        if (!b.found) continue;
+        const Vec2 et = extents(truth[h], truth_models[h].shape.dimensions.width, b);
+        const Vec2 ef = extents(r.hands[h], r.models[h].shape.dimensions.width, b);
+        std::printf("TH t %.2f h %d fill %.2f obs %.0f x %.1f truth %.0f x %.1f fit %.0f x %.1f depth %+.0f\n", t, h, b.fill,
+                    b.length_px, b.thickness_px, et.x(), et.y(), ef.x(), ef.y(),
+                    1e3 * (camera.depth(hand::hand_pose(r.hands[h]).p) - camera.depth(hand::hand_pose(truth[h]).p)));
+      }
+    }
     if (!a.dump_dir.empty() && m.iou < a.dump_below) {
       // Green: the real hands only; red: the fitted model's hand pixels; the frame beside.
       cv::Mat overlay(frame.hand_only.size(), CV_8UC3, cv::Scalar(0, 0, 0));

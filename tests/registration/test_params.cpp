@@ -90,6 +90,15 @@ TEST(RegistrationParams, ParsesValues) {
   EXPECT_EQ(b.bracelet_length_min_fill, 0.5);
   EXPECT_EQ(b.bracelet_length_gate, 0.3);
   EXPECT_EQ(RegistrationParams{}.bracelet_length_sigma, 0.0);  // off unless asked for
+  // The band's thickness.
+  const auto thick = core::ConfigNode::Parse(
+      "registration:\n  bracelet_width_m: 0.02\n  bracelet_thickness_sigma: 0.07\n"
+      "  bracelet_thickness_tolerance: 0.25\n",
+      "reg.yaml");
+  const RegistrationParams t = parse_registration_params(thick["registration"]);
+  EXPECT_EQ(t.bracelet_width_m, 0.02);
+  EXPECT_EQ(t.bracelet_thickness_sigma, 0.07);
+  EXPECT_EQ(t.bracelet_thickness_tolerance, 0.25);
 }
 
 std::string parse_error(const std::string& yaml) {
@@ -123,6 +132,11 @@ TEST(RegistrationParams, ParseErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("bracelet_depth_ratio"), std::string::npos) << e;
   e = parse_error("registration:\n  bracelet_length_gate: 0\n");
   EXPECT_NE(e.find("bracelet_length_gate"), std::string::npos) << e;
+  e = parse_error("registration:\n  bracelet_width_m: 0.2\n");
+  EXPECT_NE(e.find("registration.bracelet_width_m"), std::string::npos) << e;
+  EXPECT_NE(e.find("[0, 0.1] m"), std::string::npos) << e;
+  e = parse_error("registration:\n  bracelet_thickness_sigma: -1\n");
+  EXPECT_NE(e.find("bracelet_thickness_sigma"), std::string::npos) << e;
   // The little finger's settings.
   e = parse_error("registration:\n  little_free: sometimes\n");
   EXPECT_NE(e.find("reg.yaml:2"), std::string::npos) << e;

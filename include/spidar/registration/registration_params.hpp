@@ -67,6 +67,17 @@ struct RegistrationParams {
   /// pull the wrist toward the camera; a wrist at the wrong one of the two depths its ray allows
   /// predicts a band about 20–35 % shorter, which the gate still lets through).
   double bracelet_length_gate = 0.4;
+  /// The band's width along the forearm [m] (the bracelet's own, measured once), for its thickness.
+  double bracelet_width_m = 0.018;
+  /// σ of the band's thickness in the image (its extent along the forearm: the band's width and
+  /// its near rim, foreshortened by how obliquely the camera sees the forearm), relative to the
+  /// detected thickness beyond bracelet_thickness_tolerance; 0 = not used. The band's length
+  /// cannot tell the two depths of a wrist's ray apart where the user's forearm is not the
+  /// model's; the thickness can: the hand turned 20–30° about its fingertips that puts the wrist
+  /// at the deeper one sees the band 25–30 % thinner (registration study, 2026-11-26).
+  /// Used under the band length's conditions (a solid band, ends inside the image, the gate).
+  double bracelet_thickness_sigma = 0.0;
+  double bracelet_thickness_tolerance = 0.15;  ///< no cost within this share of the detected thickness
   double joint_ball_sigma_px = 4.0;   ///< σ of a joint-ball target [px]
   double joint_ball_alpha = 0.5;      ///< α of eq. 21 (dimensionless, 0..1)
   double ball_radius_scale = 1.0;     ///< ball radius = scale × the bone's projected radius

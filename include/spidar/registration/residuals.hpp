@@ -14,6 +14,9 @@
 ///              bracelet_length_sigma > 0): the band's projected length across the forearm, from
 ///              its two ends e₀, e₁ frozen in the hand frame (bracelet_band_ends), relative to
 ///              the detected one, with a dead zone of bracelet_length_tolerance          [1 / 1]
+///   thickness  the same for the band's extent across its long axis in the image, from its two
+///              frozen extreme points (bracelet_band_thickness), against wrist_thickness_px
+///              (1 row, where bracelet_thickness_sigma > 0; counted with the band)       [1 / 1]
 ///   joint-ball (uv(joint j)(θ) − P̃_j) / σ_ball (2 rows per ball with on_count ≥ 1)       [px / px]
 ///   silhouette (uv(axis point)(θ) + offset − nearest) / σ_sil (2 rows per point found outside
 ///              the real silhouette by more than 0.5 px when frozen)                      [px / px]
@@ -81,6 +84,12 @@ struct FrozenTargets {
   /// two ends in right-hand H coordinates [m] (rigid with the hand until the next freeze).
   bool band_active = false;
   std::array<Vec3, 2> band_end_H{Vec3::Zero(), Vec3::Zero()};
+  /// The band's thickness term (bracelet_band_thickness at the linearisation): whether it acts,
+  /// the two points of the band's near side farthest apart across its image axis, right-hand H
+  /// [m], and that direction in the image (unit, frozen).
+  bool thickness_active = false;
+  std::array<Vec3, 2> thickness_end_H{Vec3::Zero(), Vec3::Zero()};
+  Vec2 thickness_dir_px = Vec2::Zero();
   JointBalls balls{};
   std::array<SilhouettePoint, kMaxSilhouettePoints> silhouette{};
   int silhouette_count = 0;  ///< entries of `silhouette` in use
@@ -127,6 +136,15 @@ std::array<Vec3, 2> bracelet_band_ends(const Pose& X_WH, double hand_width_m, co
 /// projections (bracelet_band_ends). 0 when an end is behind the camera.
 double bracelet_length_px(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
                           const RegistrationParams& params);
+
+/// The band's thickness in the image for a hand at pose `X_WH`: its near side (the points of
+/// both rims, bracelet_width_m apart along the forearm around bracelet_offset_m, whose outward
+/// normal faces the camera; the section as in bracelet_band_ends) projected, and its extent along
+/// `across_px` (unit, image). `ends` (optional) receives the two points giving the extent (world).
+/// 0 when a sampled point is behind the camera.
+double bracelet_band_thickness(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                               const RegistrationParams& params, const Vec2& across_px,
+                               std::array<Vec3, 2>* ends = nullptr);
 
 /// Recomputes the image targets at pose `q` (joint-balls, silhouette points, wrist activity).
 void freeze_targets(const ResidualProblem& problem, const hand::HandParams& q,

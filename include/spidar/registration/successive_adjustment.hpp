@@ -52,6 +52,10 @@ struct HandObservation {
   /// The band's length across the forearm in the image (vision::BraceletObservation::length_px)
   /// [px], where the detection is whole enough to be measured; 0 = not measured.
   double wrist_length_px = 0.0;
+  /// The band's thickness (vision::BraceletObservation::thickness_px: its extent across its long
+  /// axis) [px] and that long axis in the image (unit), under the same conditions; 0 = not measured.
+  double wrist_thickness_px = 0.0;
+  Vec2 wrist_axis_px = Vec2::Zero();
 };
 
 /// The image evidence shared by both hands. Without a camera only the 3D terms and the prior act.
