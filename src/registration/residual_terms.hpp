@@ -163,54 +163,41 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
       const Vec3 p = bracelet_point(s, rp, J3p) + tg.bracelet_shift_W;
       add_projected(Term::kWrist, p, Vec2::Zero(), *obs.wrist_px, w);
     }
-    // The band's projected length across the forearm: how far along its ray the wrist is. No
-    // cost while within bracelet_length_tolerance of the detected length (a dead zone: the model
-    // only assumes the user's forearm size), linear in the excess beyond it.
-    if (tg.band_active) {  // frozen only with the wrist term active (freeze_targets)
-      const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / rp.bracelet_length_sigma;
-      const double tol = rp.bracelet_length_tolerance;
+    // The band's extent in the image from two points frozen on it (right-hand H), relative to
+    // the detected extent: no cost within `tol` (a dead zone: the model only assumes the user's
+    // forearm), linear in the excess beyond it. `across` (unit) measures the extent across the
+    // band's image axis; zero measures the distance itself.
+    auto add_band_extent = [&](const std::array<Vec3, 2>& end_H, double detected, double sigma, double tol,
+                               const Vec2& across) {
+      const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / sigma;
       PointJacobian J0, J1;
-      const Vec3 e0 = rigid_point(s, tg.band_end_H[0], kJacobian ? &J0 : nullptr);
-      const Vec3 e1 = rigid_point(s, tg.band_end_H[1], kJacobian ? &J1 : nullptr);
+      const Vec3 e0 = rigid_point(s, end_H[0], kJacobian ? &J0 : nullptr);
+      const Vec3 e1 = rigid_point(s, end_H[1], kJacobian ? &J1 : nullptr);
       vision::ProjectionJacobian Jp0, Jp1;
       const Vec2 d = kJacobian ? Vec2(camera->project(e1, &Jp1) - camera->project(e0, &Jp0))
                                : Vec2(camera->project(e1) - camera->project(e0));
-      const double length = d.norm();
-      const double excess = length / obs.wrist_length_px - 1.0;  // relative
+      const bool along_d = across.isZero();
+      const double extent = along_d ? d.norm() : d.dot(across);
+      const double excess = extent / detected - 1.0;  // relative
       const double beyond = excess > tol ? excess - tol : (excess < -tol ? excess + tol : 0.0);
       const Block<1> r = Block<1>::Constant(w * beyond);
       if constexpr (kJacobian) {
         BlockJacobian<1> J = BlockJacobian<1>::Zero();
-        if (beyond != 0.0 && length > 1e-9)
-          J = (w / (obs.wrist_length_px * length)) * d.transpose() * (Jp1 * J1 - Jp0 * J0);
+        const Vec2 grad = along_d ? (extent > 1e-9 ? Vec2(d / extent) : Vec2(Vec2::Zero())) : across;
+        if (beyond != 0.0) J = (w / detected) * grad.transpose() * (Jp1 * J1 - Jp0 * J0);
         sink.template add<1>(Term::kBand, r, &J);
       } else {
         sink.template add<1>(Term::kBand, r, nullptr);
       }
-    }
-    // The band's thickness across its image axis: how obliquely the camera sees the forearm
-    // (the same dead zone and weight as the band's length).
-    if (tg.thickness_active) {  // frozen only with the wrist term active (freeze_targets)
-      const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / rp.bracelet_thickness_sigma;
-      const double tol = rp.bracelet_thickness_tolerance;
-      PointJacobian J0, J1;
-      const Vec3 e0 = rigid_point(s, tg.thickness_end_H[0], kJacobian ? &J0 : nullptr);
-      const Vec3 e1 = rigid_point(s, tg.thickness_end_H[1], kJacobian ? &J1 : nullptr);
-      vision::ProjectionJacobian Jp0, Jp1;
-      const Vec2 d = kJacobian ? Vec2(camera->project(e1, &Jp1) - camera->project(e0, &Jp0))
-                               : Vec2(camera->project(e1) - camera->project(e0));
-      const Vec2& n = tg.thickness_dir_px;
-      const double excess = d.dot(n) / obs.wrist_thickness_px - 1.0;  // relative
-      const double beyond = excess > tol ? excess - tol : (excess < -tol ? excess + tol : 0.0);
-      const Block<1> r = Block<1>::Constant(w * beyond);
-      if constexpr (kJacobian) {
-        BlockJacobian<1> J = BlockJacobian<1>::Zero();
-        if (beyond != 0.0) J = (w / obs.wrist_thickness_px) * n.transpose() * (Jp1 * J1 - Jp0 * J0);
-        sink.template add<1>(Term::kBand, r, &J);
-      } else {
-        sink.template add<1>(Term::kBand, r, nullptr);
-      }
-    }
+    };
+    // The band's length across the forearm: how far along its ray the wrist is.
+    if (tg.band_active)  // frozen only with the wrist term active (freeze_targets)
+      add_band_extent(tg.band_end_H, obs.wrist_length_px, rp.bracelet_length_sigma, rp.bracelet_length_tolerance,
+                      Vec2::Zero());
+    // Its thickness across its image axis: how obliquely the camera sees the forearm.
+    if (tg.thickness_active)
+      add_band_extent(tg.thickness_end_H, obs.wrist_thickness_px, rp.bracelet_thickness_sigma,
+                      rp.bracelet_thickness_tolerance, tg.thickness_dir_px);
 
     // Joint-balls (eq. 21): the projected joint toward its frozen target P̃; the P of the paper,
     // linearised P(θ+Δθ) ≈ P(θ) + J_P Δθ (paper eqs 23–38).

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "spidar/core/units.hpp"
@@ -98,6 +99,13 @@ void freeze_coverage(const ResidualProblem& pr, const hand::HandParams& q,
   }
 }
 
+/// The forearm's section at the band, an ellipse: half breadth a (across the hand, x_H) and half
+/// depth b (dorsal-palmar, z_H) [m] (bracelet_radius_m and bracelet_depth_ratio).
+std::pair<double, double> band_section(const RegistrationParams& params, double hand_width_m) {
+  return {bracelet_radius_m(params, hand_width_m),
+          params.bracelet_depth_ratio * params.bracelet_radius_per_width * hand_width_m + params.bracelet_standoff_m};
+}
+
 /// Collects the rows (tests only).
 struct StackSink {
   std::vector<double> r;
@@ -143,9 +151,7 @@ std::array<Vec3, 2> bracelet_band_ends(const Pose& X_WH, double hand_width_m, co
   const Vec3 centre = X_WH * Vec3(0.0, -params.bracelet_offset_m, 0.0);
   const Mat3 R = X_WH.R.toRotationMatrix();
   const Vec3 x = R.col(0), y = R.col(1), z = R.col(2);
-  const double a = bracelet_radius_m(params, hand_width_m);
-  const double b = params.bracelet_depth_ratio * params.bracelet_radius_per_width * hand_width_m +
-                   params.bracelet_standoff_m;
+  const auto [a, b] = band_section(params, hand_width_m);
   Vec3 w = y.cross(centre - p_W_camera);  // across the forearm and the line of sight
   const double n = w.norm();
   if (!(n > 1e-12)) w = x;                // seen end-on: any direction across is as good
@@ -170,9 +176,7 @@ double bracelet_band_thickness(const Pose& X_WH, double hand_width_m, const visi
                                std::array<Vec3, 2>* ends) {
   const Mat3 R = X_WH.R.toRotationMatrix();
   const Vec3 x = R.col(0), z = R.col(2);  // across the forearm; y_H runs along it
-  const double a = bracelet_radius_m(params, hand_width_m);
-  const double b = params.bracelet_depth_ratio * params.bracelet_radius_per_width * hand_width_m +
-                   params.bracelet_standoff_m;
+  const auto [a, b] = band_section(params, hand_width_m);
   const Vec3 p_W_camera = camera.X_WC().p;
   constexpr int kSamples = 48;  // around each rim
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
