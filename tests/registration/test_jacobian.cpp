@@ -132,6 +132,45 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
   EXPECT_GT(palm_points, 0);
 }
 
+// What the strings and the bracelet's midpoint measure of hand `truth`, exactly: its four
+// fingertips, and its wrist joint projected (the band at the wrist joint: bracelet_offset_m 0).
+HandObservation exact_observation(const hand::HandModel& model, const hand::HandParams& truth,
+                                  const vision::Camera& camera) {
+  HandObservation obs;
+  const hand::HandPoints pts = hand::forward_kinematics(model, truth);
+  for (int f = 0; f < hand::kFingertipCount; ++f) {
+    obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
+    obs.fingertip_valid[f] = true;
+  }
+  obs.wrist_px = camera.project(truth.p_W_wrist());
+  obs.wrist_confidence = 1.0;
+  return obs;
+}
+
+// Hand `q` turned by `angle` [rad] about the line through its index and ring fingertips (which
+// stay where they are): the wrist swings on a circle about them.
+hand::HandParams turned_about_fingertips(const hand::HandModel& model, const hand::HandParams& q, double angle) {
+  const hand::HandPoints pts = hand::forward_kinematics(model, q);
+  const Vec3 pivot = pts.p_W_fingertip[hand::kIndex];
+  const Mat3 turn =
+      Eigen::AngleAxisd(angle, (pts.p_W_fingertip[hand::kRing] - pivot).normalized()).toRotationMatrix();
+  const Eigen::AngleAxisd turned(Mat3(turn * hand::hand_pose(q).R.toRotationMatrix()));
+  hand::HandParams out = q;
+  out.set_wrist(pivot + turn * (q.p_W_wrist() - pivot), turned.angle() * turned.axis());
+  return out;
+}
+
+// The fit from `start` with `params` (50 iterations) on `obs`, the camera known but no image: the
+// strings, the bracelet's midpoint and the band's terms only.
+hand::HandParams fit_image_free(const hand::HandModel& model, const HandObservation& obs,
+                                const vision::Camera& camera, RegistrationParams params, hand::HandParams start) {
+  params.max_iterations = 50;
+  ImageEvidence image;
+  image.camera = &camera;
+  SuccessiveAdjustment(params).fit(model, obs, image, nullptr, &start);
+  return start;
+}
+
 // The band's length says how far along its ray the wrist is, which its projected midpoint cannot:
 // a hand started 4 cm too deep along the ray of its bracelet's midpoint, with the fingertips from
 // the strings, comes nearer its true depth with the band's length (7 mm off, against 14 mm without: a
@@ -145,29 +184,18 @@ TEST(BraceletBand, TheBandsLengthPullsAWristBackToItsDepth) {
     RegistrationParams params;
     params.bracelet_offset_m = 0.0;  // the band at the wrist joint: its midpoint's ray is the wrist's
     params.bracelet_surface_shift = 0.0;
-    HandObservation obs;
-    const hand::HandPoints pts = hand::forward_kinematics(model, truth);
-    for (int f = 0; f < hand::kFingertipCount; ++f) {
-      obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
-      obs.fingertip_valid[f] = true;
-    }
-    obs.wrist_px = camera.project(truth.p_W_wrist());
-    obs.wrist_confidence = 1.0;
+    HandObservation obs = exact_observation(model, truth, camera);
     const double length = bracelet_length_px(hand::hand_pose(truth), model.shape.dimensions.width, camera, params);
     ASSERT_GT(length, 10.0);
     obs.wrist_length_px = length;
     hand::HandParams start = truth;
     const Vec3 ray = (truth.p_W_wrist() - camera.X_WC().p).normalized();
     start.q.segment<3>(hand::kWristX) = truth.p_W_wrist() + 0.04 * ray;
-    ImageEvidence image;
-    image.camera = &camera;
     auto depth_error = [&](double sigma) {
       RegistrationParams p = params;
       p.bracelet_length_sigma = sigma;
       p.bracelet_length_tolerance = 0.0;
-      p.max_iterations = 50;
-      hand::HandParams q = start;
-      SuccessiveAdjustment(p).fit(model, obs, image, nullptr, &q);
+      const hand::HandParams q = fit_image_free(model, obs, camera, p, start);
       return std::abs(camera.depth(q.p_W_wrist()) - camera.depth(truth.p_W_wrist()));
     };
     const double with_band = depth_error(0.05), without = depth_error(0.0);
@@ -214,13 +242,7 @@ TEST(BraceletBand, TheThicknessIsTheNearSidesExtentAcrossTheBand) {
     }
     EXPECT_NEAR(t, hi - lo, 0.01 * (hi - lo)) << "side " << side;
     // Turned 25° about the line through its index and ring fingertips, the band looks otherwise.
-    const hand::HandPoints pts = hand::forward_kinematics(model, q);
-    const Vec3 pivot = pts.p_W_fingertip[hand::kIndex];
-    const Vec3 turn_axis = (pts.p_W_fingertip[hand::kRing] - pivot).normalized();
-    const Mat3 turn = Eigen::AngleAxisd(0.44, turn_axis).toRotationMatrix();
-    Pose turned = X;
-    turned.R = Eigen::Quaterniond(turn * R);
-    turned.p = pivot + turn * (X.p - pivot);
+    const Pose turned = hand::hand_pose(turned_about_fingertips(model, q, 0.44));
     const double t_turned = bracelet_band_thickness(turned, width, camera, params, across);
     EXPECT_GT(std::abs(t_turned / t - 1.0), 0.1) << "side " << side << ": " << t << " → " << t_turned << " px";
   }
@@ -238,14 +260,7 @@ TEST(BraceletBand, TheBandsThicknessTurnsAHandBackAboutItsFingertips) {
     RegistrationParams params;
     params.bracelet_offset_m = 0.0;
     params.bracelet_surface_shift = 0.0;
-    HandObservation obs;
-    const hand::HandPoints pts = hand::forward_kinematics(model, truth);
-    for (int f = 0; f < hand::kFingertipCount; ++f) {
-      obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
-      obs.fingertip_valid[f] = true;
-    }
-    obs.wrist_px = camera.project(truth.p_W_wrist());
-    obs.wrist_confidence = 1.0;
+    HandObservation obs = exact_observation(model, truth, camera);
     const Pose X = hand::hand_pose(truth);
     const auto ends = bracelet_band_ends(X, model.shape.dimensions.width, camera.X_WC().p, params);
     obs.wrist_axis_px = (camera.project(ends[1]) - camera.project(ends[0])).normalized();
@@ -253,21 +268,12 @@ TEST(BraceletBand, TheBandsThicknessTurnsAHandBackAboutItsFingertips) {
     obs.wrist_thickness_px = bracelet_band_thickness(X, model.shape.dimensions.width, camera, params, across);
     ASSERT_GT(obs.wrist_thickness_px, 5.0);
     // Start: the true pose turned 25° about the line through the index and ring fingertips.
-    const Vec3 pivot = pts.p_W_fingertip[hand::kIndex];
-    const Vec3 turn_axis = (pts.p_W_fingertip[hand::kRing] - pivot).normalized();
-    const Mat3 turn = Eigen::AngleAxisd(0.44, turn_axis).toRotationMatrix();
-    hand::HandParams start = truth;
-    const Eigen::AngleAxisd turned(Mat3(turn * X.R.toRotationMatrix()));
-    start.set_wrist(pivot + turn * (truth.p_W_wrist() - pivot), turned.angle() * turned.axis());
-    ImageEvidence image;
-    image.camera = &camera;
+    const hand::HandParams start = turned_about_fingertips(model, truth, 0.44);
     auto angle_error = [&](double sigma) {
       RegistrationParams p = params;
       p.bracelet_thickness_sigma = sigma;
       p.bracelet_thickness_tolerance = 0.0;
-      p.max_iterations = 50;
-      hand::HandParams q = start;
-      SuccessiveAdjustment(p).fit(model, obs, image, nullptr, &q);
+      const hand::HandParams q = fit_image_free(model, obs, camera, p, start);
       return Eigen::AngleAxisd(hand::hand_pose(q).R * X.R.inverse()).angle();
     };
     // One scalar against a turn of three angles: it takes back the part it sees (measured: 0.101 →
