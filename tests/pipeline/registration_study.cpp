@@ -495,10 +495,8 @@ int main(int argc, char** argv) {
       cv::imwrite(a.dump_dir + name, row);
     }
     // How far along the camera's axis the fitted wrist is from the true one (the direction the
-    // strings and the bracelet's point observe least).
-    for (int h = 0; h < 2; ++h)
-      wrist_depth_mm[h].push_back(1e3 * (camera.depth(hand::hand_pose(r.hands[h]).p) -
-                                         camera.depth(hand::hand_pose(truth[h]).p)));
+    // strings and the bracelet's point observe least; measure_frame's).
+    for (int h = 0; h < 2; ++h) wrist_depth_mm[h].push_back(m.wrist_depth_mm[h]);
     // The joint error by part (the wrist, then each digit's four joints), and its floor: the
     // model's skeleton with the user's true sizes at the true pose, whose little finger can only
     // follow the ring finger's (the model has no parameters of its own for it).
