@@ -111,7 +111,9 @@ void AsyncSinks::copy_into(const FrameEvent& from, Slot& to) const {
     to.scene = *from.scene;  // shapes by value; the meshes are shared and not changed per frame
     to.e.scene = &to.scene;
   }
-  if (from.result != nullptr) {
+  if (from.result_hold) {
+    to.e.result = from.result_hold.get();  // held by to.e.result_hold until the sinks are done
+  } else if (from.result != nullptr) {
     pipeline::copy_frame_result(*from.result, &to.result);
     to.e.result = &to.result;
   }
@@ -180,6 +182,7 @@ void AsyncSinks::run() {
       error_ = std::current_exception();
       failed = true;
     }
+    slots_[k].e.result_hold.reset();  // back to the session's pool, unless a sink kept it
     {
       std::lock_guard lock(mutex_);
       free_.push_back(k);

@@ -166,7 +166,8 @@ Session::Step Session::step() {
     if (!take_inputs(t_exp, &e.servo)) return Step::kSkipped;  // a stall: no servo samples around it
 
     e.cold_start = !pipe_->has_previous();
-    if (auto st = pipe_->process(frame_.bgr, measured_, snapshot_, &result_); !st)
+    result_ = results_.take();  // one no sink still holds (its images are reused, not reallocated)
+    if (auto st = pipe_->process(frame_.bgr, measured_, snapshot_, result_.get()); !st)
       throw SpidarError(st.error().message);
     e.t_done_ns = core::monotonic_ns();
     // The comparison registration runs every frame (it must track), its rendering every
@@ -178,7 +179,7 @@ Session::Step Session::step() {
       const bool same_key = alt_->params().chroma_key == pipe_->params().chroma_key;
       if (pipe_->params().personalise_shape) alt_->use_model_sizes(pipe_->models());
       if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !here,
-                                  same_key ? &result_.key : nullptr);
+                                  same_key ? &result_->key : nullptr);
           !st)
         throw SpidarError(st.error().message);
       if (render) e.compared = &alt_result_;
@@ -192,7 +193,8 @@ Session::Step Session::step() {
     e.bgr = &frame_.bgr;
     e.measured = &measured_;
     e.scene = &snapshot_;
-    e.result = &result_;
+    e.result = result_.get();
+    e.result_hold = result_;
     e.filmed = frame_.filmed;
     for (FrameSink* sink : sinks_) sink->on_frame(e);
     ++frames_;

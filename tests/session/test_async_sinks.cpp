@@ -1,5 +1,6 @@
-// AsyncSinks: the sinks run on one output thread, in order, on deep copies of each event; a slow
-// sink makes the frame thread wait (no frame is skipped); a sink's exception comes back.
+// AsyncSinks: the sinks run on one output thread, in order, on deep copies of each event (or on the
+// main result itself where the event shares it); a slow sink makes the frame thread wait (no frame
+// is skipped); a sink's exception comes back.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -7,6 +8,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "spidar/core/recycling_pool.hpp"
 #include "spidar/session/async_sinks.hpp"
 
 namespace spidar::session {
@@ -106,6 +108,51 @@ TEST(AsyncSinks, EverySinkSeesEveryFrameInOrderOnOneOutputThreadWithItsOwnCopies
       EXPECT_EQ(r->truth_pixel[i], 3 * k);
     }
   }
+}
+
+// The session's way: each frame's result taken from a pool and shared (FrameEvent::result_hold).
+// The sinks see the very object, not a copy; while they hold it the pool never hands it out again,
+// so frames filled later cannot overwrite it; and once they are done it goes back to the pool.
+TEST(AsyncSinks, ASharedResultIsHeldNotCopiedAndGoesBackToItsPoolWhenTheSinksAreDone) {
+  class Addresses final : public FrameSink {
+   public:
+    void on_frame(const FrameEvent& e) override {
+      seen.push_back(e.result);
+      composite_pixel.push_back(e.result->composite.at<cv::Vec3b>(0, 0)[1]);
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));  // slower than the frames
+    }
+    std::vector<const pipeline::FrameResult*> seen;
+    std::vector<int> composite_pixel;
+  } sink;
+  core::RecyclingPool<pipeline::FrameResult> pool;
+  Buffers buf;
+  const int n = 20;
+  std::vector<const pipeline::FrameResult*> handed;
+  {
+    AsyncSinks sinks({&sink}, 3);
+    sinks.on_start();
+    for (int k = 0; k < n; ++k) {
+      auto result = pool.take();
+      result->composite.create(4, 5, CV_8UC3);
+      result->composite.setTo(cv::Scalar::all(2 * k));
+      FrameEvent e = buf.event(k, false);
+      e.result = result.get();
+      e.result_hold = result;
+      handed.push_back(result.get());
+      sinks.on_frame(e);
+    }
+    SessionSummary s;
+    sinks.on_end(s);
+  }
+  ASSERT_EQ(sink.seen.size(), static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    EXPECT_EQ(sink.seen[i], handed[i]);           // the object itself, not a copy
+    EXPECT_EQ(sink.composite_pixel[i], 2 * k);    // not overwritten by a later frame
+  }
+  // Recycled: no more objects than the slots, the one being filled and the one just let go.
+  EXPECT_LE(pool.created(), 5u);
+  EXPECT_EQ(pool.free(), pool.created());  // every one back once the sinks are done
 }
 
 TEST(AsyncSinks, ASinkThatThrowsStopsTheFramesAndTheErrorComesBackToTheFrameThread) {

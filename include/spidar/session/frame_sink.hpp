@@ -4,6 +4,7 @@
 /// video and keyframe writers, the progress bar), and a summary when the session ends.
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -34,6 +35,10 @@ struct FrameEvent {
   const device::FingertipSample* measured = nullptr;  ///< servo samples interpolated at exposure
   const SceneSnapshot* scene = nullptr;            ///< the virtual world the frame was rendered with
   const pipeline::FrameResult* result = nullptr;   ///< the main pipeline's fit and composite
+  /// The same result, shared (a session hands out each frame's from a core::RecyclingPool and
+  /// fills another next frame): a sink that keeps it past on_frame holds this instead of copying
+  /// it, and nobody overwrites it while it is held. Null where the result is not shared (copy it).
+  std::shared_ptr<const pipeline::FrameResult> result_hold;
   /// The comparison pipeline (silhouette term switched the other way), rendered this frame;
   /// null when the session has no comparison or skipped its rendering in this frame.
   const pipeline::FrameResult* compared = nullptr;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "spidar/core/recycling_pool.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
@@ -146,7 +147,12 @@ class Session {
   CameraFrame frame_;
   SceneSnapshot snapshot_;
   device::FingertipSample measured_;
-  pipeline::FrameResult result_, alt_result_;
+  /// The main fit's results: each frame's taken from the pool and shared with the sinks
+  /// (FrameEvent::result_hold), so that the output thread reads it while the next is filled,
+  /// without a copy of its eleven images per frame.
+  core::RecyclingPool<pipeline::FrameResult> results_;
+  std::shared_ptr<pipeline::FrameResult> result_;
+  pipeline::FrameResult alt_result_;
 };
 
 }  // namespace spidar::session
