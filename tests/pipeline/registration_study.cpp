@@ -286,6 +286,8 @@ int main(int argc, char** argv) {
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
   std::array<std::vector<double>, 2> wrist_depth_mm;  // fit − truth along the camera's axis, per hand
+  // Joint error by digit and joint along it (fit, and the floor as above) [px sums], and counts.
+  std::array<std::array<double, 4>, 5> joint_at_sum{}, joint_at_floor{}, joint_at_n{};
   std::array<Vec3, 8> g;
   for (double t = a.t0; t < a.t1 && !task.finished(t); t += 1.0 / a.fps) {
     // The device's caps: at the face, pressed a fifth of the squeeze in (the displayed force
@@ -516,6 +518,13 @@ int main(int argc, char** argv) {
         joint_floor_sum[static_cast<std::size_t>(part)] +=
             (camera.project(floor_pts.p_W_joint[static_cast<std::size_t>(j)]) - at).norm();
         joint_part_n[static_cast<std::size_t>(part)] += 1;
+        // By joint along each digit (0 its base: the thumb's CMC, a finger's MCP; 3 its tip).
+        if (j > 0) {
+          const auto d = static_cast<std::size_t>((j - 1) / 4), k = static_cast<std::size_t>((j - 1) % 4);
+          joint_at_sum[d][k] += (camera.project(fit_pts.p_W_joint[static_cast<std::size_t>(j)]) - at).norm();
+          joint_at_floor[d][k] += (camera.project(floor_pts.p_W_joint[static_cast<std::size_t>(j)]) - at).norm();
+          joint_at_n[d][k] += 1;
+        }
       }
     }
     obs.push_back(1e3 * obs_res);
@@ -572,6 +581,18 @@ int main(int argc, char** argv) {
                 floor_all / std::max(n_all, 1.0),
                 (fit_all - joint_part_sum[5] + joint_part_n[5] * (joint_part_sum[5] / little_n - joint_floor_sum[5] / little_n)) /
                     std::max(n_all, 1.0));
+  }
+  {
+    const char* names[5] = {"thumb", "index", "middle", "ring", "little"};
+    std::printf("joint error along each digit [px], base (CMC / MCP) to tip, fit (floor):\n");
+    for (std::size_t d = 0; d < 5; ++d) {
+      std::printf("  %-7s", names[d]);
+      for (std::size_t k = 0; k < 4; ++k) {
+        const double n = std::max(joint_at_n[d][k], 1.0);
+        std::printf(" %5.2f (%5.2f)", joint_at_sum[d][k] / n, joint_at_floor[d][k] / n);
+      }
+      std::printf("\n");
+    }
   }
   for (int h = 0; h < 2; ++h) {
     const auto& d = wrist_depth_mm[h];
