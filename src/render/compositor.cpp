@@ -130,12 +130,15 @@ Status Compositor::compose(const CompositeInputs& in, cv::Mat* out, cv::Mat* alp
 Status Compositor::compose_paper(const CompositeInputs& in, cv::Mat* out, cv::Mat* alpha) {
   if (auto s = check_inputs(in, false); !s) return s;
   const RenderTargets& v = *in.virt;
-  // The real image wherever the virtual hand is front-most.
-  compose_rows(v.colour, in.real_bgr, cv::Rect(0, 0, v.colour.cols, v.colour.rows),
+  // The real image wherever the virtual hand is front-most: only within the hands' box, where the
+  // rendering says where that is (outside it the virtual image, alpha 0).
+  const cv::Rect whole(0, 0, v.colour.cols, v.colour.rows);
+  const cv::Rect roi = v.hand_box ? (*v.hand_box & whole) : whole;
+  compose_rows(v.colour, in.real_bgr, roi,
                [&](int y, float* a) {
-                 const float* hand = v.hand_depth.ptr<float>(y);
-                 const float* depth = v.depth.ptr<float>(y);
-                 for (int x = 0; x < v.colour.cols; ++x) a[x] = hand[x] < depth[x] ? 1.f : 0.f;
+                 const float* hand = v.hand_depth.ptr<float>(y) + roi.x;
+                 const float* depth = v.depth.ptr<float>(y) + roi.x;
+                 for (int x = 0; x < roi.width; ++x) a[x] = hand[x] < depth[x] ? 1.f : 0.f;
                },
                *out, *alpha);
   return Ok{};

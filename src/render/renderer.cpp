@@ -760,6 +760,9 @@ Status Renderer::read(RenderTargets* out, unsigned targets) const {
     // Every hand fragment drawn wrote an id ≥ 1: where the next render must reset.
     r.hands_written = cv::boundingRect(out->hand_id);
     r.hands_written_known = true;
+    out->hand_box = r.hands_written;
+  } else {
+    out->hand_box.reset();
   }
   gl::BindFramebuffer(GL_READ_FRAMEBUFFER, 0);
   return gl::check_gl("renderer: read-back");

@@ -215,6 +215,14 @@ TEST(CompositorReference, PaperModeIsTheReferenceBitForBit) {
       ASSERT_GT(cv::countNonZero(want.alpha), 100);
       EXPECT_EQ(differing(out, want.out), 0) << seed;
       EXPECT_EQ(differing(alpha, want.alpha), 0) << seed;
+      // The same within the hands' box, as the renderer reports it (RenderTargets::hand_box);
+      // the caller's buffers hold the previous composite.
+      LayeredScene boxed = s;
+      boxed.virt.hand_box = cv::boundingRect(s.virt.hand_depth < std::numeric_limits<float>::infinity());
+      ASSERT_LT(boxed.virt.hand_box->area(), size.area());  // the box leaves pixels out
+      ASSERT_TRUE(compositor.compose({&boxed.virt, s.real_bgr, s.alpha}, &out, &alpha).ok());
+      EXPECT_EQ(differing(out, want.out), 0) << seed << " (hand box)";
+      EXPECT_EQ(differing(alpha, want.alpha), 0) << seed << " (hand box)";
     }
   }
 }

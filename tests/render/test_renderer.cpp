@@ -149,6 +149,13 @@ TEST(Renderer, HandTargetsAndOcclusion) {
       const bool looks_like_box = bgr[0] > bgr[2] + 40;  // the box is blue, the hand skin
       EXPECT_EQ(looks_like_box, !(in_front && mode == HandDrawMode::kVisible))
           << "in_front " << in_front << " visible " << (mode == HandDrawMode::kVisible);
+      // The hands' box: around every hand pixel, and unknown when the hand ids were not read.
+      ASSERT_TRUE(t.hand_box.has_value());
+      EXPECT_EQ(*t.hand_box, cv::boundingRect(t.hand_id));
+      EXPECT_EQ(*t.hand_box, cv::boundingRect(t.hand_depth < std::numeric_limits<float>::infinity()));
+      EXPECT_GT(t.hand_box->area(), 100);
+      ASSERT_TRUE(renderer->read(&t, kColour | kDepth | kHandDepth).ok());
+      EXPECT_FALSE(t.hand_box.has_value());
     }
   }
 }

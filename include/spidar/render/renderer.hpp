@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <opencv2/core/mat.hpp>
 
 #include "spidar/core/result.hpp"
@@ -81,6 +82,9 @@ struct RenderTargets {
   cv::Mat depth;       ///< CV_32FC1 [m], +inf: empty
   cv::Mat hand_depth;  ///< CV_32FC1 [m], +inf: no hand
   cv::Mat hand_id;     ///< CV_8UC1, encode_hand_id, 0: no hand
+  /// The bounding box of every pixel a hand was drawn at (an empty rectangle: no hand), known when
+  /// read() copied hand_id; std::nullopt: not known (a compositor then looks at the whole image).
+  std::optional<cv::Rect> hand_box;
 };
 
 class Renderer {
