@@ -286,6 +286,8 @@ int main(int argc, char** argv) {
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
   std::array<std::vector<double>, 2> wrist_depth_mm;  // fit − truth along the camera's axis, per hand
+  std::array<Vec3, 2> palm_rot{Vec3::Zero(), Vec3::Zero()};  // |rotation error| about x_H, y_H, z_H [° sums]
+  std::array<double, 2> palm_n{};
   // Joint error by digit and joint along it (fit, and the floor as above) [px sums], and counts.
   std::array<std::array<double, 4>, 5> joint_at_sum{}, joint_at_floor{}, joint_at_n{};
   std::array<Vec3, 8> g;
@@ -499,6 +501,15 @@ int main(int argc, char** argv) {
     // How far along the camera's axis the fitted wrist is from the true one (the direction the
     // strings and the bracelet's point observe least; measure_frame's).
     for (int h = 0; h < 2; ++h) wrist_depth_mm[h].push_back(m.wrist_depth_mm[h]);
+    for (int h = 0; h < 2; ++h) {
+      const Mat3 Rf = hand::hand_pose(r.hands[h]).R.toRotationMatrix(), Rt = hand::hand_pose(truth[h]).R.toRotationMatrix();
+      // The fit's palm in the truth's frame, as a rotation vector in H (x across the palm, y along
+      // it toward the fingers, z out of its back): how far it is turned about each of its axes.
+      const Eigen::AngleAxisd d(Rt.transpose() * Rf);
+      const Vec3 v = d.angle() * d.axis();
+      for (int k = 0; k < 3; ++k) palm_rot[h][k] += std::abs(v[k]) * 180 / units::kPi;
+      palm_n[h] += 1;
+    }
     // The joint error by part (the wrist, then each digit's four joints), and its floor: the
     // model's skeleton with the user's true sizes at the true pose, whose little finger can only
     // follow the ring finger's (the model has no parameters of its own for it).
@@ -601,6 +612,9 @@ int main(int argc, char** argv) {
     std::printf("%s wrist depth, fit − truth [mm]: median %+.1f (p10 %+.1f, p90 %+.1f), |·| mean %.1f\n",
                 h == 0 ? "left" : "right", quantile(d, 0.5), quantile(d, 0.1), quantile(d, 0.9), mean(magnitude));
   }
+  for (int h = 0; h < 2; ++h)
+    std::printf("%s palm rotation error, mean |angle| about x_H (across) %.2f°, y_H (along) %.2f°, z_H (normal) %.2f°\n", h == 0 ? "left" : "right",
+                palm_rot[h].x() / std::max(palm_n[h], 1.0), palm_rot[h].y() / std::max(palm_n[h], 1.0), palm_rot[h].z() / std::max(palm_n[h], 1.0));
   std::printf("fitted caps to the strings %.2f mm (p95 %.2f), truth caps to the strings %.2f mm (max %.2f)\n",
               mean(obs), quantile(obs, 0.95), mean(caps), quantile(caps, 1.0));
   std::printf("bracelet midpoint to the band's axis centre %.2f px (p95 %.2f), to its visible surface %.2f px (p95 %.2f)\n",
