@@ -288,6 +288,7 @@ int main(int argc, char** argv) {
   std::array<std::vector<double>, 2> wrist_depth_mm;  // fit − truth along the camera's axis, per hand
   std::array<Vec3, 2> palm_rot{Vec3::Zero(), Vec3::Zero()};  // |rotation error| about x_H, y_H, z_H [° sums]
   std::array<double, 2> palm_n{};
+  std::array<std::vector<double>, 2> palm_roll_deg;  // signed, about y_H
   // Joint error by digit and joint along it (fit, and the floor as above) [px sums], and counts.
   std::array<std::array<double, 4>, 5> joint_at_sum{}, joint_at_floor{}, joint_at_n{};
   std::array<Vec3, 8> g;
@@ -508,6 +509,7 @@ int main(int argc, char** argv) {
       const Eigen::AngleAxisd d(Rt.transpose() * Rf);
       const Vec3 v = d.angle() * d.axis();
       for (int k = 0; k < 3; ++k) palm_rot[h][k] += std::abs(v[k]) * 180 / units::kPi;
+      palm_roll_deg[h].push_back(v.y() * 180 / units::kPi);
       palm_n[h] += 1;
     }
     // The joint error by part (the wrist, then each digit's four joints), and its floor: the
@@ -615,6 +617,9 @@ int main(int argc, char** argv) {
   for (int h = 0; h < 2; ++h)
     std::printf("%s palm rotation error, mean |angle| about x_H (across) %.2f°, y_H (along) %.2f°, z_H (normal) %.2f°\n", h == 0 ? "left" : "right",
                 palm_rot[h].x() / std::max(palm_n[h], 1.0), palm_rot[h].y() / std::max(palm_n[h], 1.0), palm_rot[h].z() / std::max(palm_n[h], 1.0));
+  for (int h = 0; h < 2; ++h)
+    std::printf("%s palm roll about y_H, signed [°]: p10 %+.1f, median %+.1f, p90 %+.1f\n", h == 0 ? "left" : "right",
+                quantile(palm_roll_deg[h], 0.1), quantile(palm_roll_deg[h], 0.5), quantile(palm_roll_deg[h], 0.9));
   std::printf("fitted caps to the strings %.2f mm (p95 %.2f), truth caps to the strings %.2f mm (max %.2f)\n",
               mean(obs), quantile(obs, 0.95), mean(caps), quantile(caps, 1.0));
   std::printf("bracelet midpoint to the band's axis centre %.2f px (p95 %.2f), to its visible surface %.2f px (p95 %.2f)\n",
