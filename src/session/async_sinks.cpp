@@ -55,7 +55,8 @@ void AsyncSinks::make_picture(Slot& slot) {
                       "(AsyncSinks::picture_comparisons)");
   const auto t0 = std::chrono::steady_clock::now();
   if (auto st = pictures_->context->make_current(); !st) throw SpidarError("comparison pictures: " + st.error().message);
-  if (auto st = pictures_->pipeline->picture(slot.bgr, slot.scene, &slot.compared); !st)
+  if (e.bgr == nullptr) throw SpidarError("comparison pictures: a frame left pending without its camera image");
+  if (auto st = pictures_->pipeline->picture(*e.bgr, slot.scene, &slot.compared); !st)
     throw SpidarError("comparison pictures: " + st.error().message);
   e.compared_picture_pending = false;
   e.compare_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -99,7 +100,10 @@ void AsyncSinks::rethrow_if_failed() {
 
 void AsyncSinks::copy_into(const FrameEvent& from, Slot& to) const {
   to.e = from;
-  if (from.bgr != nullptr) {
+  if (from.bgr != nullptr && from.filmed_hold && from.bgr->data == from.filmed_hold->frame.bgr.data &&
+      from.bgr->size() == from.filmed_hold->frame.bgr.size()) {
+    to.e.bgr = &from.filmed_hold->frame.bgr;  // the held filmed frame's own image
+  } else if (from.bgr != nullptr) {
     from.bgr->copyTo(to.bgr);
     to.e.bgr = &to.bgr;
   }
@@ -121,7 +125,9 @@ void AsyncSinks::copy_into(const FrameEvent& from, Slot& to) const {
     pipeline::copy_frame_result(*from.compared, &to.compared);
     to.e.compared = &to.compared;
   }
-  if (from.filmed != nullptr) {
+  if (from.filmed_hold) {
+    to.e.filmed = from.filmed_hold.get();  // held by to.e.filmed_hold until the sinks are done
+  } else if (from.filmed != nullptr) {
     sim::copy_filmed_frame(*from.filmed, &to.filmed);
     to.e.filmed = &to.filmed;
   }
@@ -182,7 +188,8 @@ void AsyncSinks::run() {
       error_ = std::current_exception();
       failed = true;
     }
-    slots_[k].e.result_hold.reset();  // back to the session's pool, unless a sink kept it
+    slots_[k].e.result_hold.reset();  // back to their pools, unless a sink kept them
+    slots_[k].e.filmed_hold.reset();
     {
       std::lock_guard lock(mutex_);
       free_.push_back(k);

@@ -42,6 +42,7 @@ class RecordingRig::Source final : public FrameSource {
       out->bgr = image_;
       out->t_exposure_ns = f.t_exposure_ns;
       out->filmed = nullptr;
+      out->filmed_hold.reset();
       out->measured = &f.measured;
       out->scene_poses = i < rec_.scene.size() ? &rec_.scene[i] : nullptr;
       out->t_recorded_s = core::ns_to_s(f.t_exposure_ns - rec_.frames.front().t_exposure_ns);

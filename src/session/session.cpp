@@ -196,6 +196,7 @@ Session::Step Session::step() {
     e.result = result_.get();
     e.result_hold = result_;
     e.filmed = frame_.filmed;
+    e.filmed_hold = frame_.filmed != nullptr ? frame_.filmed_hold : nullptr;
     for (FrameSink* sink : sinks_) sink->on_frame(e);
     ++frames_;
     return Step::kFrame;

@@ -39,8 +39,9 @@ class SyntheticSource final : public FrameSource {
   }
   bool take(CameraFrame* out) override {
     if (!thread_ || stopped_ || !thread_->take()) return false;
-    const sim::FilmedFrame& f = thread_->frame();
-    out->bgr = f.frame.bgr;  // a header on the thread's buffer: valid until the next take()
+    out->filmed_hold = thread_->shared();
+    const sim::FilmedFrame& f = *out->filmed_hold;
+    out->bgr = f.frame.bgr;  // a header on the frame's image: valid while the frame is held
     out->t_exposure_ns = f.t_exposure_ns;
     out->filmed = &f;
     return true;

@@ -27,6 +27,7 @@ class ThreadedSource : public FrameSource {
     latest_.copyTo(out->bgr);
     out->t_exposure_ns = latest_t_;
     out->filmed = nullptr;
+    out->filmed_hold.reset();
     return true;
   }
   bool ended() const override { return done_.load(std::memory_order_acquire); }

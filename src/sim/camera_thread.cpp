@@ -56,7 +56,12 @@ void CameraThread::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-bool CameraThread::take() { return frames_.update(); }
+bool CameraThread::take() {
+  std::lock_guard lock(newest_mutex_);
+  if (!newest_) return false;
+  current_ = std::move(newest_);  // the previous one goes back to the pool once nobody holds it
+  return true;
+}
 
 void CameraThread::run(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
                        const SyntheticCameraParams& film_params, const RubiksTask& task,
@@ -81,7 +86,8 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
     if (truth_at_(t_exp, caps)) {
       const double t_script = core::ns_to_s(t_exp - params_.t0_ns);
       user.update(t_script, caps);
-      FilmedFrame& out = frames_.back();
+      std::shared_ptr<FilmedFrame> frame = pool_.take();  // nobody holds it: its buffers are reused
+      FilmedFrame& out = *frame;
       out.index = index;
       out.t_exposure_ns = t_exp;
       out.t_script_s = t_script;
@@ -93,7 +99,10 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
         break;
       }
       out.film_ms = core::ns_to_s(core::monotonic_ns() - t_start) * 1e3;
-      frames_.publish();
+      {
+        std::lock_guard lock(newest_mutex_);
+        newest_ = std::move(frame);  // a newer frame replaces one not taken (back to the pool)
+      }
       filmed_.fetch_add(1, std::memory_order_acq_rel);
     } else {
       // No fingertips yet at this exposure (the device's first samples come later on a busy

@@ -110,24 +110,34 @@ TEST(AsyncSinks, EverySinkSeesEveryFrameInOrderOnOneOutputThreadWithItsOwnCopies
   }
 }
 
-// The session's way: each frame's result taken from a pool and shared (FrameEvent::result_hold).
-// The sinks see the very object, not a copy; while they hold it the pool never hands it out again,
-// so frames filled later cannot overwrite it; and once they are done it goes back to the pool.
-TEST(AsyncSinks, ASharedResultIsHeldNotCopiedAndGoesBackToItsPoolWhenTheSinksAreDone) {
+// The session's way: each frame's result and filmed frame taken from pools and shared
+// (FrameEvent::result_hold, filmed_hold; the camera image a header on the filmed frame's). The sinks
+// see the very objects, not copies; while they hold them the pools never hand them out again, so
+// frames filled later cannot overwrite them; and once they are done they go back to their pools.
+TEST(AsyncSinks, SharedResultsAndFilmedFramesAreHeldNotCopiedAndGoBackToTheirPools) {
   class Addresses final : public FrameSink {
    public:
     void on_frame(const FrameEvent& e) override {
       seen.push_back(e.result);
+      seen_filmed.push_back(e.filmed);
+      seen_image.push_back(e.bgr->data);
       composite_pixel.push_back(e.result->composite.at<cv::Vec3b>(0, 0)[1]);
+      bgr_pixel.push_back(e.bgr->at<cv::Vec3b>(1, 2)[0]);
+      truth_pixel.push_back(e.filmed->frame.hand_only.at<std::uint8_t>(0, 1));
       std::this_thread::sleep_for(std::chrono::milliseconds(2));  // slower than the frames
     }
     std::vector<const pipeline::FrameResult*> seen;
-    std::vector<int> composite_pixel;
+    std::vector<const sim::FilmedFrame*> seen_filmed;
+    std::vector<const std::uint8_t*> seen_image;
+    std::vector<int> composite_pixel, bgr_pixel, truth_pixel;
   } sink;
   core::RecyclingPool<pipeline::FrameResult> pool;
+  core::RecyclingPool<sim::FilmedFrame> films;  // as sim::CameraThread's
   Buffers buf;
   const int n = 20;
   std::vector<const pipeline::FrameResult*> handed;
+  std::vector<const sim::FilmedFrame*> handed_filmed;
+  std::vector<const std::uint8_t*> handed_image;
   {
     AsyncSinks sinks({&sink}, 3);
     sinks.on_start();
@@ -135,10 +145,21 @@ TEST(AsyncSinks, ASharedResultIsHeldNotCopiedAndGoesBackToItsPoolWhenTheSinksAre
       auto result = pool.take();
       result->composite.create(4, 5, CV_8UC3);
       result->composite.setTo(cv::Scalar::all(2 * k));
+      auto filmed = films.take();
+      filmed->frame.bgr.create(4, 5, CV_8UC3);
+      filmed->frame.bgr.setTo(cv::Scalar::all(k));
+      filmed->frame.hand_only.create(4, 5, CV_8UC1);
+      filmed->frame.hand_only.setTo(3 * k);
+      const cv::Mat image = filmed->frame.bgr;  // the session's image: a header on the filmed frame's
       FrameEvent e = buf.event(k, false);
       e.result = result.get();
       e.result_hold = result;
+      e.bgr = &image;
+      e.filmed = filmed.get();
+      e.filmed_hold = filmed;
       handed.push_back(result.get());
+      handed_filmed.push_back(filmed.get());
+      handed_image.push_back(image.data);
       sinks.on_frame(e);
     }
     SessionSummary s;
@@ -147,12 +168,18 @@ TEST(AsyncSinks, ASharedResultIsHeldNotCopiedAndGoesBackToItsPoolWhenTheSinksAre
   ASSERT_EQ(sink.seen.size(), static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) {
     const auto i = static_cast<std::size_t>(k);
-    EXPECT_EQ(sink.seen[i], handed[i]);           // the object itself, not a copy
-    EXPECT_EQ(sink.composite_pixel[i], 2 * k);    // not overwritten by a later frame
+    EXPECT_EQ(sink.seen[i], handed[i]);                // the objects themselves, not copies
+    EXPECT_EQ(sink.seen_filmed[i], handed_filmed[i]);
+    EXPECT_EQ(sink.seen_image[i], handed_image[i]);
+    EXPECT_EQ(sink.composite_pixel[i], 2 * k);         // not overwritten by a later frame
+    EXPECT_EQ(sink.bgr_pixel[i], k);
+    EXPECT_EQ(sink.truth_pixel[i], 3 * k);
   }
   // Recycled: no more objects than the slots, the one being filled and the one just let go.
   EXPECT_LE(pool.created(), 5u);
+  EXPECT_LE(films.created(), 5u);
   EXPECT_EQ(pool.free(), pool.created());  // every one back once the sinks are done
+  EXPECT_EQ(films.free(), films.created());
 }
 
 TEST(AsyncSinks, ASinkThatThrowsStopsTheFramesAndTheErrorComesBackToTheFrameThread) {

@@ -5,7 +5,11 @@
 
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <thread>
+#include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "spidar/core/clock.hpp"
 #include "spidar/hand/kinematics.hpp"
@@ -60,6 +64,61 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
   EXPECT_GE(last_index, 6u);
   // Every index before the last frame's was filmed or skipped.
   EXPECT_LE(last_index + 1, cam.filmed() + cam.skipped());
+}
+
+// A frame taken and held (CameraThread::shared) is not filmed over while the camera goes on: its
+// index, exposure and image stay as they were when it was taken, frames not taken go back to the
+// pool, and the pool makes no more frames than are held at once.
+TEST(CameraThread, AHeldFrameIsNotFilmedOver) {
+  const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
+                                             hand::default_hand_model(hand::Side::kRight)};
+  RubiksTask task({});
+  CameraThreadParams params;
+  params.fps = 60;
+  params.t0_ns = core::monotonic_ns();
+  const std::int64_t t0 = params.t0_ns;
+  TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
+    const double t = 1.0 + core::ns_to_s(t_ns - t0);  // hands in view, moving
+    for (int h = 0; h < 2; ++h) {
+      const hand::HandModel& m = truth[static_cast<std::size_t>(h)];
+      const hand::HandPoints pts = hand::forward_kinematics(m, task.nominal(t, m.side));
+      for (int f = 0; f < hand::kFingertipCount; ++f) out[static_cast<std::size_t>(4 * h + f)] = pts.p_W_fingertip[f];
+    }
+    return true;
+  };
+  auto thread = CameraThread::start(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+  ASSERT_TRUE(thread.ok()) << thread.error().message;
+  CameraThread& cam = *thread.value();
+  EXPECT_EQ(cam.shared(), nullptr);  // nothing taken yet
+  struct Held {
+    std::shared_ptr<const FilmedFrame> frame;
+    std::uint64_t index;
+    std::int64_t t_exposure_ns;
+    cv::Mat image;  // a deep copy made when it was taken
+  };
+  std::vector<Held> held;
+  for (int i = 0; i < 4000 && held.size() < 4; ++i) {  // waits for frames, not for a time
+    if (cam.take()) {
+      const auto f = cam.shared();
+      ASSERT_NE(f, nullptr);
+      EXPECT_EQ(f.get(), &cam.frame());
+      if (held.empty() || f->index >= held.back().index + 2)  // frames apart (the camera went on)
+        held.push_back({f, f->index, f->t_exposure_ns, f->frame.bgr.clone()});
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(3));
+  }
+  // Let the camera film a few more frames over whatever it may still reuse.
+  const std::uint64_t filmed = cam.filmed();
+  for (int i = 0; i < 4000 && cam.filmed() < filmed + 5; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(3));
+  cam.stop();
+  ASSERT_EQ(held.size(), 4u) << cam.error();
+  for (const Held& h : held) {
+    EXPECT_EQ(h.frame->index, h.index);
+    EXPECT_EQ(h.frame->t_exposure_ns, h.t_exposure_ns);
+    ASSERT_EQ(h.frame->frame.bgr.size(), h.image.size());
+    EXPECT_EQ(cv::norm(h.frame->frame.bgr, h.image, cv::NORM_INF), 0.0) << "frame " << h.index;
+  }
+  EXPECT_NE(held.front().frame.get(), held.back().frame.get());
 }
 
 }  // namespace

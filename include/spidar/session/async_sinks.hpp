@@ -43,8 +43,9 @@ class AsyncSinks final : public FrameSink {
                            const pipeline::FramePipelineParams& params);
   /// Starts the output thread and waits for the sinks' on_start there (re-throws its exception).
   void on_start() override;
-  /// Copies the event into a free slot (waiting for one if none is) and queues it. A result the
-  /// event shares (FrameEvent::result_hold) is held there instead of copied, until the sinks are done.
+  /// Copies the event into a free slot (waiting for one if none is) and queues it. A result or a
+  /// filmed frame the event shares (FrameEvent::result_hold, filmed_hold) is held there instead of
+  /// copied (the filmed frame's image too, when the event's image is it), until the sinks are done.
   void on_frame(const FrameEvent& e) override;
   /// Delivers every queued frame, then the sinks' on_end, on the output thread; joins it.
   void on_end(const SessionSummary& s) override;

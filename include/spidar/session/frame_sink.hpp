@@ -47,6 +47,9 @@ struct FrameEvent {
   bool compared_picture_pending = false;
   /// What the synthetic camera filmed (ground truth); null for real cameras.
   const sim::FilmedFrame* filmed = nullptr;
+  /// The same filmed frame, shared (the synthetic camera films into others while it is held): a
+  /// sink that keeps it past on_frame holds this instead of copying it; null: copy it.
+  std::shared_ptr<const sim::FilmedFrame> filmed_hold;
   ServoTiming servo;  ///< the servo loop's rate and jitter since the previous frame
   bool cold_start = false;  ///< the main fit started from the rest pose, not the previous frame
   /// The scene's cube when the frame was processed (its monitor's newest status); empty without

@@ -29,6 +29,9 @@ struct CameraFrame {
   std::int64_t t_exposure_ns = 0;  ///< host monotonic time of the exposure [ns]
   /// What the synthetic camera filmed (true hand poses, script time, ...); null for real cameras.
   const sim::FilmedFrame* filmed = nullptr;
+  /// The same filmed frame, shared (sim::CameraThread::shared): valid, and not overwritten, for as
+  /// long as it is held; null where the source does not share its frames.
+  std::shared_ptr<const sim::FilmedFrame> filmed_hold;
   /// A recording's frame (Rig::plays_back): the fingertip sample its registration used, the scene
   /// poses it was rendered with (empty: the scene has no shapes) and its time since the
   /// recording's first frame [s]; null for live cameras.

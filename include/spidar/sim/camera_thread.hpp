@@ -11,12 +11,13 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <string>
 #include <thread>
 
 #include "spidar/core/result.hpp"
-#include "spidar/core/triple_buffer.hpp"
+#include "spidar/core/recycling_pool.hpp"
 #include "spidar/device/servo_types.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
 #include "spidar/sim/user_hands.hpp"
@@ -34,7 +35,8 @@ struct FilmedFrame {
 };
 
 /// A deep copy (the images copied into `to`'s buffers when they fit, so a reused `to` allocates
-/// nothing); a FilmedFrame taken from CameraThread::frame() is only valid until the next take().
+/// nothing). A FilmedFrame taken from CameraThread::frame() is only valid until the next take();
+/// CameraThread::shared() keeps one for longer without a copy.
 void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to);
 
 /// Fills `out` with the true fingertip caps at t_ns (8 of them); false if there are none yet.
@@ -62,9 +64,14 @@ class CameraThread {
   CameraThread(const CameraThread&) = delete;
   CameraThread& operator=(const CameraThread&) = delete;
 
-  /// The newest frame if one arrived since the last call (then `frame()` holds it).
+  /// The newest frame if one arrived since the last call (then `frame()` holds it). Frames filmed
+  /// in between and never taken go back to the pool.
   bool take();
-  const FilmedFrame& frame() const { return frames_.front(); }
+  /// The frame the last successful take() gave (an empty frame before the first).
+  const FilmedFrame& frame() const { return current_ ? *current_ : empty_; }
+  /// The same frame, shared: the camera films into other frames (core::RecyclingPool) while anyone
+  /// holds it, so a holder may read it after the next take() (null before the first take()).
+  std::shared_ptr<const FilmedFrame> shared() const { return current_; }
   /// Frames filmed so far.
   std::uint64_t filmed() const { return filmed_.load(std::memory_order_acquire); }
   /// Exposures this thread let pass without filming them: because it was late (on a busy machine
@@ -84,7 +91,13 @@ class CameraThread {
 
   CameraThreadParams params_;
   TruthAt truth_at_;
-  core::TripleBuffer<FilmedFrame> frames_;
+  /// Frames to film into; the newest filmed one not yet taken (under newest_mutex_); the one the
+  /// frame thread took last (its thread only).
+  core::RecyclingPool<FilmedFrame> pool_;
+  std::mutex newest_mutex_;
+  std::shared_ptr<FilmedFrame> newest_;
+  std::shared_ptr<const FilmedFrame> current_;
+  FilmedFrame empty_;
   std::atomic<std::uint64_t> filmed_{0};
   std::atomic<std::uint64_t> skipped_{0};
   std::atomic<bool> stop_{false};
