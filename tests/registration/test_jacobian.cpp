@@ -171,20 +171,30 @@ hand::HandParams fit_image_free(const hand::HandModel& model, const HandObservat
   return start;
 }
 
+/// What the band tests start from: a model hand at the reaching pose, the band at the wrist joint
+/// (its midpoint's ray is the wrist's), and the exact observation of that pose.
+struct BandCase {
+  hand::HandModel model;
+  hand::HandParams truth;
+  RegistrationParams params;
+  HandObservation obs;
+};
+BandCase band_case(int side, const vision::Camera& camera) {
+  BandCase c{test::model_hands()[side], test::reaching_hands()[side], {}, {}};
+  c.params.bracelet_offset_m = 0.0;
+  c.params.bracelet_surface_shift = 0.0;
+  c.obs = exact_observation(c.model, c.truth, camera);
+  return c;
+}
+
 // The band's length says how far along its ray the wrist is, which its projected midpoint cannot:
 // a hand started 4 cm too deep along the ray of its bracelet's midpoint, with the fingertips from
 // the strings, comes nearer its true depth with the band's length (7 mm off, against 14 mm without: a
 // weak term stops within its σ).
 TEST(BraceletBand, TheBandsLengthPullsAWristBackToItsDepth) {
-  const auto models = test::model_hands();
   const vision::Camera camera = vision::default_rig_camera();
   for (int side = 0; side < 2; ++side) {
-    const hand::HandModel& model = models[side];
-    const hand::HandParams truth = test::reaching_hands()[side];
-    RegistrationParams params;
-    params.bracelet_offset_m = 0.0;  // the band at the wrist joint: its midpoint's ray is the wrist's
-    params.bracelet_surface_shift = 0.0;
-    HandObservation obs = exact_observation(model, truth, camera);
+    auto [model, truth, params, obs] = band_case(side, camera);
     const double length = bracelet_length_px(hand::hand_pose(truth), model.shape.dimensions.width, camera, params);
     ASSERT_GT(length, 10.0);
     obs.wrist_length_px = length;
@@ -252,15 +262,9 @@ TEST(BraceletBand, TheThicknessIsTheNearSidesExtentAcrossTheBand) {
 // fingertips is held by nothing but the image; the band's thickness turns it back nearer the
 // truth.
 TEST(BraceletBand, TheBandsThicknessTurnsAHandBackAboutItsFingertips) {
-  const auto models = test::model_hands();
   const vision::Camera camera = vision::default_rig_camera();
   for (int side = 0; side < 2; ++side) {
-    const hand::HandModel& model = models[side];
-    const hand::HandParams truth = test::reaching_hands()[side];
-    RegistrationParams params;
-    params.bracelet_offset_m = 0.0;
-    params.bracelet_surface_shift = 0.0;
-    HandObservation obs = exact_observation(model, truth, camera);
+    auto [model, truth, params, obs] = band_case(side, camera);
     const Pose X = hand::hand_pose(truth);
     const auto ends = bracelet_band_ends(X, model.shape.dimensions.width, camera.X_WC().p, params);
     obs.wrist_axis_px = (camera.project(ends[1]) - camera.project(ends[0])).normalized();

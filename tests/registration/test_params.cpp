@@ -2,6 +2,8 @@
 // name the key (and, when parsed, file:line).
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "spidar/core/config.hpp"
 #include "spidar/registration/registration_params.hpp"
 
@@ -69,21 +71,21 @@ TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
   EXPECT_EQ(p.step_epsilon, d.step_epsilon);
 }
 
+/// The settings parsed from a registration.yaml whose `registration:` map holds `body`.
+RegistrationParams parse(const std::string& body) {
+  return parse_registration_params(core::ConfigNode::Parse("registration:\n" + body, "reg.yaml")["registration"]);
+}
+
 TEST(RegistrationParams, ParsesValues) {
-  const auto root = core::ConfigNode::Parse(
-      "registration:\n  silhouette_term: true\n  wrist_sigma_px: 6\n  max_iterations: 4\n",
-      "reg.yaml");
-  const RegistrationParams p = parse_registration_params(root["registration"]);
+  const RegistrationParams p = parse("  silhouette_term: true\n  wrist_sigma_px: 6\n  max_iterations: 4\n");
   EXPECT_TRUE(p.silhouette_term);
   EXPECT_EQ(p.wrist_sigma_px, 6.0);
   EXPECT_EQ(p.max_iterations, 4);
   EXPECT_EQ(p.fingertip_sigma_m, RegistrationParams{}.fingertip_sigma_m);
   // The band's length.
-  const auto band = core::ConfigNode::Parse(
-      "registration:\n  bracelet_length_sigma: 0.03\n  bracelet_length_tolerance: 0.15\n"
-      "  bracelet_depth_ratio: 0.7\n  bracelet_length_min_fill: 0.5\n  bracelet_length_gate: 0.3\n",
-      "reg.yaml");
-  const RegistrationParams b = parse_registration_params(band["registration"]);
+  const RegistrationParams b =
+      parse("  bracelet_length_sigma: 0.03\n  bracelet_length_tolerance: 0.15\n"
+            "  bracelet_depth_ratio: 0.7\n  bracelet_length_min_fill: 0.5\n  bracelet_length_gate: 0.3\n");
   EXPECT_EQ(b.bracelet_length_sigma, 0.03);
   EXPECT_EQ(b.bracelet_length_tolerance, 0.15);
   EXPECT_EQ(b.bracelet_depth_ratio, 0.7);
@@ -91,11 +93,8 @@ TEST(RegistrationParams, ParsesValues) {
   EXPECT_EQ(b.bracelet_length_gate, 0.3);
   EXPECT_EQ(RegistrationParams{}.bracelet_length_sigma, 0.0);  // off unless asked for
   // The band's thickness.
-  const auto thick = core::ConfigNode::Parse(
-      "registration:\n  bracelet_width_m: 0.02\n  bracelet_thickness_sigma: 0.07\n"
-      "  bracelet_thickness_tolerance: 0.25\n",
-      "reg.yaml");
-  const RegistrationParams t = parse_registration_params(thick["registration"]);
+  const RegistrationParams t =
+      parse("  bracelet_width_m: 0.02\n  bracelet_thickness_sigma: 0.07\n  bracelet_thickness_tolerance: 0.25\n");
   EXPECT_EQ(t.bracelet_width_m, 0.02);
   EXPECT_EQ(t.bracelet_thickness_sigma, 0.07);
   EXPECT_EQ(t.bracelet_thickness_tolerance, 0.25);

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -19,6 +20,17 @@
 
 namespace spidar::sim {
 namespace {
+
+/// The script's nominal fingertips of both hands at script time t (what the simulated device's
+/// ground truth gives a camera thread), into out[0..7].
+void nominal_caps(const std::array<hand::HandModel, 2>& truth, const RubiksTask& task, double t,
+                  std::span<Vec3> out) {
+  for (int h = 0; h < 2; ++h) {
+    const hand::HandModel& m = truth[static_cast<std::size_t>(h)];
+    const hand::HandPoints pts = hand::forward_kinematics(m, task.nominal(t, m.side));
+    for (int f = 0; f < hand::kFingertipCount; ++f) out[static_cast<std::size_t>(4 * h + f)] = pts.p_W_fingertip[f];
+  }
+}
 
 // The ground truth has no fingertips for the first 0.2 s (as when the device's first samples
 // come late on a busy machine): those exposures are skipped, not lost from the counts.
@@ -36,12 +48,7 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
       ++refused;
       return false;
     }
-    const double t = core::ns_to_s(t_ns - t0);
-    for (int h = 0; h < 2; ++h) {
-      const hand::HandModel& m = truth[static_cast<std::size_t>(h)];
-      const hand::HandPoints pts = hand::forward_kinematics(m, task.nominal(t, m.side));
-      for (int f = 0; f < hand::kFingertipCount; ++f) out[static_cast<std::size_t>(4 * h + f)] = pts.p_W_fingertip[f];
-    }
+    nominal_caps(truth, task, core::ns_to_s(t_ns - t0), out);
     return true;
   };
   auto thread = CameraThread::start(vision::default_rig_camera(), truth, {}, task, truth_at, params);
@@ -67,8 +74,7 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
 }
 
 // A frame taken and held (CameraThread::shared) is not filmed over while the camera goes on: its
-// index, exposure and image stay as they were when it was taken, frames not taken go back to the
-// pool, and the pool makes no more frames than are held at once.
+// index, exposure and image stay as they were when it was taken, however many frames come after.
 TEST(CameraThread, AHeldFrameIsNotFilmedOver) {
   const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
                                              hand::default_hand_model(hand::Side::kRight)};
@@ -78,12 +84,7 @@ TEST(CameraThread, AHeldFrameIsNotFilmedOver) {
   params.t0_ns = core::monotonic_ns();
   const std::int64_t t0 = params.t0_ns;
   TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
-    const double t = 1.0 + core::ns_to_s(t_ns - t0);  // hands in view, moving
-    for (int h = 0; h < 2; ++h) {
-      const hand::HandModel& m = truth[static_cast<std::size_t>(h)];
-      const hand::HandPoints pts = hand::forward_kinematics(m, task.nominal(t, m.side));
-      for (int f = 0; f < hand::kFingertipCount; ++f) out[static_cast<std::size_t>(4 * h + f)] = pts.p_W_fingertip[f];
-    }
+    nominal_caps(truth, task, 1.0 + core::ns_to_s(t_ns - t0), out);  // hands in view, moving
     return true;
   };
   auto thread = CameraThread::start(vision::default_rig_camera(), truth, {}, task, truth_at, params);
