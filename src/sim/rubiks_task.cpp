@@ -70,6 +70,38 @@ Nominal nominal_grasp(hand::Side side) {
   return {Vec3(-0.070, -0.080, 0.0), Eigen::AngleAxisd(-1.45, Vec3::UnitY()).toRotationMatrix()};
 }
 
+/// The point a share w of the way from `from` to `to` [m, world] along an arc about the vertical
+/// axis of grasp frame G (through p_WG along z_G): angle about the axis, distance from it and height
+/// along it each blended linearly. A hand cross-fading between two yaws of the turn (a retry) then
+/// goes around the cube, as the script's own turns do, and not across it: the straight chord
+/// between two open fingertips a quarter turn apart cuts into the top layer. A fingertip that
+/// swings about the axis by more than kSwingFrom also rises, by up to kSwingRise at mid-swing, so
+/// it passes over the top layer's corners instead of brushing them; a holding hand, whose
+/// fingertips keep their angle, is blended as before.
+Vec3 blend_about_axis(const Vec3& from, const Vec3& to, double w, const Vec3& p_WG, const Mat3& R_WG) {
+  constexpr double kSwingFrom = 0.17, kSwingFull = 0.5;  // [rad] about 10° and 30°
+  constexpr double kSwingRise = 0.015;                    // [m]
+  const Vec3 a = from - p_WG, b = to - p_WG;
+  const Vec3 x = R_WG.col(0), y = R_WG.col(1), z = R_WG.col(2);
+  const double ra = std::hypot(a.dot(x), a.dot(y)), rb = std::hypot(b.dot(x), b.dot(y));
+  constexpr double kNearAxis = 1e-4;  // [m] too close to the axis for an angle: straight
+  if (ra < kNearAxis || rb < kNearAxis) return (1.0 - w) * from + w * to;
+  const double phi_a = std::atan2(a.dot(y), a.dot(x));
+  const double dphi = std::remainder(std::atan2(b.dot(y), b.dot(x)) - phi_a, 2.0 * units::kPi);
+  const double phi = phi_a + w * dphi, r = (1.0 - w) * ra + w * rb;
+  const double swing = std::clamp((std::abs(dphi) - kSwingFrom) / (kSwingFull - kSwingFrom), 0.0, 1.0);
+  const double h = (1.0 - w) * a.dot(z) + w * b.dot(z) + swing * kSwingRise * std::sin(units::kPi * w);
+  return p_WG + r * (std::cos(phi) * x + std::sin(phi) * y) + h * z;
+}
+
+/// A grasp frame G from its published position [m] and orientation (w, x, y, z).
+Pose grasp_frame(const std::array<double, 3>& p_WG, const std::array<double, 4>& q_WG) {
+  Pose X;
+  X.p = Vec3(p_WG[0], p_WG[1], p_WG[2]);
+  X.R = Quat(q_WG[0], q_WG[1], q_WG[2], q_WG[3]).normalized();
+  return X;
+}
+
 }  // namespace
 
 bool RubiksTask::looks_for_grasp(double t, hand::Side side) {
@@ -175,7 +207,11 @@ void RubiksTask::scheduled_goals(const Plan& plan, double t_run, const GraspFram
   std::array<Vec3, 8> from;
   const bool newest = &seg == &plan.schedule.newest();
   goals_at(seg.s_from_s, newest ? plan.from_frames : fr, from, squeeze);
-  for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f) goal[f] = (1.0 - w) * from[f] + w * goal[f];
+  for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f) {
+    const int h = f >= 4 ? 1 : 0;
+    const Pose G = grasp_frame(fr.p_W[h], fr.q_WG[h]);
+    goal[f] = blend_about_axis(from[f], goal[f], w, G.p, G.R.toRotationMatrix());
+  }
 }
 
 Vec3 RubiksTask::contact_normal(int f) const {
@@ -300,7 +336,12 @@ hand::HandParams RubiksTask::nominal(double t_run, hand::Side side) const {
   if (w < 1.0) {  // neighbouring poses of one hand: a linear blend of the parameters is smooth
     const bool newest = &seg == &plan.schedule.newest();
     const hand::HandParams from = nominal_at(seg.s_from_s, side, newest ? plan.from_frames : fr);
+    const Vec3 p_W_wrist = q.p_W_wrist();
     q.q = (1.0 - w) * from.q + w * q.q;
+    // The wrist around the cube with the fingertips (scheduled_goals), not across it.
+    const int h = side == hand::Side::kRight ? 1 : 0;
+    const Pose G = grasp_frame(fr.p_W[h], fr.q_WG[h]);
+    q.set_wrist(blend_about_axis(from.p_W_wrist(), p_W_wrist, w, G.p, G.R.toRotationMatrix()), q.r_W_hand());
   }
   return q;
 }

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 
 #include "spidar/core/seqlock.hpp"
@@ -104,6 +105,45 @@ TEST(ClosedLoopUser, ATurnThatDoesNotClickIsTriedAgain) {
   EXPECT_GT(r.finished_at_s, p.duration + 3.0);
   EXPECT_LE(r.finished_at_s, p.deadline);
   EXPECT_LT(r.max_step_m, 0.0005);  // cross-faded: no jump in the fingertips
+}
+
+/// How far a fingertip proxy centred at p_W stands clear of the axis-aligned cube centred at
+/// c_W (half size `half`, proxy radius `radius`) [m]; negative: it would be inside.
+double clearance(const Vec3& p_W, const Vec3& c_W, double half, double radius) {
+  const Vec3 d = (p_W - c_W).cwiseAbs() - Vec3::Constant(half);
+  const double outside = d.cwiseMax(0.0).norm();
+  return (outside > 0 ? outside : d.maxCoeff()) - radius;
+}
+
+TEST(ClosedLoopUser, ARetriedSecondTurnTakesTheOpenHandAroundTheCubeNotThroughIt) {
+  RubiksTask task({});
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const RubiksTaskParams p = task.params();
+  // The first turn clicks, the second does not: at the later check (9.9 s) the right hand is open
+  // at the second turn's yaw, and the retry cross-fades it to where the regrasp starts (5.7 s),
+  // open at the first turn's yaw, a quarter turn and more away about the cube's vertical axis.
+  // Cut straight across, that path went through the top layer (the short, wide user's cube was
+  // squeezed out of the hands and thrown off the table, 2026-11-26).
+  double check_t = -1, min_clear = 1.0, s_prev = 0;
+  Vec3 cube_W = Vec3::Zero();
+  std::array<Vec3, 8> g;
+  for (int k = 0; k <= 11000; ++k) {
+    const double t = k * 1e-3, s = task.script_time(t);
+    if (check_t < 0 && s < s_prev - 1.0) check_t = t;  // the jump back of the retry
+    s_prev = s;
+    const CubePoseSample c = cube_at(p, script_lift(p, s), s >= 5.3 ? 1 : 0);
+    feed.publish(c);
+    task.goals(t, g);
+    cube_W = Vec3(c.p_W[0], c.p_W[1], c.p_W[2]);
+    if (check_t >= 0 && t <= check_t + 0.8)
+      for (int f = 4; f < 8; ++f) min_clear = std::min(min_clear, clearance(g[f], cube_W, p.half, p.proxy_radius));
+  }
+  ASSERT_GT(check_t, 9.8);
+  ASSERT_LT(check_t, 10.0);
+  std::printf("the right hand's fingertip proxies clear the cube by %.1f mm or more in the cross-fade\n", 1e3 * min_clear);
+  EXPECT_EQ(task.progress().retries_turn, 1);
+  EXPECT_GT(min_clear, 0.0) << "the right hand's open fingertips cut into the cube during the retry's cross-fade";
 }
 
 TEST(ClosedLoopUser, RetriesStopAtTheDeadline) {
