@@ -39,7 +39,7 @@ double RubiksTask::script_time(double t_run) const { return read_plan().schedule
 
 TaskProgress RubiksTask::progress() const { return read_plan().progress; }
 
-void RubiksTask::jump(double t_run, double s0, double blend_s, SegmentKind kind, int attempt) {
+void RubiksTask::jump(double t_run, double s0, double blend_s, SegmentKind kind, int attempt, int turn) {
   ScriptSegment seg;
   seg.t0_s = t_run;
   seg.s0_s = s0;
@@ -47,6 +47,7 @@ void RubiksTask::jump(double t_run, double s0, double blend_s, SegmentKind kind,
   seg.blend_s = blend_s;
   seg.kind = kind;
   seg.attempt = attempt;
+  seg.turn = turn;
   plan_.schedule.start(seg);
   plan_.from_frames = frames_;
 }
@@ -60,14 +61,18 @@ void RubiksTask::check_turns(double t_run, int seen, bool first) {
   if (seen >= pr.turns_planned) {
     // Done turning: after the first turn skip the regrasp-and-turn stretch (the right hand is
     // open at both ends); after a later one the script goes on to set the cube down anyway.
-    if (first) jump(t_run, kLaterCheck, kTurnBlend, SegmentKind::kSkip, attempt);
+    if (first) jump(t_run, kLaterCheck, kTurnBlend, SegmentKind::kSkip, attempt, seen + 1);
     return;
   }
   // Another attempt: a retry when this one did not click, else the next planned turn.
   const SegmentKind kind = progressed ? SegmentKind::kNextTurn : SegmentKind::kRetryTurn;
   if (first) {  // the script's own next stretch is that attempt
-    if (!progressed) ++pr.retries_turn;
     ++pr.attempts;
+    if (!progressed) {  // the same turn again: a segment in place, to name it so
+      ++pr.retries_turn;
+      const double s_now = plan_.schedule.script_time(t_run);
+      jump(t_run, s_now, 0.0, SegmentKind::kRetryTurn, pr.attempts, seen + 1);
+    }
     return;
   }
   // The rest of the script from the regrasp must fit before the deadline.
@@ -77,7 +82,7 @@ void RubiksTask::check_turns(double t_run, int seen, bool first) {
   }
   if (!progressed) ++pr.retries_turn;
   ++pr.attempts;
-  jump(t_run, kFirstCheck, kTurnBlend, kind, pr.attempts);
+  jump(t_run, kFirstCheck, kTurnBlend, kind, pr.attempts, seen + 1);
 }
 
 void RubiksTask::update_plan(double t_run, const std::optional<CubePoseSample>& cube) {
@@ -91,7 +96,8 @@ void RubiksTask::update_plan(double t_run, const std::optional<CubePoseSample>& 
       // The cube left the scene (off the table, thrown): nothing to grasp again. Withdraw.
       if (plan_.schedule.newest().kind != SegmentKind::kGiveUp && s < kWithdrawFrom) {
         plan_.progress.gave_up = true;
-        jump(t_run, kWithdrawFrom, kRegraspBlend, SegmentKind::kGiveUp, plan_.schedule.newest().attempt);
+        jump(t_run, kWithdrawFrom, kRegraspBlend, SegmentKind::kGiveUp, plan_.schedule.newest().attempt,
+             plan_.schedule.newest().turn);
         changed = true;
       }
     } else if (s >= kHeldFrom && s < kHeldUntil) {
@@ -107,10 +113,10 @@ void RubiksTask::update_plan(double t_run, const std::optional<CubePoseSample>& 
         if (t_run + kRegraspBlend + (p_.duration - kRegraspFrom) <= p_.deadline) {
           ++plan_.progress.retries_grasp;
           ++plan_.progress.attempts;
-          jump(t_run, kRegraspFrom, kRegraspBlend, SegmentKind::kRegrasp, attempt);
+          jump(t_run, kRegraspFrom, kRegraspBlend, SegmentKind::kRegrasp, attempt, plan_.progress.turns_seen + 1);
         } else {
           plan_.progress.gave_up = true;
-          jump(t_run, kWithdrawFrom, kRegraspBlend, SegmentKind::kGiveUp, attempt - 1);
+          jump(t_run, kWithdrawFrom, kRegraspBlend, SegmentKind::kGiveUp, attempt - 1, plan_.schedule.newest().turn);
         }
         changed = true;
       }
@@ -136,9 +142,9 @@ std::string RubiksTask::phase(double t_run) const {
   const ScriptSchedule sched = read_plan().schedule;
   const ScriptSegment& seg = sched.at(t_run);
   const double s = sched.script_time(t_run);
-  // The attempt a turn phase is: a segment from before the first turn holds its own attempt
-  // there and the next one in the second turn phase.
-  const int first_turn = seg.s0_s < kHeldFrom ? seg.attempt : seg.attempt - 1;
+  // The turn a turn phase makes: a segment from before the first turn phase makes its own turn
+  // there and the next one in the second turn phase; a later one makes its own in the second.
+  const int first_turn = seg.s0_s < kHeldFrom ? seg.turn : seg.turn - 1;
   const bool again = seg.kind == SegmentKind::kRegrasp;
   const bool cube = p_.has_cube;
   auto turn = [&](int n) {

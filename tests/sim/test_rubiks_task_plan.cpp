@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <set>
+#include <string>
 
 #include "spidar/core/seqlock.hpp"
 #include "spidar/sim/rubiks_task.hpp"
@@ -90,10 +92,12 @@ TEST(ClosedLoopUser, ATurnThatDoesNotClickIsTriedAgain) {
   // The first turn slips (no click); the second attempt clicks, and so does the third.
   int clicks = 0;
   double last_s = 0;
-  const Played r = play(task, feed, 22.0, [&](double, double s) {
+  std::set<std::string> phases;
+  const Played r = play(task, feed, 22.0, [&](double t, double s) {
     // A click whenever a turn phase (7.2–9.2 script time) has just been played to its end.
     if (last_s < 9.25 && s >= 9.25) ++clicks;
     last_s = s;
+    phases.insert(task.phase(t));
     return cube_at(p, script_lift(p, s), clicks);
   });
   const TaskProgress pr = task.progress();
@@ -105,6 +109,11 @@ TEST(ClosedLoopUser, ATurnThatDoesNotClickIsTriedAgain) {
   EXPECT_GT(r.finished_at_s, p.duration + 3.0);
   EXPECT_LE(r.finished_at_s, p.deadline);
   EXPECT_LT(r.max_step_m, 0.0005);  // cross-faded: no jump in the fingertips
+  // The phases name the turn being made: the first, then the first again, then the second.
+  EXPECT_TRUE(phases.count("turn 1 (top layer)"));
+  EXPECT_TRUE(phases.count("turn 1 (top layer), again"));
+  EXPECT_TRUE(phases.count("turn 2 (top layer)"));
+  for (const auto& name : phases) EXPECT_EQ(name.find("turn 3"), std::string::npos) << name;
 }
 
 /// How far a fingertip proxy centred at p_W stands clear of the axis-aligned cube centred at

@@ -175,7 +175,7 @@ class RubiksTask final : public device::FingertipSource {
   /// After a turn, once the right hand has let go (`first`: after the first turn).
   void check_turns(double t_s, int turns_seen, bool first);
   /// Starts a segment at run time t from script time s0, blending from the present script time.
-  void jump(double t_s, double s0, double blend_s, SegmentKind kind, int attempt);
+  void jump(double t_s, double s0, double blend_s, SegmentKind kind, int attempt, int turn);
   Plan read_plan() const;
   /// True while the cube is where a hand can take it: near its start place (not thrown off the
   /// table). Hands follow only such a cube.

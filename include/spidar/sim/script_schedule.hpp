@@ -32,6 +32,8 @@ struct ScriptSegment {
   double blend_s = 0;   ///< cross-fade duration from s_from [s] (0: none)
   SegmentKind kind = SegmentKind::kStart;
   std::int32_t attempt = 1;  ///< number of the turn attempt the segment's turn phase is
+  /// The turn (1-based) the segment's first turn phase makes: a retry makes the same turn again.
+  std::int32_t turn = 1;
 };
 
 struct ScriptSchedule {
