@@ -289,6 +289,9 @@ int main(int argc, char** argv) {
   std::array<Vec3, 2> palm_rot{Vec3::Zero(), Vec3::Zero()};  // |rotation error| about x_H, y_H, z_H [° sums]
   std::array<double, 2> palm_n{};
   std::array<std::vector<double>, 2> palm_roll_deg;  // signed, about y_H
+  // Each finger parameter's error (fit − truth) per hand and frame [rad], for its bias, its spread
+  // and how it moves with the palm's roll.
+  std::array<std::array<std::vector<double>, hand::kParamCount>, 2> param_err;
   // Joint error by digit and joint along it (fit, and the floor as above) [px sums], and counts.
   std::array<std::array<double, 4>, 5> joint_at_sum{}, joint_at_floor{}, joint_at_n{};
   std::array<Vec3, 8> g;
@@ -511,6 +514,8 @@ int main(int argc, char** argv) {
       for (int k = 0; k < 3; ++k) palm_rot[h][k] += std::abs(v[k]) * 180 / units::kPi;
       palm_roll_deg[h].push_back(v.y() * 180 / units::kPi);
       palm_n[h] += 1;
+      for (int k = hand::kThumbCmcFlexion; k < hand::kParamCount; ++k)
+        param_err[h][static_cast<std::size_t>(k)].push_back(r.hands[h][k] - truth[h][k]);
     }
     // The joint error by part (the wrist, then each digit's four joints), and its floor: the
     // model's skeleton with the user's true sizes at the true pose, whose little finger can only
@@ -620,6 +625,27 @@ int main(int argc, char** argv) {
   for (int h = 0; h < 2; ++h)
     std::printf("%s palm roll about y_H, signed [°]: p10 %+.1f, median %+.1f, p90 %+.1f\n", h == 0 ? "left" : "right",
                 quantile(palm_roll_deg[h], 0.1), quantile(palm_roll_deg[h], 0.5), quantile(palm_roll_deg[h], 0.9));
+  std::printf("finger parameters, fit − truth [°]: mean (mean |·|), correlation with the palm's roll\n");
+  for (int k = hand::kThumbCmcFlexion; k < hand::kParamCount; ++k) {
+    std::printf("  %-22s", std::string(hand::param_name(k)).c_str());
+    for (int h = 0; h < 2; ++h) {
+      const auto& e = param_err[h][static_cast<std::size_t>(k)];
+      const auto& roll = palm_roll_deg[h];
+      std::vector<double> magnitude(e.size());
+      for (std::size_t i = 0; i < e.size(); ++i) magnitude[i] = std::abs(e[i]);
+      const double me = mean(e), mr = mean(roll);
+      double sxy = 0, sxx = 0, syy = 0;
+      for (std::size_t i = 0; i < e.size() && i < roll.size(); ++i) {
+        sxy += (e[i] - me) * (roll[i] - mr);
+        sxx += (e[i] - me) * (e[i] - me);
+        syy += (roll[i] - mr) * (roll[i] - mr);
+      }
+      const double corr = sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
+      std::printf("  %s %+6.1f (%5.1f) r %+.2f", h == 0 ? "left" : "right", me * 180 / units::kPi,
+                  mean(magnitude) * 180 / units::kPi, corr);
+    }
+    std::printf("\n");
+  }
   std::printf("fitted caps to the strings %.2f mm (p95 %.2f), truth caps to the strings %.2f mm (max %.2f)\n",
               mean(obs), quantile(obs, 0.95), mean(caps), quantile(caps, 1.0));
   std::printf("bracelet midpoint to the band's axis centre %.2f px (p95 %.2f), to its visible surface %.2f px (p95 %.2f)\n",
