@@ -178,6 +178,8 @@ int run_mr_demo(const DemoOptions& o) {
     summary.solved = s->solved;
   }
   summary.task = task.progress();
+  summary.phases.reserve(trace.frames.size());
+  for (const MrFrame& m : trace.frames) summary.phases.emplace_back(task.phase_kind(m.t_s));
   summary.has_cube = cube.has_value();
   summary.facelets = cube ? cube->facelets() : "";
   if (cube) {

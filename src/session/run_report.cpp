@@ -65,8 +65,45 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
           {"frames", t.frames.size()}};
 }
 
+/// The main registration's figures and the contested pixels over the frames of each part of the
+/// task (`phases`: one word per trace frame), in the order the parts first occur: where the hard
+/// frames are (the approach and the release, one hand or forearm hiding the other) without the
+/// run's easy frames averaging them away. Empty without phases.
+nlohmann::ordered_json by_phase_json(const MrTrace& t, const std::vector<std::string>& phases) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::object();
+  if (phases.size() != t.frames.size()) return out;
+  std::vector<std::string> order;
+  for (const auto& p : phases)
+    if (std::find(order.begin(), order.end(), p) == order.end()) order.push_back(p);
+  for (const auto& name : order) {
+    MrTrace part;
+    long contested = 0, wrong = 0, wrong_paper = 0;
+    for (std::size_t i = 0; i < t.frames.size(); ++i) {
+      if (phases[i] != name) continue;
+      const MrFrame& m = t.frames[i];
+      part.frames.push_back(m);
+      contested += m.truth[0].contested_pixels;
+      wrong += m.truth[0].contested_wrong;
+      wrong_paper += m.truth[0].contested_wrong_paper;
+    }
+    const auto iou = column(part, [](const MrFrame& m) { return m.truth[0].iou; });
+    const auto jp = column(part, [](const MrFrame& m) { return 0.5 * (m.truth[0].joint_px[0] + m.truth[0].joint_px[1]); });
+    const auto tip = column(part, [](const MrFrame& m) { return 0.5 * (m.truth[0].fingertip_mm[0] + m.truth[0].fingertip_mm[1]); });
+    const auto pct = [contested](long w) { return contested > 0 ? 100.0 * static_cast<double>(w) / static_cast<double>(contested) : 0.0; };
+    out[name] = {{"frames", part.frames.size()},
+                 {"iou_mean", mean(iou)},
+                 {"iou_p5", quantile(iou, 0.05)},
+                 {"joint_px_mean", mean(jp)},
+                 {"fingertip_mm_mean", mean(tip)},
+                 {"contested_pixels_mean", static_cast<double>(contested) / static_cast<double>(part.frames.size())},
+                 {"contested_error_pct", pct(wrong)},
+                 {"contested_error_pct_paper", pct(wrong_paper)}};
+  }
+  return out;
+}
+
 /// One row per processed frame: what the report's figures are computed from.
-void write_frames_csv(const std::string& path, const MrTrace& t) {
+void write_frames_csv(const std::string& path, const MrTrace& t, const std::vector<std::string>& phases) {
   std::ostringstream f;
   f << "t_s,latency_ms,pipeline_ms,registration_ms,truth_ms,output_ms,film_ms,iou,fingertip_mm,"
        "joint_px_left,joint_px_right,occlusion_pct,occlusion_pct_paper,contested_pixels,"
@@ -74,9 +111,10 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
        "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou,"
        "length_mm_left,width_mm_left,length_mm_right,width_mm_right,dropped_before,joint_px_floor,"
-       "wrist_depth_mm_left,wrist_depth_mm_right\n";
+       "wrist_depth_mm_left,wrist_depth_mm_right,phase\n";
   f << std::setprecision(6);
-  for (const MrFrame& m : t.frames) {
+  for (std::size_t i = 0; i < t.frames.size(); ++i) {
+    const MrFrame& m = t.frames[i];
     const auto& a = m.truth[0];
     f << m.t_s << ',' << m.latency_ms << ',' << m.pipeline_ms << ',' << m.registration_ms << ','
       << m.truth_ms << ',' << m.output_ms << ',' << m.film_ms << ',' << a.iou << ','
@@ -91,7 +129,8 @@ void write_frames_csv(const std::string& path, const MrTrace& t) {
     if (m.ceiling_measured) f << m.ceiling_iou;
     for (int h = 0; h < 2; ++h) f << ',' << 1e3 * m.shape[h].length_m << ',' << 1e3 * m.shape[h].width_m;
     f << ',' << m.dropped_before << ',' << 0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1]) << ','
-      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << '\n';
+      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << ',' << (i < phases.size() ? phases[i] : "")
+      << '\n';
   }
   core::write_file_atomic(path, f.str());
 }
@@ -248,6 +287,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   reg["preprocess_ms_median"] = quantile(pre_ms, 0.5);
   reg["iterations_mean"] = mean(iters);
   reg["method"] = s.main_silhouette ? "joint-balls + silhouette" : "joint-balls (paper)";
+  const nlohmann::ordered_json by_phase = by_phase_json(t, s.phases);
+  if (!by_phase.empty()) reg["by_phase"] = nlohmann::json::parse(by_phase.dump());
   nlohmann::json other = registration_json(t, 1);
   other["method"] = s.main_silhouette ? "joint-balls (paper)" : "joint-balls + silhouette";
   reg["comparison"] = other;
@@ -374,7 +415,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   require_finite_json(report, (dir / "report.json").string());
   // Whole or not at all (a directory or unwritable path there is an error naming it, exit 2).
   core::write_file_atomic((dir / "report.json").string(), report.dump(2) + "\n");
-  write_frames_csv((dir / "frames.csv").string(), t);
+  write_frames_csv((dir / "frames.csv").string(), t, s.phases);
   if (frames > 1) write_plots(dir, t, s);
 
   os << "\nresult (" << frames << " frames in " << std::fixed << std::setprecision(1) << s.wall_s
@@ -390,6 +431,19 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << reg["iterations_mean"].get<double>() << " iterations\n"
      << "  model ceiling  IoU " << std::setprecision(3) << mean(ceiling)
      << " (the model's skin at the true pose with the user's sizes)\n"
+     << [&] {
+          if (by_phase.empty()) return std::string();
+          std::ostringstream line;
+          line << "  by phase       IoU (p5), contested wrong:";
+          const char* sep = " ";
+          for (const auto& [name, v] : by_phase.items()) {
+            line << sep << name << " " << std::fixed << std::setprecision(3) << v["iou_mean"].get<double>() << " ("
+                 << std::setprecision(2) << v["iou_p5"].get<double>() << "), " << std::setprecision(1)
+                 << v["contested_error_pct"].get<double>() << " %";
+            sep = "; ";
+          }
+          return line.str() + "\n";
+        }()
      << "  comparison     " << other["method"].get<std::string>() << ": IoU "
      << std::setprecision(3) << other["iou_mean"].get<double>() << ", fingertip "
      << std::setprecision(2) << other["fingertip_mm_mean"].get<double>() << " mm, joints "

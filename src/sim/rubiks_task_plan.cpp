@@ -167,4 +167,17 @@ std::string RubiksTask::phase(double t_run) const {
   return "done";
 }
 
+std::string_view RubiksTask::phase_kind(double t_run) const {
+  const double s = read_plan().schedule.script_time(t_run);
+  if (s < 1.0) return "approach";
+  if (s < 2.0) return "grasp";
+  if (s < kHeldFrom) return "lift";
+  if (s < 5.0) return "turn";
+  if (s < 7.2) return "regrasp";
+  if (s < 9.2) return "turn";
+  if (s < kWithdrawFrom) return "release";
+  if (s < p_.duration) return "withdraw";
+  return "done";
+}
+
 }  // namespace spidar::sim

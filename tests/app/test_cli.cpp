@@ -263,6 +263,20 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_GE(reg["comparison"]["wrist_depth_mm_mean"].get<double>(), 0.0);
   EXPECT_GT(reg["iterations_mean"].get<double>(), 0.0);
   EXPECT_TRUE(reg["comparison"].is_object());
+  {  // The figures per part of the task: the 3 s hold the approach, the grasp and the lift, and
+     // every frame is in one part.
+    const auto& parts = reg["by_phase"];
+    ASSERT_TRUE(parts.is_object());
+    int in_parts = 0;
+    for (const auto& [name, v] : parts.items()) {
+      in_parts += v["frames"].get<int>();
+      EXPECT_GE(v["iou_mean"].get<double>(), 0.0) << name;
+      EXPECT_GE(v["contested_error_pct"].get<double>(), 0.0) << name;
+    }
+    EXPECT_EQ(in_parts, j["frames"].get<int>());
+    EXPECT_TRUE(parts.contains("approach"));
+    EXPECT_FALSE(parts.contains("withdraw"));
+  }
   // The default: joint-balls with the hand-aware silhouette term, the paper's as the comparison.
   EXPECT_EQ(reg["method"], "joint-balls + silhouette");
   EXPECT_EQ(reg["comparison"]["method"], "joint-balls (paper)");
@@ -297,6 +311,7 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
         for (std::size_t k = 0; k < cells.size(); ++k)
           if (cells[k] == "dropped_before") dropped_column = static_cast<int>(k);
         ASSERT_GE(dropped_column, 0) << line;
+        EXPECT_EQ(cells.back(), "phase") << line;
       } else if (dropped_column < static_cast<int>(cells.size())) {
         dropped_sum += std::stoi(cells[static_cast<std::size_t>(dropped_column)]);
       }

@@ -272,5 +272,30 @@ TEST(ClosedLoopUser, PhasesAreNamedFromTheScene) {
   EXPECT_EQ(b.progress().turns_planned, 0);
 }
 
+TEST(ClosedLoopUser, PhaseKindsGroupTheScriptAndFollowItsJumps) {
+  RubiksTask task({});
+  const std::pair<double, const char*> expected[] = {{0.5, "approach"}, {1.5, "grasp"},   {2.5, "lift"},
+                                                     {4.0, "turn"},     {6.0, "regrasp"}, {8.0, "turn"},
+                                                     {10.0, "release"}, {11.5, "withdraw"}, {12.5, "done"}};
+  for (const auto& [t, kind] : expected) EXPECT_EQ(task.phase_kind(t), kind) << t;
+  // A retried second turn jumps back in the script: its frames are "regrasp" and "turn" again.
+  core::Latest<CubePoseSample> feed;
+  RubiksTask retry({});
+  retry.track(&feed);
+  const RubiksTaskParams p = retry.params();
+  std::array<Vec3, 8> g;
+  double jumped_at = -1, s_prev = 0;
+  for (int k = 0; k <= 14000; ++k) {
+    const double t = k * 1e-3, s = retry.script_time(t);
+    if (jumped_at < 0 && s < s_prev - 1.0) jumped_at = t;
+    s_prev = s;
+    feed.publish(cube_at(p, script_lift(p, s), s >= 5.3 ? 1 : 0));
+    retry.goals(t, g);
+  }
+  ASSERT_GT(jumped_at, 0);
+  EXPECT_EQ(retry.phase_kind(jumped_at + 0.3), "regrasp");
+  EXPECT_EQ(retry.phase_kind(jumped_at + 3.0), "turn");  // script time 8.7 s
+}
+
 }  // namespace
 }  // namespace spidar::sim

@@ -42,6 +42,10 @@ struct MrSummary {
   bool bending_wrists = false;  ///< the simulated user's forearms point at fixed elbows
   bool shaped_fingers = false;  ///< the simulated user's fingertips held by their own fingers' stiffness
   int width = 0, height = 0;
+  /// Each trace frame's part of the task (sim::RubiksTask::phase_kind), in trace order: the report
+  /// gives the registration and the contested pixels per part (registration.by_phase) and
+  /// frames.csv a `phase` column. Empty: not known (the figures over the whole run only).
+  std::vector<std::string> phases;
   std::string ended_by = "completed";  ///< completed | SIGINT | SIGTERM
   std::uint64_t mujoco_warnings = 0;   ///< MuJoCo warnings in the process (physics::mujoco_warnings)
   std::vector<physics::World::WarningCount> mujoco_warning_kinds;  ///< the world's, by kind

@@ -38,6 +38,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "spidar/core/pose.hpp"
@@ -142,6 +143,11 @@ class RubiksTask final : public device::FingertipSource {
   hand::HandParams nominal(double t_s, hand::Side side) const;
   /// Name of the phase at run time t, from the scene ("turn 2 (top layer)" only with a cube).
   std::string phase(double t_s) const;
+  /// The part of the task run time t belongs to, a fixed word for grouping frames in a report:
+  /// "approach" (the hands reach, also again after a slip), "grasp", "lift", "turn", "regrasp" (the
+  /// turning hand lets go, goes back and grasps again), "release" (the hands let go, the cube is set
+  /// down), "withdraw", "done".
+  std::string_view phase_kind(double t_s) const;
   /// Script time at run time t (the published schedule).
   double script_time(double t_s) const;
   /// True once the script has played to its end.
