@@ -77,8 +77,12 @@ Nominal nominal_grasp(hand::Side side) {
 /// between two open fingertips a quarter turn apart cuts into the top layer. A fingertip that
 /// swings about the axis by more than kSwingFrom also rises, by up to kSwingRise at mid-swing, so
 /// it passes over the top layer's corners instead of brushing them; a holding hand, whose
-/// fingertips keep their angle, is blended as before.
-Vec3 blend_about_axis(const Vec3& from, const Vec3& to, double w, const Vec3& p_WG, const Mat3& R_WG) {
+/// fingertips keep their angle, is blended as before. `swing_rad`: how far the hand turns about
+/// the axis between the two (the difference of the script's yaws, unwrapped): the arc takes the
+/// way round nearest to it, so that a swing near half a turn, whose target moves on, never flips
+/// to the other side of the cube.
+Vec3 blend_about_axis(const Vec3& from, const Vec3& to, double w, const Vec3& p_WG, const Mat3& R_WG,
+                      double swing_rad) {
   constexpr double kSwingFrom = 0.17, kSwingFull = 0.5;  // [rad] about 10° and 30°
   constexpr double kSwingRise = 0.015;                    // [m]
   const Vec3 a = from - p_WG, b = to - p_WG;
@@ -87,7 +91,8 @@ Vec3 blend_about_axis(const Vec3& from, const Vec3& to, double w, const Vec3& p_
   constexpr double kNearAxis = 1e-4;  // [m] too close to the axis for an angle: straight
   if (ra < kNearAxis || rb < kNearAxis) return (1.0 - w) * from + w * to;
   const double phi_a = std::atan2(a.dot(y), a.dot(x));
-  const double dphi = std::remainder(std::atan2(b.dot(y), b.dot(x)) - phi_a, 2.0 * units::kPi);
+  const double dphi =
+      swing_rad + std::remainder(std::atan2(b.dot(y), b.dot(x)) - phi_a - swing_rad, 2.0 * units::kPi);
   const double phi = phi_a + w * dphi, r = (1.0 - w) * ra + w * rb;
   const double swing = std::clamp((std::abs(dphi) - kSwingFrom) / (kSwingFull - kSwingFrom), 0.0, 1.0);
   const double h = (1.0 - w) * a.dot(z) + w * b.dot(z) + swing * kSwingRise * std::sin(units::kPi * w);
@@ -207,10 +212,13 @@ void RubiksTask::scheduled_goals(const Plan& plan, double t_run, const GraspFram
   std::array<Vec3, 8> from;
   const bool newest = &seg == &plan.schedule.newest();
   goals_at(seg.s_from_s, newest ? plan.from_frames : fr, from, squeeze);
+  const double s_to = plan.schedule.script_time(t_run);
   for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f) {
     const int h = f >= 4 ? 1 : 0;
+    const auto side = h == 1 ? hand::Side::kRight : hand::Side::kLeft;
     const Pose G = grasp_frame(fr.p_W[h], fr.q_WG[h]);
-    goal[f] = blend_about_axis(from[f], goal[f], w, G.p, G.R.toRotationMatrix());
+    const double swing = state(s_to, side, 0).yaw - state(seg.s_from_s, side, 0).yaw;
+    goal[f] = blend_about_axis(from[f], goal[f], w, G.p, G.R.toRotationMatrix(), swing);
   }
 }
 
@@ -341,7 +349,9 @@ hand::HandParams RubiksTask::nominal(double t_run, hand::Side side) const {
     // The wrist around the cube with the fingertips (scheduled_goals), not across it.
     const int h = side == hand::Side::kRight ? 1 : 0;
     const Pose G = grasp_frame(fr.p_W[h], fr.q_WG[h]);
-    q.set_wrist(blend_about_axis(from.p_W_wrist(), p_W_wrist, w, G.p, G.R.toRotationMatrix()), q.r_W_hand());
+    const double swing = state(plan.schedule.script_time(t_run), side, 0).yaw - state(seg.s_from_s, side, 0).yaw;
+    q.set_wrist(blend_about_axis(from.p_W_wrist(), p_W_wrist, w, G.p, G.R.toRotationMatrix(), swing),
+                q.r_W_hand());
   }
   return q;
 }
