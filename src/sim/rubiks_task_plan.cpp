@@ -17,6 +17,9 @@ constexpr double kRegraspFrom = 0.7;   ///< a new approach: the hands nearly ope
 constexpr double kWithdrawFrom = 11.3; ///< both hands withdraw
 
 constexpr double kTurnBlend = 0.6;     ///< [s] cross-fade into a new turn attempt
+/// [s] the same from the later check, where the left hand must lift the set-down cube again
+/// while the right hand swings back a turn: no faster than the script's own lift and return.
+constexpr double kLaterTurnBlend = 1.2;
 constexpr double kRegraspBlend = 0.8;  ///< [s] cross-fade from a lost grasp to the approach
 constexpr double kDropHold = 0.3;      ///< [s] a drop must last this long to count as a slip
 constexpr double kDroppedLift = 0.15;  ///< a cube below this share of the script's lift is down (3 mm of 20)
@@ -76,13 +79,13 @@ void RubiksTask::check_turns(double t_run, int seen, bool first) {
     return;
   }
   // The rest of the script from the regrasp must fit before the deadline.
-  if (t_run + kTurnBlend + (p_.duration - kFirstCheck) > p_.deadline) {
+  if (t_run + kLaterTurnBlend + (p_.duration - kFirstCheck) > p_.deadline) {
     pr.gave_up = true;
     return;
   }
   if (!progressed) ++pr.retries_turn;
   ++pr.attempts;
-  jump(t_run, kFirstCheck, kTurnBlend, kind, pr.attempts, seen + 1);
+  jump(t_run, kFirstCheck, kLaterTurnBlend, kind, pr.attempts, seen + 1);
 }
 
 void RubiksTask::update_plan(double t_run, const std::optional<CubePoseSample>& cube) {
