@@ -388,6 +388,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"turn_attempts", s.task.attempts},
         {"retries", {{"turn", s.task.retries_turn}, {"grasp", s.task.retries_grasp}}},
         {"gave_up", s.task.gave_up},
+        {"grip_firmed_s", s.task.firm_since_s},
         {"solved", s.solved},
         {"facelets", s.facelets},
         {"face_angles_deg", [&] {

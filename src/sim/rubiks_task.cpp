@@ -206,12 +206,20 @@ bool RubiksTask::holds(std::span<device::FingertipHold> hold) {
 void RubiksTask::scheduled_goals(const Plan& plan, double t_run, const GraspFrames& fr,
                                  std::span<Vec3> goal, bool squeeze) const {
   const ScriptSegment& seg = plan.schedule.at(t_run);
-  goals_at(plan.schedule.script_time(t_run), fr, goal, squeeze);
+  // The holding hand gripping harder (update_plan), ramped in over 0.2 s.
+  const double since = plan.progress.firm_since_s;
+  const double firm = squeeze && since >= 0 ? p_.firm_squeeze * ramp(t_run, since, since + 0.2) : 0.0;
+  goals_at(plan.schedule.script_time(t_run), fr, goal, squeeze, firm);
+  blend_goals(plan, seg, t_run, fr, goal, squeeze, firm);
+}
+
+void RubiksTask::blend_goals(const Plan& plan, const ScriptSegment& seg, double t_run, const GraspFrames& fr,
+                             std::span<Vec3> goal, bool squeeze, double firm_m) const {
   const double w = blend_weight(seg, t_run);
   if (w >= 1.0) return;
   std::array<Vec3, 8> from;
   const bool newest = &seg == &plan.schedule.newest();
-  goals_at(seg.s_from_s, newest ? plan.from_frames : fr, from, squeeze);
+  goals_at(seg.s_from_s, newest ? plan.from_frames : fr, from, squeeze, firm_m);
   const double s_to = plan.schedule.script_time(t_run);
   for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f) {
     const int h = f >= 4 ? 1 : 0;
@@ -291,7 +299,8 @@ void RubiksTask::touch_points(double t_run, std::span<Vec3> p_W) const {
   scheduled_goals(read_plan(), t_run, published_.read().value_or(frames_), p_W, false);
 }
 
-void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal, bool squeeze) const {
+void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal, bool squeeze,
+                          double firm_m) const {
   for (int f = 0; f < 8 && f < static_cast<int>(goal.size()); ++f) {
     const bool right = f >= 4;
     const auto side = right ? hand::Side::kRight : hand::Side::kLeft;
@@ -301,6 +310,8 @@ void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal,
     const Vec3 p_WG(fr.p_W[h][0], fr.p_W[h][1], fr.p_W[h][2]);
     const Vec3 p = squeeze ? path(t, f) : Vec3(path(t, f) - pressing(t, f));
     goal[f] = p_WG + q_WG * (rot_z(s.yaw) * p) + Vec3(0, 0, s.lift - fr.lift[h]);
+    // The holding hand's firmer grip: deeper along its faces' inward normals, as far as it is closed.
+    if (!right && firm_m > 0) goal[f] -= firm_m * closeness(t, side) * (q_WG * contact_normal(f));
   }
 }
 

@@ -126,6 +126,18 @@ void RubiksTask::update_plan(double t_run, const std::optional<CubePoseSample>& 
     } else {
       drop_since_ = -1;
     }
+    // A cube sinking in the holding hand during a turn: grip harder (once).
+    const bool turning = (s >= kHeldFrom && s < 5.0) || (s >= 7.2 && s < 9.2);
+    if (!turning) {
+      turn_start_lift_ = -1;
+    } else if (p_.firm_squeeze > 0 && plan_.progress.firm_since_s < 0) {
+      const double lifted = cube->p_W[2] - frames_.p_W[0][2];
+      if (turn_start_lift_ < 0) turn_start_lift_ = lifted;
+      if (lifted < turn_start_lift_ - p_.sink) {
+        plan_.progress.firm_since_s = t_run;
+        changed = true;
+      }
+    }
     if (!changed && cube->turns >= 0) {
       if (prev_s_ < kFirstCheck && s >= kFirstCheck) {
         check_turns(t_run, cube->turns, true);

@@ -2,6 +2,7 @@
 // what did not work, within the run's deadline, without a jump in the fingertips.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -161,6 +162,49 @@ TEST(ClosedLoopUser, ARetriedSecondTurnTakesTheOpenHandAroundTheCubeNotThroughIt
   // half a turn: it keeps its way round, and no goal jumps (measured: 0.3 mm per ms at most).
   std::printf("largest goal step in the cross-fade %.2f mm per ms\n", 1e3 * max_step);
   EXPECT_LT(max_step, 0.001);
+}
+
+// A cube that sinks in the holding hand while the other turns the layer: the user grips harder,
+// the holding hand's goals going firm_squeeze deeper into their faces; a cube that stays put
+// changes nothing.
+TEST(ClosedLoopUser, ACubeSinkingInTheHoldingHandMakesItGripHarder) {
+  struct Run {
+    std::array<Vec3, 8> goals_at_8_8;
+    double max_step_m = 0;
+    TaskProgress progress;
+  };
+  auto run = [](double sink_m) {
+    RubiksTask task({});
+    core::Latest<CubePoseSample> feed;
+    task.track(&feed);
+    const RubiksTaskParams p = task.params();
+    Run r;
+    std::array<Vec3, 8> g, prev;
+    for (int k = 0; k <= 8800; ++k) {
+      const double t = k * 1e-3, s = task.script_time(t);
+      // Turn 2 (7.2–9.2 s): the cube sinks by sink_m between 7.8 and 8.3 s.
+      const double sunk = sink_m * std::clamp((s - 7.8) / 0.5, 0.0, 1.0);
+      feed.publish(cube_at(p, script_lift(p, s) - sunk, (s >= 5.3) + (s >= 9.5)));
+      task.goals(t, g);
+      if (k > 0)
+        for (int f = 0; f < 8; ++f) r.max_step_m = std::max(r.max_step_m, (g[f] - prev[f]).norm());
+      prev = g;
+    }
+    r.goals_at_8_8 = g;
+    r.progress = task.progress();
+    return r;
+  };
+  const Run steady = run(0.0), sinking = run(0.004);
+  const RubiksTaskParams p{};
+  EXPECT_LT(steady.progress.firm_since_s, 0.0);
+  EXPECT_GT(sinking.progress.firm_since_s, 7.8);  // once the cube is 2 mm (sink) lower
+  EXPECT_LT(sinking.progress.firm_since_s, 8.1);
+  // The left thumb presses +y (its face is the front), the fingers −y; the right hand unchanged.
+  EXPECT_NEAR(sinking.goals_at_8_8[0].y() - steady.goals_at_8_8[0].y(), p.firm_squeeze, 1e-4);
+  for (int f = 1; f < 4; ++f)
+    EXPECT_NEAR(sinking.goals_at_8_8[f].y() - steady.goals_at_8_8[f].y(), -p.firm_squeeze, 1e-4) << f;
+  for (int f = 4; f < 8; ++f) EXPECT_LT((sinking.goals_at_8_8[f] - steady.goals_at_8_8[f]).norm(), 1e-9) << f;
+  EXPECT_LT(sinking.max_step_m, 0.0005);  // ramped in: no jump
 }
 
 TEST(ClosedLoopUser, RetriesStopAtTheDeadline) {

@@ -64,6 +64,11 @@ struct RubiksTaskParams {
   double duration = 12.0;        ///< the script's length (script time) [s]
   int turns = 2;                 ///< layer turns to make (≥ 1)
   double deadline = 20.0;        ///< run time by which the user must be done: retries must fit [s]
+  /// A user who feels the held cube sink in the holding (left) hand while the other turns a layer
+  /// grips harder: once the cube is `sink` lower than when the turn began, the holding hand's
+  /// goals go `firm_squeeze` deeper into the faces (over 0.2 s) for the rest of the run. 0 = never.
+  double firm_squeeze = 0.004;   ///< [m]
+  double sink = 0.002;           ///< [m]
   bool has_cube = true;          ///< a Rubik's cube (false: another object; no turns are counted)
   /// The user's fingertips held with their own fingers' stiffness (sim/finger_hold.hpp) once
   /// fit_to_hands is called: the caps then yield to the displayed forces only where the fingers
@@ -97,6 +102,7 @@ struct TaskProgress {
   std::int32_t retries_turn = 0;   ///< turns tried again after one that did not click
   std::int32_t retries_grasp = 0;  ///< grasps made again after the cube slipped
   bool gave_up = false;            ///< a retry was needed but no longer fitted before the deadline
+  double firm_since_s = -1;        ///< run time the holding hand began to grip harder (−1: it did not)
 };
 
 class RubiksTask final : public device::FingertipSource {
@@ -191,12 +197,17 @@ class RubiksTask final : public device::FingertipSource {
   static double closeness(double t_s, hand::Side side);
   /// True while a hand approaches for a grasp: then it follows the cube's pose.
   static bool looks_for_grasp(double t_s, hand::Side side);
+  /// `firm_m`: how much deeper the holding (left) hand presses, as far as it is closed [m].
   void goals_at(double t_s, const GraspFrames& frames, std::span<Vec3> p_W_goal,
-                bool squeeze = true) const;
+                bool squeeze = true, double firm_m = 0.0) const;
   /// goals_at at run time t through the schedule (cross-fading during a segment's blend from
   /// where the previous segment was left, in the grasp frames of then).
   void scheduled_goals(const Plan& plan, double t_s, const GraspFrames& frames,
                        std::span<Vec3> p_W_goal, bool squeeze) const;
+  /// The cross-fade of scheduled_goals: `goal` (at the segment's script time) blended from where
+  /// the previous segment was left, during the segment's blend.
+  void blend_goals(const Plan& plan, const ScriptSegment& seg, double t_s, const GraspFrames& frames,
+                   std::span<Vec3> p_W_goal, bool squeeze, double firm_m) const;
   /// nominal() at script time s with these grasp frames.
   hand::HandParams nominal_at(double s, hand::Side side, const GraspFrames& frames) const;
   /// Finger f's (0..7) goal in its hand's grasp frame before the hand's yaw and lift: the
@@ -240,6 +251,7 @@ class RubiksTask final : public device::FingertipSource {
   double prev_goal_t_ = -1;                 ///< run time of the previous goals() call (−1: none)
   std::array<Vec3, 8> prev_goal_{};         ///< the goals it gave
   double drop_since_ = -1;                  ///< run time the cube was first seen dropped (−1: not)
+  double turn_start_lift_ = -1;             ///< the held cube's lift when the current turn began [m] (−1: no turn)
   int turns_at_check_ = 0;                  ///< turns seen at the previous turn check
   /// Fitted fingertip paths (fit_to_hands): per hand, 4 fingertips every fit_dt_ seconds.
   std::array<std::vector<std::array<Vec3, 4>>, 2> fitted_;
