@@ -21,6 +21,8 @@
 ///   - while the cube is held up (s in 3.0 – 9.2): is it still in the hand? A cube that dropped
 ///     more than half the lift below where the holding hand carries it, for 0.15 s, is a slipped
 ///     grasp: both hands open and approach and grasp it again from s = 0.4, where it lies.
+///   - during each turn: has the held cube sunk in the holding hand (`sink` lower than when the
+///     turn began)? Then the holding hand grips harder for the rest of the run (`firm_squeeze`).
 /// Each jump in s is cross-faded over a fraction of a second, so the fingertips never jump.
 ///
 /// It gives the eight fingertip goals (left thumb, index, middle, ring, then right; the simulated
