@@ -102,6 +102,22 @@ nlohmann::ordered_json by_phase_json(const MrTrace& t, const std::vector<std::st
   return out;
 }
 
+/// The summary's line of by_phase_json: each part's IoU (p5) and contested pixels wrong; empty
+/// without parts.
+std::string by_phase_line(const nlohmann::ordered_json& by_phase) {
+  if (by_phase.empty()) return {};
+  std::ostringstream line;
+  line << "  by phase       IoU (p5), contested wrong:";
+  const char* sep = " ";
+  for (const auto& [name, v] : by_phase.items()) {
+    line << sep << name << " " << std::fixed << std::setprecision(3) << v["iou_mean"].get<double>() << " ("
+         << std::setprecision(2) << v["iou_p5"].get<double>() << "), " << std::setprecision(1)
+         << v["contested_error_pct"].get<double>() << " %";
+    sep = "; ";
+  }
+  return line.str() + "\n";
+}
+
 /// One row per processed frame: what the report's figures are computed from.
 void write_frames_csv(const std::string& path, const MrTrace& t, const std::vector<std::string>& phases) {
   std::ostringstream f;
@@ -432,19 +448,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << reg["iterations_mean"].get<double>() << " iterations\n"
      << "  model ceiling  IoU " << std::setprecision(3) << mean(ceiling)
      << " (the model's skin at the true pose with the user's sizes)\n"
-     << [&] {
-          if (by_phase.empty()) return std::string();
-          std::ostringstream line;
-          line << "  by phase       IoU (p5), contested wrong:";
-          const char* sep = " ";
-          for (const auto& [name, v] : by_phase.items()) {
-            line << sep << name << " " << std::fixed << std::setprecision(3) << v["iou_mean"].get<double>() << " ("
-                 << std::setprecision(2) << v["iou_p5"].get<double>() << "), " << std::setprecision(1)
-                 << v["contested_error_pct"].get<double>() << " %";
-            sep = "; ";
-          }
-          return line.str() + "\n";
-        }()
+     << by_phase_line(by_phase)
      << "  comparison     " << other["method"].get<std::string>() << ": IoU "
      << std::setprecision(3) << other["iou_mean"].get<double>() << ", fingertip "
      << std::setprecision(2) << other["fingertip_mm_mean"].get<double>() << " mm, joints "

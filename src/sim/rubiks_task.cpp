@@ -221,13 +221,16 @@ void RubiksTask::blend_goals(const Plan& plan, const ScriptSegment& seg, double 
   const bool newest = &seg == &plan.schedule.newest();
   goals_at(seg.s_from_s, newest ? plan.from_frames : fr, from, squeeze, firm_m);
   const double s_to = plan.schedule.script_time(t_run);
-  for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f) {
-    const int h = f >= 4 ? 1 : 0;
-    const auto side = h == 1 ? hand::Side::kRight : hand::Side::kLeft;
-    const Pose G = grasp_frame(fr.p_W[h], fr.q_WG[h]);
-    const double swing = state(s_to, side, 0).yaw - state(seg.s_from_s, side, 0).yaw;
-    goal[f] = blend_about_axis(from[f], goal[f], w, G.p, G.R.toRotationMatrix(), swing);
-  }
+  for (std::size_t f = 0; f < goal.size() && f < from.size(); ++f)
+    goal[f] = around_cube(f >= 4 ? hand::Side::kRight : hand::Side::kLeft, seg.s_from_s, s_to, fr, from[f], goal[f], w);
+}
+
+Vec3 RubiksTask::around_cube(hand::Side side, double s_from, double s_to, const GraspFrames& fr, const Vec3& from,
+                             const Vec3& to, double w) const {
+  const int h = side == hand::Side::kRight ? 1 : 0;
+  const Pose G = grasp_frame(fr.p_W[h], fr.q_WG[h]);
+  const double swing = state(s_to, side, 0).yaw - state(s_from, side, 0).yaw;
+  return blend_about_axis(from, to, w, G.p, G.R.toRotationMatrix(), swing);
 }
 
 Vec3 RubiksTask::contact_normal(int f) const {
@@ -358,10 +361,7 @@ hand::HandParams RubiksTask::nominal(double t_run, hand::Side side) const {
     const Vec3 p_W_wrist = q.p_W_wrist();
     q.q = (1.0 - w) * from.q + w * q.q;
     // The wrist around the cube with the fingertips (scheduled_goals), not across it.
-    const int h = side == hand::Side::kRight ? 1 : 0;
-    const Pose G = grasp_frame(fr.p_W[h], fr.q_WG[h]);
-    const double swing = state(plan.schedule.script_time(t_run), side, 0).yaw - state(seg.s_from_s, side, 0).yaw;
-    q.set_wrist(blend_about_axis(from.p_W_wrist(), p_W_wrist, w, G.p, G.R.toRotationMatrix(), swing),
+    q.set_wrist(around_cube(side, seg.s_from_s, plan.schedule.script_time(t_run), fr, from.p_W_wrist(), p_W_wrist, w),
                 q.r_W_hand());
   }
   return q;

@@ -210,6 +210,11 @@ class RubiksTask final : public device::FingertipSource {
   /// the previous segment was left, during the segment's blend.
   void blend_goals(const Plan& plan, const ScriptSegment& seg, double t_s, const GraspFrames& frames,
                    std::span<Vec3> p_W_goal, bool squeeze, double firm_m) const;
+  /// A point of `side`'s hand a share w of the way from `from` (script time s_from) to `to`
+  /// (s_to) [m, world], along an arc about the cube's vertical axis in that hand's grasp frame,
+  /// turning the way the script's yaw turns between the two.
+  Vec3 around_cube(hand::Side side, double s_from, double s_to, const GraspFrames& frames, const Vec3& from,
+                   const Vec3& to, double w) const;
   /// nominal() at script time s with these grasp frames.
   hand::HandParams nominal_at(double s, hand::Side side, const GraspFrames& frames) const;
   /// Finger f's (0..7) goal in its hand's grasp frame before the hand's yaw and lift: the
