@@ -55,6 +55,7 @@ hand::HandParams reaching_right() {
 const Frame& frame() {
   static const std::unique_ptr<Frame> f = [] {
     auto fr = std::make_unique<Frame>();
+    render::render_in_drawing_thread();  // as the app renders
     auto ctx = render::Context::create_headless();
     if (!ctx) return fr;
     const auto profiles = hand::load_hand_profiles(SPIDAR_SOURCE_DIR "/configs/hands.yaml");

@@ -22,6 +22,7 @@ using namespace spidar;
 
 render::Context* context() {
   static std::unique_ptr<render::Context> ctx = [] {
+    render::render_in_drawing_thread();  // as the app renders
     auto r = render::Context::create_headless();
     if (!r) {
       std::cerr << "bench_render: " << r.error().message << "\n";

@@ -93,6 +93,9 @@ int run_mr_demo(const DemoOptions& o) {
   // Its picture (and the model ceiling, measured on the same frames) every 10th frame: 30 to 36
   // frames of a run, a sample of every phase, at a third of the output thread's work.
   sp.compare_every = 10;
+  // The other compositor's picture (the paper's, for the report's comparison) on the output
+  // thread too (AsyncSinks::compose_others): the frame thread composes only what is shown.
+  sp.pipeline.other_composite = false;
   sp.seconds = seconds;
   sp.end_with_script = true;
 
@@ -140,6 +143,7 @@ int run_mr_demo(const DemoOptions& o) {
   // the progress line on the output thread, off the pipeline's critical path.
   session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 10);
   off_path.picture_comparisons(camera, models, *run->comparison_params());
+  off_path.compose_others(sp.pipeline.compositor);
   run->add_sink(window);
   run->add_sink(off_path);
 

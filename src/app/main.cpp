@@ -10,14 +10,13 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "spidar/core/config.hpp"
+#include "spidar/render/context.hpp"
 
 int main(int argc, char** argv) {
-  // Mesa's software rasteriser (llvmpipe, the headless GL here) renders in the thread that draws
-  // instead of a pool shared by every context of the process: the simulated camera, the frame
-  // thread and the output thread then each render at their own priority rather than queueing
-  // behind one another (on this 2-core VM: 18 fps instead of 15–16, latency median 75 instead
-  // of 90 ms). Set before any thread or GL context exists; an LP_NUM_THREADS of the user's wins.
-  setenv("LP_NUM_THREADS", "0", 0);
+  // Software GL renders in each drawing thread, at that thread's priority (on this 2-core VM: 18
+  // fps instead of 15–16, latency median 75 instead of 90 ms, session 9). Before any thread or
+  // GL context exists; an LP_NUM_THREADS of the user's wins.
+  spidar::render::render_in_drawing_thread();
   using namespace spidar::app;
   // Logs and warnings (e.g. "SCHED_FIFO not permitted") go to stderr: stdout carries only the
   // command's result (JSON for device-test, position, tension).

@@ -109,10 +109,7 @@ struct FramePipeline::Impl {
         main(p.compositor),
         start(given) {
     make_estimators();
-    render::CompositorParams o = p.compositor;
-    o.mode = p.compositor.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper
-                                                                : render::CompositeMode::kDepth;
-    other.set_params(o);
+    other.set_params(other_compositor_params(p.compositor));
   }
 
   void make_estimators() {
@@ -413,6 +410,25 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   return Ok{};
 }
 
+render::CompositorParams other_compositor_params(const render::CompositorParams& main) {
+  render::CompositorParams o = main;
+  o.mode = main.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper
+                                                      : render::CompositeMode::kDepth;
+  return o;
+}
+
+Status compose_result(render::Compositor& compositor, const FrameResult& result, const cv::Mat& bgr,
+                      cv::Mat* image, cv::Mat* alpha) {
+  if (result.key.alpha.size() != bgr.size())
+    return Error{"composite: the result has no matte of the image's size (FrameResult::key)"};
+  render::CompositeInputs in;
+  in.virt = &result.virt;
+  const bool depth = compositor.params().mode == render::CompositeMode::kDepth;
+  in.real_bgr = depth && !result.key.foreground.empty() ? result.key.foreground : bgr;
+  in.real_alpha = result.key.alpha;
+  return compositor.compose(in, image, alpha);
+}
+
 Status FramePipeline::picture(const cv::Mat& bgr, const SceneSnapshot& world, FrameResult* out) {
   if (out == nullptr) return Error{"frame pipeline: no output given"};
   Impl& s = *impl_;
@@ -461,17 +477,12 @@ Status FramePipeline::picture(const cv::Mat& bgr, const SceneSnapshot& world, Fr
 
   // Compositing.
   t0 = Clock::now();
-  auto compose = [&](render::Compositor& c, cv::Mat* img, cv::Mat* alpha) -> Status {
-    render::CompositeInputs in;
-    in.virt = &out->virt;
-    const bool depth = c.params().mode == render::CompositeMode::kDepth;
-    in.real_bgr = depth && !out->key.foreground.empty() ? out->key.foreground : bgr;
-    in.real_alpha = out->key.alpha;
-    return c.compose(in, img, alpha);
-  };
-  if (auto st = compose(s.main, &out->composite, &out->composite_alpha); !st) return st;
+  if (auto st = compose_result(s.main, *out, bgr, &out->composite, &out->composite_alpha); !st) return st;
   if (p.other_composite) {
-    if (auto st = compose(s.other, &out->other, &out->other_alpha); !st) return st;
+    if (auto st = compose_result(s.other, *out, bgr, &out->other, &out->other_alpha); !st) return st;
+  } else {
+    out->other.release();  // a result reused from a pool must not show an older frame's
+    out->other_alpha.release();
   }
   tm.composite_ms = ms_since(t0);
   return Ok{};

@@ -13,6 +13,8 @@
 #include "gl_api.hpp"
 
 namespace spidar::render {
+
+void render_in_drawing_thread() { setenv("LP_NUM_THREADS", "0", 0); }
 namespace {
 
 constexpr const char* kMesaHint =

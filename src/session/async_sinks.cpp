@@ -36,6 +36,40 @@ void AsyncSinks::picture_comparisons(const vision::Camera& camera,
   pictures_->params = params;
 }
 
+void AsyncSinks::compose_others(const render::CompositorParams& main) {
+  if (started_) throw std::logic_error("async sinks: compose_others after on_start");
+  if (auto st = render::validate(main); !st) throw SpidarError("other composites: " + st.error().message);
+  other_.emplace(pipeline::other_compositor_params(main));
+}
+
+void AsyncSinks::compose_other(Slot& slot) {
+  FrameEvent& e = slot.e;
+  if (!other_ || e.bgr == nullptr) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (e.result != nullptr && e.result->other.empty() && !e.result->virt.colour.empty()) {
+    pipeline::FrameResult* r = &slot.result;
+    if (e.result != r) {  // held: shared, not ours to change
+      slot.shown = *e.result;  // the images shared, not copied
+      r = &slot.shown;
+    }
+    if (auto st = pipeline::compose_result(*other_, *r, *e.bgr, &slot.other, &slot.other_alpha); !st)
+      throw SpidarError("other composite: " + st.error().message);
+    r->other = slot.other;
+    r->other_alpha = slot.other_alpha;
+    e.result = r;
+  }
+  if (e.compared != nullptr && !e.compared_picture_pending && e.compared->other.empty() &&
+      !e.compared->virt.colour.empty()) {
+    if (e.compared != &slot.compared) throw std::logic_error("async sinks: a comparison not copied");
+    if (auto st = pipeline::compose_result(*other_, slot.compared, *e.bgr, &slot.compared.other,
+                                           &slot.compared.other_alpha);
+        !st)
+      throw SpidarError("other composite (comparison): " + st.error().message);
+  }
+  // Comparison work, as the comparison's pictures are (the report's truth_ms).
+  e.compare_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 void AsyncSinks::start_pictures() {
   if (!pictures_) return;
   auto ctx = render::Context::create_headless();
@@ -182,6 +216,7 @@ void AsyncSinks::run() {
     bool failed = false;
     try {
       make_picture(slots_[k]);
+      compose_other(slots_[k]);
       for (FrameSink* sink : sinks_) sink->on_frame(slots_[k].e);
     } catch (...) {
       std::lock_guard lock(mutex_);
@@ -190,6 +225,8 @@ void AsyncSinks::run() {
     }
     slots_[k].e.result_hold.reset();  // back to their pools, unless a sink kept them
     slots_[k].e.filmed_hold.reset();
+    // Nor may a view of the held result's images outlive the hold: the pipeline refills them.
+    slots_[k].shown = pipeline::FrameResult{};
     {
       std::lock_guard lock(mutex_);
       free_.push_back(k);

@@ -214,9 +214,16 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
   auto fit = FramePipeline::create(*context_, camera_, models_, p).value();
   auto other_context = render::Context::create_headless().value();
   auto painter = FramePipeline::create(*other_context, camera_, models_, p).value();
+  // Without the other composite (the demo's frame thread), which is then made elsewhere.
+  FramePipelineParams lean_params = p;
+  lean_params.other_composite = false;
+  auto lean = FramePipeline::create(*context_, camera_, models_, lean_params).value();
+  render::Compositor other_compositor(other_compositor_params(p.compositor));
+  EXPECT_NE(other_compositor.params().mode, p.compositor.mode);
   sim::UserHands user(truth_models_, task);
   sim::SyntheticFrame frame;
-  FrameResult a, b;
+  FrameResult a, b, c;
+  c.other = cv::Mat(2, 2, CV_8UC3);  // an older frame's, as in a result reused from a pool
   int frames = 0;
   for (double t = 1.5; t < 2.2; t += 1.0 / 30, ++frames) {
     const auto sample = pose_user(user, task, t);
@@ -228,6 +235,14 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
     ASSERT_TRUE(fit->process(frame.bgr, sample, scene_, &b, true, &a.key).ok());
     ASSERT_TRUE(other_context->make_current().ok());
     ASSERT_TRUE(painter->picture(frame.bgr, scene_, &b).ok());
+    ASSERT_TRUE(context_->make_current().ok());
+    ASSERT_TRUE(lean->process(frame.bgr, sample, scene_, &c).ok());
+    EXPECT_TRUE(c.other.empty() && c.other_alpha.empty()) << t;
+    EXPECT_EQ(cv::norm(a.composite, c.composite, cv::NORM_INF), 0.0) << t;
+    cv::Mat other, other_alpha;
+    ASSERT_TRUE(compose_result(other_compositor, c, frame.bgr, &other, &other_alpha).ok());
+    EXPECT_EQ(cv::norm(a.other, other, cv::NORM_INF), 0.0) << t;
+    EXPECT_EQ(cv::norm(a.other_alpha, other_alpha, cv::NORM_INF), 0.0) << t;
     for (int h = 0; h < 2; ++h) ASSERT_LT((a.hands[h].q - b.hands[h].q).norm(), 1e-12) << t;
     EXPECT_EQ(cv::norm(a.virt.hand_depth, b.virt.hand_depth, cv::NORM_INF), 0.0) << t;
     EXPECT_EQ(cv::norm(a.composite, b.composite, cv::NORM_INF), 0.0) << t;
@@ -245,6 +260,10 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
   const auto st = painter->picture(frame.bgr, scene_, &empty);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().message.find("matte"), std::string::npos) << st.error().message;
+  cv::Mat other;
+  const auto composed = compose_result(other_compositor, empty, frame.bgr, &other, nullptr);
+  ASSERT_FALSE(composed.ok());
+  EXPECT_NE(composed.error().message.find("matte"), std::string::npos) << composed.error().message;
   ASSERT_TRUE(context_->make_current().ok());
 }
 

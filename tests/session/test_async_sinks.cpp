@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 
@@ -222,6 +223,89 @@ TEST(AsyncSinks, APictureLeftPendingWithNobodyToMakeItIsAnError) {
     EXPECT_NE(std::string(err.what()).find("picture_comparisons"), std::string::npos) << err.what();
   }
   EXPECT_TRUE(a.indices.empty());  // the sinks never saw a frame without its picture
+}
+
+// compose_others: the other compositor's picture (here the paper's: the real image exactly where
+// the virtual hand is in front of the scene) is made on the output thread for a held result and a
+// copied comparison, the held result itself left as the frame thread made it.
+TEST(AsyncSinks, TheOtherCompositeIsMadeOnTheOutputThreadWithoutTouchingTheHeldResult) {
+  class Others final : public FrameSink {
+   public:
+    void on_frame(const FrameEvent& e) override {
+      ASSERT_NE(e.result, nullptr);
+      ASSERT_NE(e.compared, nullptr);
+      results.push_back(e.result);
+      other_alpha.push_back(e.result->other_alpha.clone());
+      other.push_back(e.result->other.clone());
+      compared_alpha.push_back(e.compared->other_alpha.clone());
+      composite_pixel.push_back(e.result->composite.at<cv::Vec3b>(0, 0)[1]);
+    }
+    std::vector<const pipeline::FrameResult*> results;
+    std::vector<cv::Mat> other_alpha, other, compared_alpha;
+    std::vector<int> composite_pixel;
+  } sink;
+  const cv::Size size(5, 4);
+  // Frame k: a virtual hand at 0.4 m over columns x < k + 1, the scene at 0.5 m everywhere but
+  // row 0 (0.3 m, in front of the hand); the real image grey 200, the virtual one grey 50.
+  auto fill = [&](pipeline::FrameResult& r, int k) {
+    r.virt.colour.create(size, CV_8UC3);
+    r.virt.colour.setTo(cv::Scalar::all(50));
+    r.virt.depth.create(size, CV_32FC1);
+    r.virt.depth.setTo(0.5f);
+    r.virt.depth.row(0).setTo(0.3f);
+    r.virt.hand_depth.create(size, CV_32FC1);
+    r.virt.hand_depth.setTo(std::numeric_limits<float>::infinity());
+    r.virt.hand_depth.colRange(0, k + 1).setTo(0.4f);
+    r.virt.hand_id.create(size, CV_8UC1);
+    r.virt.hand_id.setTo(0);
+    r.virt.hand_box.reset();
+    r.key.alpha.create(size, CV_32FC1);
+    r.key.alpha.setTo(1.f);
+    r.composite.create(size, CV_8UC3);
+    r.composite.setTo(cv::Scalar::all(2 * k));
+  };
+  core::RecyclingPool<pipeline::FrameResult> pool;
+  Buffers buf;
+  cv::Mat image(size, CV_8UC3, cv::Scalar::all(200));
+  const int n = 4;
+  std::vector<const pipeline::FrameResult*> handed;
+  {
+    AsyncSinks sinks({&sink}, 2);
+    render::CompositorParams main;
+    main.mode = render::CompositeMode::kDepth;
+    sinks.compose_others(main);
+    sinks.on_start();
+    for (int k = 0; k < n; ++k) {
+      auto result = pool.take();
+      fill(*result, k);
+      fill(buf.compared, k);
+      FrameEvent e = buf.event(k, true);
+      e.bgr = &image;
+      e.result = result.get();
+      e.result_hold = result;
+      handed.push_back(result.get());
+      sinks.on_frame(e);
+    }
+    sinks.on_end(SessionSummary{});
+    EXPECT_THROW(sinks.compose_others(main), std::logic_error);  // after on_start
+  }
+  ASSERT_EQ(sink.other_alpha.size(), static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    EXPECT_NE(sink.results[i], handed[i]);  // a view with the other composite, not the held one
+    EXPECT_EQ(sink.composite_pixel[i], 2 * k);
+    ASSERT_EQ(sink.other_alpha[i].size(), size);
+    ASSERT_EQ(sink.compared_alpha[i].size(), size);
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        const bool real = y > 0 && x < k + 1;  // the hand in front of the scene
+        EXPECT_EQ(sink.other_alpha[i].at<float>(y, x), real ? 1.f : 0.f) << k << " " << x << "," << y;
+        EXPECT_EQ(sink.compared_alpha[i].at<float>(y, x), real ? 1.f : 0.f) << k << " " << x << "," << y;
+        EXPECT_EQ(sink.other[i].at<cv::Vec3b>(y, x)[0], real ? 200 : 50) << k << " " << x << "," << y;
+      }
+  }
+  for (const auto* r : handed) EXPECT_TRUE(r->other.empty());  // the held results untouched
+  EXPECT_EQ(pool.free(), pool.created());
 }
 
 TEST(AsyncSinks, AnOnStartThatThrowsIsReThrownByOnStart) {

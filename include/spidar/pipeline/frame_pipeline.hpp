@@ -35,7 +35,10 @@ struct FramePipelineParams {
   vision::BraceletParams bracelet;
   registration::RegistrationParams registration;
   render::CompositorParams compositor;  ///< its mode makes `composite`
-  bool other_composite = true;          ///< also compose in the other mode (for comparison)
+  /// Also compose in the other mode (FrameResult::other), for comparison only: nobody sees it
+  /// live. The demo leaves it to its output thread (session::AsyncSinks::compose_others), off
+  /// the frame's path.
+  bool other_composite = true;
   int silhouette_margin_px = 40;        ///< distance-transform margin (inward silhouette only)
   /// The distance transform at full (1) or half (2) resolution (vision/silhouette.hpp): half costs
   /// about a quarter and moves a pulled point's target by at most ~2 px.
@@ -109,6 +112,17 @@ struct FrameResult {
 /// the size and type, so a reused `to` allocates nothing), every other field assigned. A plain
 /// assignment of FrameResult would share the images, which the pipeline overwrites next frame.
 void copy_frame_result(const FrameResult& from, FrameResult* to);
+
+/// The compositor parameters of the mode other than `main`'s (FrameResult::other), the rest as
+/// `main`'s.
+render::CompositorParams other_compositor_params(const render::CompositorParams& main);
+
+/// Composes `result`'s rendering (result.virt) over the camera image `bgr` with its matte
+/// (result.key) in `compositor`'s mode into `image` and `alpha` (the share of the real image):
+/// FramePipeline's own composites, and the other mode's made elsewhere (e.g. on an output thread).
+/// Error on a result without its rendering or matte, or an image of another size.
+Status compose_result(render::Compositor& compositor, const FrameResult& result, const cv::Mat& bgr,
+                      cv::Mat* image, cv::Mat* alpha);
 
 class FramePipeline {
  public:

@@ -14,6 +14,13 @@ namespace spidar::render {
 
 enum class ContextKind { kHeadless, kWindow };
 
+/// Asks Mesa's software rasteriser (llvmpipe, the headless GL here) to render in the thread that
+/// draws instead of a pool shared by every context of the process (LP_NUM_THREADS=0), unless the
+/// environment already sets LP_NUM_THREADS. Threads that each render (the simulated camera, the
+/// frame thread, the output thread) then do so at their own priority rather than queueing behind
+/// one another. Takes effect only if called before the process's first GL context.
+void render_in_drawing_thread();
+
 struct WindowParams {
   int width = 640;   ///< client area [px]
   int height = 480;  ///< [px]

@@ -41,6 +41,12 @@ class AsyncSinks final : public FrameSink {
   /// headless GL context of its own (created in on_start there). Call before on_start.
   void picture_comparisons(const vision::Camera& camera, const std::array<hand::HandModel, 2>& models,
                            const pipeline::FramePipelineParams& params);
+  /// Composes the other mode's composite (FrameResult::other, other_alpha: the comparison of the
+  /// two compositors) of every frame's result and comparison that lacks it, on the output thread
+  /// before the sinks see the frame: for a session whose pipelines leave it out
+  /// (FramePipelineParams::other_composite off), so that the frame thread makes only the
+  /// composite shown. `main`: the main pipeline's compositor. Call before on_start.
+  void compose_others(const render::CompositorParams& main);
   /// Starts the output thread and waits for the sinks' on_start there (re-throws its exception).
   void on_start() override;
   /// Copies the event into a free slot (waiting for one if none is) and queues it. A result or a
@@ -62,6 +68,10 @@ class AsyncSinks final : public FrameSink {
     SceneSnapshot scene;
     pipeline::FrameResult result, compared;
     sim::FilmedFrame filmed;
+    /// A held result with the other composite added (compose_others): its images shared with
+    /// the held one, the other composite's in `other` and `other_alpha` (reused frame to frame).
+    pipeline::FrameResult shown;
+    cv::Mat other, other_alpha;
   };
   void run();
   void copy_into(const FrameEvent& from, Slot& to) const;
@@ -77,9 +87,11 @@ class AsyncSinks final : public FrameSink {
   };
   void start_pictures();
   void make_picture(Slot& slot);
+  void compose_other(Slot& slot);
 
   std::vector<FrameSink*> sinks_;
   std::unique_ptr<Pictures> pictures_;
+  std::optional<render::Compositor> other_;  ///< compose_others: in the main one's other mode
   std::vector<Slot> slots_;
   std::thread thread_;
   mutable std::mutex mutex_;
