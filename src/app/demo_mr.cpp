@@ -89,7 +89,7 @@ int run_mr_demo(const DemoOptions& o) {
   // estimates, so a replay could not reproduce fits made with them).
   sp.pipeline.personalise_shape = !o.fixed_hand_size;
   sp.compare = true;  // the same registration with the silhouette term switched the other way
-  sp.defer_compare_picture = true;  // its picture on the output thread (AsyncSinks)
+  sp.defer_compare = true;  // fitted and pictured on the output thread (AsyncSinks::compare)
   // Its picture (and the model ceiling, measured on the same frames) every 10th frame: 30 to 36
   // frames of a run, a sample of every phase, at a third of the output thread's work.
   sp.compare_every = 10;
@@ -142,7 +142,7 @@ int run_mr_demo(const DemoOptions& o) {
   // The window on the frame thread (its GL context lives there); scoring, video, keyframes and
   // the progress line on the output thread, off the pipeline's critical path.
   session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 10);
-  off_path.picture_comparisons(camera, models, *run->comparison_params());
+  off_path.compare(camera, models, sp.pipeline);
   off_path.compose_others(sp.pipeline.compositor);
   run->add_sink(window);
   run->add_sink(off_path);

@@ -410,6 +410,13 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   return Ok{};
 }
 
+FramePipelineParams comparison_params(const FramePipelineParams& main) {
+  FramePipelineParams alt = main;
+  alt.registration.silhouette_term = !alt.registration.silhouette_term;
+  alt.personalise_shape = false;
+  return alt;
+}
+
 render::CompositorParams other_compositor_params(const render::CompositorParams& main) {
   render::CompositorParams o = main;
   o.mode = main.mode == render::CompositeMode::kDepth ? render::CompositeMode::kPaper

@@ -26,14 +26,13 @@ AsyncSinks::~AsyncSinks() {
   if (thread_.joinable()) thread_.join();
 }
 
-void AsyncSinks::picture_comparisons(const vision::Camera& camera,
-                                     const std::array<hand::HandModel, 2>& models,
-                                     const pipeline::FramePipelineParams& params) {
-  if (started_) throw std::logic_error("async sinks: picture_comparisons after on_start");
-  pictures_ = std::make_unique<Pictures>();
-  pictures_->camera = camera;
-  pictures_->models = models;
-  pictures_->params = params;
+void AsyncSinks::compare(const vision::Camera& camera, const std::array<hand::HandModel, 2>& models,
+                         const pipeline::FramePipelineParams& main) {
+  if (started_) throw std::logic_error("async sinks: compare after on_start");
+  comparison_ = std::make_unique<Comparison>();
+  comparison_->camera = camera;
+  comparison_->models = models;
+  comparison_->params = pipeline::comparison_params(main);
 }
 
 void AsyncSinks::compose_others(const render::CompositorParams& main) {
@@ -58,41 +57,52 @@ void AsyncSinks::compose_other(Slot& slot) {
     r->other_alpha = slot.other_alpha;
     e.result = r;
   }
-  if (e.compared != nullptr && !e.compared_picture_pending && e.compared->other.empty() &&
-      !e.compared->virt.colour.empty()) {
-    if (e.compared != &slot.compared) throw std::logic_error("async sinks: a comparison not copied");
-    if (auto st = pipeline::compose_result(*other_, slot.compared, *e.bgr, &slot.compared.other,
-                                           &slot.compared.other_alpha);
-        !st)
+  if (e.compared != nullptr && e.compared->other.empty() && !e.compared->virt.colour.empty()) {
+    // Ours: the copy of the frame thread's comparison, or the one made here (compare).
+    pipeline::FrameResult* c = e.compared == &slot.compared ? &slot.compared
+                               : comparison_ && e.compared == &comparison_->result ? &comparison_->result
+                                                                                   : nullptr;
+    if (c == nullptr) throw std::logic_error("async sinks: a comparison neither copied nor made here");
+    if (auto st = pipeline::compose_result(*other_, *c, *e.bgr, &c->other, &c->other_alpha); !st)
       throw SpidarError("other composite (comparison): " + st.error().message);
   }
   // Comparison work, as the comparison's pictures are (the report's truth_ms).
   e.compare_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void AsyncSinks::start_pictures() {
-  if (!pictures_) return;
+void AsyncSinks::start_comparison() {
+  if (!comparison_) return;
   auto ctx = render::Context::create_headless();
-  if (!ctx) throw SpidarError("comparison pictures: OpenGL: " + ctx.error().message);
-  pictures_->context = std::move(ctx).value();
-  auto pipe = pipeline::FramePipeline::create(*pictures_->context, pictures_->camera, pictures_->models,
-                                              pictures_->params);
-  if (!pipe) throw SpidarError("comparison pictures: " + pipe.error().message);
-  pictures_->pipeline = std::move(pipe).value();
+  if (!ctx) throw SpidarError("comparison: OpenGL: " + ctx.error().message);
+  comparison_->context = std::move(ctx).value();
+  auto pipe = pipeline::FramePipeline::create(*comparison_->context, comparison_->camera, comparison_->models,
+                                              comparison_->params);
+  if (!pipe) throw SpidarError("comparison: " + pipe.error().message);
+  comparison_->pipeline = std::move(pipe).value();
 }
 
-void AsyncSinks::make_picture(Slot& slot) {
+void AsyncSinks::make_comparison(Slot& slot) {
   FrameEvent& e = slot.e;
-  if (!e.compared_picture_pending || e.compared == nullptr) return;
-  if (!pictures_ || !pictures_->pipeline)
-    throw SpidarError("comparison pictures: a frame's picture was left pending but nobody makes it "
-                      "(AsyncSinks::picture_comparisons)");
+  if (e.compare_pending == PendingComparison::kNone) return;
+  if (!comparison_ || !comparison_->pipeline)
+    throw SpidarError("comparison: a frame's comparison was left pending but nobody makes it "
+                      "(AsyncSinks::compare)");
+  if (e.bgr == nullptr || e.measured == nullptr || e.scene == nullptr || e.result == nullptr)
+    throw SpidarError("comparison: a frame left pending without its image, fingertips, scene or result");
   const auto t0 = std::chrono::steady_clock::now();
-  if (auto st = pictures_->context->make_current(); !st) throw SpidarError("comparison pictures: " + st.error().message);
-  if (e.bgr == nullptr) throw SpidarError("comparison pictures: a frame left pending without its camera image");
-  if (auto st = pictures_->pipeline->picture(*e.bgr, slot.scene, &slot.compared); !st)
-    throw SpidarError("comparison pictures: " + st.error().message);
-  e.compared_picture_pending = false;
+  if (auto st = comparison_->context->make_current(); !st) throw SpidarError("comparison: " + st.error().message);
+  pipeline::FramePipeline& p = *comparison_->pipeline;
+  const pipeline::FrameResult& main = *e.result;
+  p.use_model_sizes(main.models);  // the sizes the main fit used on this frame
+  // The same image keyed with the same params (comparison_params keeps them): the main matte.
+  const bool same_key = main.key.alpha.size() == e.bgr->size();
+  const bool picture = e.compare_pending == PendingComparison::kFitAndPicture;
+  if (auto st = p.process(*e.bgr, *e.measured, *e.scene, &comparison_->result, !picture,
+                          same_key ? &main.key : nullptr);
+      !st)
+    throw SpidarError("comparison: " + st.error().message);
+  if (picture) e.compared = &comparison_->result;
+  e.compare_pending = PendingComparison::kNone;
   e.compare_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -104,12 +114,12 @@ void AsyncSinks::on_start() {
   thread_ = std::thread([this, &ready] {
     if (nice_ != 0) (void)core::set_nice(nice_);  // best effort: a normal share otherwise
     try {
-      start_pictures();
+      start_comparison();
       for (FrameSink* k : sinks_) k->on_start();
     } catch (...) {
-      if (pictures_) {  // its GL objects go on this thread, with their context
-        pictures_->pipeline.reset();
-        pictures_->context.reset();
+      if (comparison_) {  // its GL objects go on this thread, with their context
+        comparison_->pipeline.reset();
+        comparison_->context.reset();
       }
       ready.set_exception(std::current_exception());
       return;
@@ -193,16 +203,16 @@ void AsyncSinks::on_frame(const FrameEvent& e) {
 }
 
 void AsyncSinks::run() {
-  // However the thread ends, the pictures' GL objects go with their context on this thread.
-  struct ReleasePictures {
-    Pictures* p;
-    ~ReleasePictures() {
+  // However the thread ends, the comparison's GL objects go with their context on this thread.
+  struct ReleaseComparison {
+    Comparison* p;
+    ~ReleaseComparison() {
       if (p == nullptr) return;
       if (p->context) (void)p->context->make_current();
       p->pipeline.reset();
       p->context.reset();
     }
-  } release{pictures_.get()};
+  } release{comparison_.get()};
   for (;;) {
     std::size_t k = 0;
     {
@@ -215,7 +225,7 @@ void AsyncSinks::run() {
     }
     bool failed = false;
     try {
-      make_picture(slots_[k]);
+      make_comparison(slots_[k]);
       compose_other(slots_[k]);
       for (FrameSink* sink : sinks_) sink->on_frame(slots_[k].e);
     } catch (...) {

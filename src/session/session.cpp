@@ -36,11 +36,9 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
   auto pipe_r = pipeline::FramePipeline::create(context, camera, models, params.pipeline);
   if (!pipe_r) throw SpidarError(pipe_r.error().message);
   s->pipe_ = std::move(pipe_r).value();
-  if (params.compare) {
-    pipeline::FramePipelineParams alt = params.pipeline;
-    alt.registration.silhouette_term = !alt.registration.silhouette_term;
-    alt.personalise_shape = false;  // it fits with the main fit's sizes (use_model_sizes)
-    auto alt_r = pipeline::FramePipeline::create(context, camera, models, alt);
+  s->alt_params_ = pipeline::comparison_params(params.pipeline);
+  if (params.compare && !params.defer_compare) {
+    auto alt_r = pipeline::FramePipeline::create(context, camera, models, s->alt_params_);
     if (!alt_r) throw SpidarError(alt_r.error().message);
     s->alt_ = std::move(alt_r).value();
   }
@@ -172,19 +170,21 @@ Session::Step Session::step() {
     e.t_done_ns = core::monotonic_ns();
     // The comparison registration runs every frame (it must track), its rendering every
     // compare_every-th frame (a sample of the run; it costs as much as the main pipeline).
-    if (alt_) {
+    if (params_.compare) {
       const bool render = frames_ % static_cast<std::uint64_t>(std::max(1, params_.compare_every)) == 0;
-      const bool here = render && !params_.defer_compare_picture;
-      // The same image keyed with the same params: the main pipeline's matte.
-      const bool same_key = alt_->params().chroma_key == pipe_->params().chroma_key;
-      if (pipe_->params().personalise_shape) alt_->use_model_sizes(pipe_->models());
-      if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !here,
-                                  same_key ? &result_->key : nullptr);
-          !st)
-        throw SpidarError(st.error().message);
-      if (render) e.compared = &alt_result_;
-      e.compared_picture_pending = render && !here;
-      e.compare_ms = core::ns_to_s(core::monotonic_ns() - e.t_done_ns) * 1e3;
+      if (!alt_) {
+        e.compare_pending = render ? PendingComparison::kFitAndPicture : PendingComparison::kFit;
+      } else {
+        // The same image keyed with the same params: the main pipeline's matte.
+        const bool same_key = alt_->params().chroma_key == pipe_->params().chroma_key;
+        if (pipe_->params().personalise_shape) alt_->use_model_sizes(result_->models);
+        if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !render,
+                                    same_key ? &result_->key : nullptr);
+            !st)
+          throw SpidarError(st.error().message);
+        if (render) e.compared = &alt_result_;
+        e.compare_ms = core::ns_to_s(core::monotonic_ns() - e.t_done_ns) * 1e3;
+      }
     }
     if (scene_.monitor) e.cube = scene_.monitor->status().read();
     e.index = frames_;

@@ -208,21 +208,21 @@ TEST(AsyncSinks, ASinkThatThrowsStopsTheFramesAndTheErrorComesBackToTheFrameThre
   EXPECT_TRUE(a.ended_by.empty());      // no on_end after a failure
 }
 
-TEST(AsyncSinks, APictureLeftPendingWithNobodyToMakeItIsAnError) {
+TEST(AsyncSinks, AComparisonLeftPendingWithNobodyToMakeItIsAnError) {
   Recorder a;
   Buffers buf;
   AsyncSinks sinks({&a}, 1);
   sinks.on_start();
-  FrameEvent e = buf.event(0, true);
-  e.compared_picture_pending = true;  // the session deferred it, but no picture_comparisons
+  FrameEvent e = buf.event(0, false);
+  e.compare_pending = PendingComparison::kFit;  // the session deferred it, but no compare()
   sinks.on_frame(e);
   try {
     sinks.on_end(SessionSummary{});
     ADD_FAILURE() << "no error";
   } catch (const SpidarError& err) {
-    EXPECT_NE(std::string(err.what()).find("picture_comparisons"), std::string::npos) << err.what();
+    EXPECT_NE(std::string(err.what()).find("AsyncSinks::compare"), std::string::npos) << err.what();
   }
-  EXPECT_TRUE(a.indices.empty());  // the sinks never saw a frame without its picture
+  EXPECT_TRUE(a.indices.empty());  // the sinks never saw a frame without its comparison
 }
 
 // compose_others: the other compositor's picture (here the paper's: the real image exactly where

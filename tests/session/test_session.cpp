@@ -6,10 +6,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <functional>
+#include <thread>
 #include <stdexcept>
 #include <vector>
 
 #include "spidar/render/context.hpp"
+#include "spidar/session/async_sinks.hpp"
 #include "spidar/session/frame_stats.hpp"
 #include "spidar/session/rig.hpp"
 #include "spidar/session/rig_inputs.hpp"
@@ -22,7 +25,8 @@ namespace {
 
 /// Everything a session on the simulated rig needs, at 320×240 and 30 fps.
 struct SimulatedSetup {
-  explicit SimulatedSetup(double seconds, bool warm_up = true) {
+  explicit SimulatedSetup(double seconds, bool warm_up = true,
+                          const std::function<void(SessionParams&)>& tweak = {}) {
     auto ctx = render::Context::create_headless();
     if (!ctx) throw SpidarError("OpenGL: " + ctx.error().message);
     context = std::move(ctx).value();
@@ -42,6 +46,8 @@ struct SimulatedSetup {
                                   render::CompositeMode::kDepth, scene->initial_r_W_hand());
     sp.seconds = seconds;
     sp.warm_up = warm_up;
+    if (tweak) tweak(sp);
+    params = sp;
     session = Session::create(*rig, *scene, *context, camera, models, sp);
   }
   std::unique_ptr<render::Context> context;
@@ -50,6 +56,7 @@ struct SimulatedSetup {
   vision::Camera camera;
   std::unique_ptr<Scene> scene;
   std::unique_ptr<SimulatedRig> rig;
+  SessionParams params;
   std::unique_ptr<Session> session;
 };
 
@@ -152,6 +159,81 @@ TEST(Session, ASinkThatThrowsStopsTheSessionCleanly) {
   EXPECT_EQ(before.indices.size(), 4u);
   EXPECT_EQ(after.indices.size(), 3u) << "sinks after the failing one do not see its frame";
   EXPECT_EQ(before.calls.find('e'), std::string::npos) << "on_end only for a run that ended";
+}
+
+// The comparison left to the output thread (SessionParams::defer_compare, AsyncSinks::compare):
+// fitted on every frame, pictured (both composites) on every compare_every-th, and the same fit a
+// comparison pipeline on the frame's own inputs makes here afterwards (the one the frame thread
+// used to make), to the last bit.
+TEST(Session, ADeferredComparisonIsFittedOnTheOutputThreadAsTheFrameThreadWould) {
+  constexpr int kEvery = 3;
+  SimulatedSetup s(1.0, true, [](SessionParams& sp) {
+    sp.compare = true;
+    sp.defer_compare = true;
+    sp.compare_every = kEvery;
+    sp.pipeline.other_composite = false;
+  });
+  ASSERT_NE(s.session->comparison_params(), nullptr);
+  EXPECT_NE(s.session->comparison_params()->registration.silhouette_term,
+            s.params.pipeline.registration.silhouette_term);
+  struct Seen {
+    std::uint64_t index = 0;
+    cv::Mat bgr;
+    device::FingertipSample measured;
+    SceneSnapshot scene;
+    vision::ChromaKeyResult key;
+    std::array<hand::HandModel, 2> models;
+    bool compared = false, compared_other = false, main_other = false;
+    std::array<hand::HandParams, 2> compared_hands{};
+    std::thread::id thread;
+  };
+  std::vector<Seen> seen;
+  FunctionSink keep([&](const FrameEvent& e) {
+    Seen k;
+    k.index = e.index;
+    e.bgr->copyTo(k.bgr);
+    k.measured = *e.measured;
+    k.scene = *e.scene;
+    e.result->key.alpha.copyTo(k.key.alpha);
+    e.result->key.silhouette.copyTo(k.key.silhouette);
+    e.result->key.foreground.copyTo(k.key.foreground);
+    k.models = e.result->models;
+    k.main_other = !e.result->other_alpha.empty();
+    k.compared = e.compared != nullptr;
+    if (e.compared != nullptr) {
+      k.compared_hands = e.compared->hands;
+      k.compared_other = !e.compared->other_alpha.empty() && !e.compared->composite.empty();
+    }
+    k.thread = std::this_thread::get_id();
+    seen.push_back(std::move(k));
+  });
+  AsyncSinks off_path({&keep}, 3, 0);
+  off_path.compare(s.camera, s.models, s.params.pipeline);
+  off_path.compose_others(s.params.pipeline.compositor);
+  s.session->add_sink(off_path);
+  const SessionSummary end = s.session->run();
+  ASSERT_GE(end.frames, 4u);
+  ASSERT_EQ(seen.size(), end.frames);
+
+  auto replay = pipeline::FramePipeline::create(*s.context, s.camera, s.models,
+                                                pipeline::comparison_params(s.params.pipeline))
+                    .value();
+  pipeline::FrameResult r;
+  int compared = 0;
+  for (const Seen& k : seen) {
+    EXPECT_NE(k.thread, std::this_thread::get_id());
+    EXPECT_TRUE(k.main_other) << "frame " << k.index << ": the other composite, made off the frame thread";
+    const bool picture = k.index % kEvery == 0;
+    EXPECT_EQ(k.compared, picture) << "frame " << k.index;
+    replay->use_model_sizes(k.models);
+    ASSERT_TRUE(replay->process(k.bgr, k.measured, k.scene, &r, !picture, &k.key).ok());
+    if (!picture) continue;
+    ++compared;
+    EXPECT_TRUE(k.compared_other) << "frame " << k.index;
+    for (int h = 0; h < 2; ++h)
+      EXPECT_EQ((k.compared_hands[h].q - r.hands[h].q).norm(), 0.0) << "frame " << k.index << " hand " << h;
+  }
+  EXPECT_GE(compared, 2);
 }
 
 TEST(FrameStatsSink, HistoryNeverExceedsItsCapacityAndMeansCoverTheWholeRun) {

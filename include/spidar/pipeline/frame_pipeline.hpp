@@ -113,6 +113,11 @@ struct FrameResult {
 /// assignment of FrameResult would share the images, which the pipeline overwrites next frame.
 void copy_frame_result(const FrameResult& from, FrameResult* to);
 
+/// The comparison's pipeline params (the demo's `registration.comparison`): `main`'s with the
+/// silhouette term switched the other way, and no size estimate of its own (it fits with the
+/// main fit's sizes: FramePipeline::use_model_sizes).
+FramePipelineParams comparison_params(const FramePipelineParams& main);
+
 /// The compositor parameters of the mode other than `main`'s (FrameResult::other), the rest as
 /// `main`'s.
 render::CompositorParams other_compositor_params(const render::CompositorParams& main);

@@ -36,11 +36,15 @@ class AsyncSinks final : public FrameSink {
   AsyncSinks(const AsyncSinks&) = delete;
   AsyncSinks& operator=(const AsyncSinks&) = delete;
 
-  /// Makes the pictures the session left pending (FrameEvent::compared_picture_pending) on the
-  /// output thread, before the sinks see the frame, with a FramePipeline of `params` and a
-  /// headless GL context of its own (created in on_start there). Call before on_start.
-  void picture_comparisons(const vision::Camera& camera, const std::array<hand::HandModel, 2>& models,
-                           const pipeline::FramePipelineParams& params);
+  /// Makes the comparisons the session left pending (FrameEvent::compare_pending,
+  /// SessionParams::defer_compare) on the output thread, before the sinks see the frame: every
+  /// frame's fit (the comparison tracks) with the sizes the main fit used, and the picture where
+  /// asked (then FrameEvent::compared points at it), with a FramePipeline of the comparison's
+  /// params (pipeline::comparison_params of `main`, the main pipeline's) and a headless GL
+  /// context of its own (created in on_start there); it reuses the main result's matte. Call
+  /// before on_start.
+  void compare(const vision::Camera& camera, const std::array<hand::HandModel, 2>& models,
+               const pipeline::FramePipelineParams& main);
   /// Composes the other mode's composite (FrameResult::other, other_alpha: the comparison of the
   /// two compositors) of every frame's result and comparison that lacks it, on the output thread
   /// before the sinks see the frame: for a session whose pipelines leave it out
@@ -77,20 +81,21 @@ class AsyncSinks final : public FrameSink {
   void copy_into(const FrameEvent& from, Slot& to) const;
   void rethrow_if_failed();
 
-  /// The comparison's pictures (picture_comparisons), made on the output thread.
-  struct Pictures {
+  /// The comparison (compare), made on the output thread.
+  struct Comparison {
     vision::Camera camera;
     std::array<hand::HandModel, 2> models;
     pipeline::FramePipelineParams params;
     std::unique_ptr<render::Context> context;
     std::unique_ptr<pipeline::FramePipeline> pipeline;
+    pipeline::FrameResult result;  ///< the newest frame's (the sinks read it during on_frame)
   };
-  void start_pictures();
-  void make_picture(Slot& slot);
+  void start_comparison();
+  void make_comparison(Slot& slot);
   void compose_other(Slot& slot);
 
   std::vector<FrameSink*> sinks_;
-  std::unique_ptr<Pictures> pictures_;
+  std::unique_ptr<Comparison> comparison_;
   std::optional<render::Compositor> other_;  ///< compose_others: in the main one's other mode
   std::vector<Slot> slots_;
   std::thread thread_;

@@ -23,6 +23,13 @@
 
 namespace spidar::session {
 
+/// A comparison the session left to be made elsewhere (SessionParams::defer_compare).
+enum class PendingComparison {
+  kNone,
+  kFit,            ///< fit this frame (the comparison tracks every frame)
+  kFitAndPicture,  ///< fit it and render its picture (a compared frame)
+};
+
 /// One processed frame. Everything it refers to is valid during on_frame only (clone to keep).
 struct FrameEvent {
   std::uint64_t index = 0;          ///< processed frames before this one
@@ -42,9 +49,9 @@ struct FrameEvent {
   /// The comparison pipeline (silhouette term switched the other way), rendered this frame;
   /// null when the session has no comparison or skipped its rendering in this frame.
   const pipeline::FrameResult* compared = nullptr;
-  /// `compared` holds the comparison's fit but not yet its picture (SessionParams::
-  /// defer_compare_picture): AsyncSinks::picture_comparisons makes it before its sinks see it.
-  bool compared_picture_pending = false;
+  /// The comparison left to another thread (SessionParams::defer_compare): AsyncSinks::compare
+  /// fits it (and pictures it, then setting `compared`) before its sinks see the frame.
+  PendingComparison compare_pending = PendingComparison::kNone;
   /// What the synthetic camera filmed (ground truth); null for real cameras.
   const sim::FilmedFrame* filmed = nullptr;
   /// The same filmed frame, shared (the synthetic camera films into others while it is held): a

@@ -33,10 +33,10 @@ struct SessionParams {
   /// (it must track) and rendered every `compare_every`-th frame (FrameEvent::compared).
   bool compare = false;
   int compare_every = 5;
-  /// The comparison's picture (render and composites) is left to a sink on another thread
-  /// (AsyncSinks::picture_comparisons): the frame thread fits it only, and FrameEvent::compared
-  /// carries the fit with compared_picture_pending set.
-  bool defer_compare_picture = false;
+  /// The comparison (its fit every frame, its picture every compare_every-th) is left to a sink
+  /// on another thread (AsyncSinks::compare): the frame thread only marks each event
+  /// (FrameEvent::compare_pending) and spends nothing on a figure nobody sees live.
+  bool defer_compare = false;
   /// One blank frame through each pipeline before the clock starts (GL programs, skins and
   /// workspaces cost ~130 ms on the first frame; in the run they would drop the camera's first
   /// frames); the fits are reset after it, so the first real frame is a cold start.
@@ -114,8 +114,11 @@ class Session {
   const device::ServoLoop& servo() const;
   sim::PhysicsThreadStats physics_stats() const;
   pipeline::FramePipeline& pipeline() { return *pipe_; }
-  /// The comparison pipeline's params (the silhouette term switched); null without a comparison.
-  const pipeline::FramePipelineParams* comparison_params() const { return alt_ ? &alt_->params() : nullptr; }
+  /// The comparison pipeline's params (pipeline::comparison_params of the main one's); null
+  /// without a comparison.
+  const pipeline::FramePipelineParams* comparison_params() const {
+    return params_.compare ? &alt_params_ : nullptr;
+  }
   const SessionParams& params() const { return params_; }
 
  private:
@@ -133,7 +136,8 @@ class Session {
   SessionParams params_;
   vision::Camera camera_;
   std::unique_ptr<HapticSide> haptic_;
-  std::unique_ptr<pipeline::FramePipeline> pipe_, alt_;
+  std::unique_ptr<pipeline::FramePipeline> pipe_, alt_;  // alt_: a comparison made here
+  pipeline::FramePipelineParams alt_params_;
   std::vector<FrameSink*> sinks_;
 
   bool started_ = false, threads_stopped_ = false;
