@@ -24,6 +24,15 @@ constexpr double kRegraspBlend = 0.8;  ///< [s] cross-fade from a lost grasp to 
 constexpr double kDropHold = 0.3;      ///< [s] a drop must last this long to count as a slip
 constexpr double kDroppedLift = 0.15;  ///< a cube below this share of the script's lift is down (3 mm of 20)
 
+/// [s] from a slip to the script's end, at most (the cross-fades counted in full), when the grasp
+/// is made again from kRegraspFrom with `remaining` planned turns still to make: the regrasp
+/// replays the first turn's stretch, and when that makes the last turn the first check skips to
+/// the set-down (check_turns), else the script plays on from there.
+double regrasp_time_s(double duration, int remaining) {
+  if (remaining <= 1) return kRegraspBlend + (kFirstCheck - kRegraspFrom) + kTurnBlend + (duration - kLaterCheck);
+  return kRegraspBlend + (duration - kRegraspFrom);
+}
+
 }  // namespace
 
 bool RubiksTask::within_reach(const CubePoseSample& c) const {
@@ -113,7 +122,10 @@ void RubiksTask::update_plan(double t_run, const std::optional<CubePoseSample>& 
       if (drop_since_ >= 0 && t_run - drop_since_ >= kDropHold) {
         drop_since_ = -1;
         const int attempt = plan_.progress.attempts + 1;
-        if (t_run + kRegraspBlend + (p_.duration - kRegraspFrom) <= p_.deadline) {
+        // The turns made so far stay made: only the ones left need time (a slip in the second
+        // turn, at 8.6 s, leaves room for one more, not for the whole script again).
+        const int remaining = plan_.progress.turns_planned - std::max(cube->turns, plan_.progress.turns_seen);
+        if (t_run + regrasp_time_s(p_.duration, remaining) <= p_.deadline) {
           ++plan_.progress.retries_grasp;
           ++plan_.progress.attempts;
           jump(t_run, kRegraspFrom, kRegraspBlend, SegmentKind::kRegrasp, attempt, plan_.progress.turns_seen + 1);

@@ -261,6 +261,42 @@ TEST(ClosedLoopUser, ASlippedGraspIsMadeAgainWhereTheCubeLies) {
   EXPECT_NEAR(g1[4].x() - g0[4].x(), 0.01, 2e-3);
 }
 
+// A grasp that slips in the second turn, with the first turn made: the regrasp needs room for the
+// one turn left, not for the whole script (at most 0.8 + 5.0 + 0.6 + 2.1 s, not 12.1), so at 8.6 s it
+// still fits before the deadline of 20 s; the regrasp's turn is the last, and the script goes on
+// to set the cube down without a third.
+TEST(ClosedLoopUser, AGraspSlippedInTheLastTurnIsMadeAgainForTheTurnLeft) {
+  RubiksTask task({});
+  core::Latest<CubePoseSample> feed;
+  task.track(&feed);
+  const RubiksTaskParams p = task.params();
+  double regrasp_t = -1;
+  int turns_at_regrasp_check = -1;
+  const Played r = play(task, feed, 20.0, [&](double t, double s) {
+    if (regrasp_t < 0 && task.progress().retries_grasp > 0) regrasp_t = t;
+    if (regrasp_t < 0) {
+      if (t >= 8.6) return cube_at(p, 0.0, 1);  // down on the table, one turn made
+      return cube_at(p, script_lift(p, s), s >= 5.3 ? 1 : 0);
+    }
+    // Grasped again and turned: the turn clicks at script time 5.3 of the replay.
+    const int turns = 1 + (t > regrasp_t + 1.0 && s >= 5.3 ? 1 : 0);
+    if (turns_at_regrasp_check < 0 && t > regrasp_t + 1.0 && s >= 5.7) turns_at_regrasp_check = turns;
+    return cube_at(p, script_lift(p, s), turns);
+  });
+  const TaskProgress pr = task.progress();
+  EXPECT_EQ(pr.retries_grasp, 1);
+  EXPECT_FALSE(pr.gave_up);
+  EXPECT_GT(regrasp_t, 8.85);  // a drop must last 0.3 s
+  EXPECT_LT(regrasp_t, 9.2);
+  EXPECT_EQ(turns_at_regrasp_check, 2);
+  EXPECT_EQ(pr.turns_seen, 2);
+  EXPECT_EQ(pr.retries_turn, 0);
+  // The replayed stretch 0.7–5.7, then the set-down and withdrawal 9.9–12.0.
+  EXPECT_NEAR(r.finished_at_s, regrasp_t + 5.0 + 2.1, 0.05);
+  EXPECT_LE(r.finished_at_s, p.deadline);
+  EXPECT_LT(r.max_step_m, 0.0015);
+}
+
 TEST(ClosedLoopUser, ACubeHeldLowerThanTheScriptLiftsItIsNoSlip) {
   RubiksTask task({});
   core::Latest<CubePoseSample> feed;
