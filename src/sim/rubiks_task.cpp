@@ -163,6 +163,10 @@ void RubiksTask::goals(double t_run, std::span<Vec3> goal) {
         if (!looks_for_grasp(t, side)) continue;  // holding on or leaving: keep the frame
         if (!within_reach(*c)) continue;         // gone from the scene: never follow it away
         frames_.p_W[h] = c->p_W;
+        // Approaching for a grasp of the cube on the table (s < 1): a cube seen above where it
+        // rests is still carried by hands letting go of a slipped grasp, or falling; it will lie
+        // at its resting height, which the grasp (and the slip check's reference) then takes.
+        if (t < 1.0) frames_.p_W[h][2] = std::min(c->p_W[2], p_.p_W_cube.z());
         frames_.q_WG[h] = {g.w(), g.x(), g.y(), g.z()};
         frames_.lift[h] = state(t, side, 0).lift;
       }
