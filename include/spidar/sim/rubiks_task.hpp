@@ -20,7 +20,9 @@
 ///     `deadline`; with all `turns` done it goes on to setting the cube down;
 ///   - while the cube is held up (s in 3.0 – 9.2): is it still in the hand? A cube that dropped
 ///     more than half the lift below where the holding hand carries it, for 0.15 s, is a slipped
-///     grasp: both hands open and approach and grasp it again from s = 0.4, where it lies.
+///     grasp: both hands open and approach and grasp it again from s = 0.7, where it lies (at its
+///     resting height, though the opening hands may carry it up for a moment), if the turns left
+///     fit before `deadline` (the regrasp replays a turn; with that the last, on to the set-down).
 ///   - during each turn: has the held cube sunk in the holding hand (`sink` lower than when the
 ///     turn began)? Then the holding hand grips harder for the rest of the run (`firm_squeeze`).
 /// Each jump in s is cross-faded over a fraction of a second, so the fingertips never jump.
