@@ -233,10 +233,12 @@ void AsyncSinks::run() {
       error_ = std::current_exception();
       failed = true;
     }
+    // No view of the held result's images may outlive the hold: the pipeline refills them (the
+    // comparison shares its matte).
+    slots_[k].shown = pipeline::FrameResult{};
+    if (comparison_) comparison_->result.key = vision::ChromaKeyResult{};
     slots_[k].e.result_hold.reset();  // back to their pools, unless a sink kept them
     slots_[k].e.filmed_hold.reset();
-    // Nor may a view of the held result's images outlive the hold: the pipeline refills them.
-    slots_[k].shown = pipeline::FrameResult{};
     {
       std::lock_guard lock(mutex_);
       free_.push_back(k);
