@@ -261,6 +261,13 @@ TEST(ClosedLoopUser, ASlippedGraspIsMadeAgainWhereTheCubeLies) {
   EXPECT_NEAR(g1[4].x() - g0[4].x(), 0.01, 2e-3);
 }
 
+/// The cube of a grasp that slips in the second turn: where the script carries it, the first turn
+/// clicked at script time 5.3, until at 8.6 s it drops to the table.
+CubePoseSample slips_in_the_second_turn(const RubiksTaskParams& p, double t, double s) {
+  if (t >= 8.6) return cube_at(p, 0.0, 1);
+  return cube_at(p, script_lift(p, s), s >= 5.3 ? 1 : 0);
+}
+
 // A grasp that slips in the second turn, with the first turn made: the regrasp needs room for the
 // one turn left, not for the whole script (at most 0.8 + 5.0 + 0.6 + 2.1 s, not 12.1), so at 8.6 s it
 // still fits before the deadline of 20 s; the regrasp's turn is the last, and the script goes on
@@ -274,10 +281,7 @@ TEST(ClosedLoopUser, AGraspSlippedInTheLastTurnIsMadeAgainForTheTurnLeft) {
   int turns_at_regrasp_check = -1;
   const Played r = play(task, feed, 20.0, [&](double t, double s) {
     if (regrasp_t < 0 && task.progress().retries_grasp > 0) regrasp_t = t;
-    if (regrasp_t < 0) {
-      if (t >= 8.6) return cube_at(p, 0.0, 1);  // down on the table, one turn made
-      return cube_at(p, script_lift(p, s), s >= 5.3 ? 1 : 0);
-    }
+    if (regrasp_t < 0) return slips_in_the_second_turn(p, t, s);
     // Grasped again and turned: the turn clicks at script time 5.3 of the replay.
     const int turns = 1 + (t > regrasp_t + 1.0 && s >= 5.3 ? 1 : 0);
     if (turns_at_regrasp_check < 0 && t > regrasp_t + 1.0 && s >= 5.7) turns_at_regrasp_check = turns;
@@ -308,10 +312,7 @@ TEST(ClosedLoopUser, ACubeCarriedUpWhileTheHandsLetGoIsGraspedWhereItWillLie) {
   double regrasp_t = -1;
   const Played r = play(task, feed, 20.0, [&](double t, double s) {
     if (regrasp_t < 0 && task.progress().retries_grasp > 0) regrasp_t = t;
-    if (regrasp_t < 0) {
-      if (t >= 8.6) return cube_at(p, 0.0, 1);
-      return cube_at(p, script_lift(p, s), s >= 5.3 ? 1 : 0);
-    }
+    if (regrasp_t < 0) return slips_in_the_second_turn(p, t, s);
     if (s < 1.0) return cube_at(p, 0.012, 1);  // carried up by the opening hands
     const int turns = 1 + (t > regrasp_t + 1.0 && s >= 5.3 ? 1 : 0);
     return cube_at(p, 0.5 * script_lift(p, s), turns);  // held lower than the script lifts it
