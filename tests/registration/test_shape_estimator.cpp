@@ -311,7 +311,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.max_relative_change, d.max_relative_change);
   EXPECT_EQ(p.reach_min_miss_m, d.reach_min_miss_m);
   EXPECT_EQ(p.max_fingertip_cost, d.max_fingertip_cost);
-  EXPECT_EQ(p.apply_after_frames, 5);  // the sessions re-estimate on a thread of their own
+  EXPECT_EQ(p.apply_after_frames, 15);  // the sessions re-estimate on a thread of their own
   EXPECT_EQ(p.shared_hands, d.shared_hands);
   EXPECT_EQ(p.keyframe_prior_scale, d.keyframe_prior_scale);
   EXPECT_EQ(p.keyframe_prior, d.keyframe_prior);

@@ -88,7 +88,8 @@ struct ShapeEstimatorParams {
   /// take effect at the N-th poll() after it started, which waits for it then if it has not
   /// finished: the frame thread does not carry the re-estimate (10–25 ms), and the sequence of
   /// models stays the same from run to run. (At nice 10 a busy machine starved it past 2 frames,
-  /// and the frame thread waited.)
+  /// and the frame thread waited. At 5 frames, the demo's frame thread still waited 19–166 ms in
+  /// about 1 % of its frames on the slower VM; at 15 (configs/registration.yaml), 3 ms at most.)
   int apply_after_frames = 0;
   /// kSpill, kBoth: keyframes also keep their silhouette (the matte ≥ matte_threshold), and with
   /// kBoth the silhouette pixels their hand owned (ImageEvidence::coverage); the re-estimate fits
