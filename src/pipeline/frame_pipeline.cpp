@@ -410,6 +410,14 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   return Ok{};
 }
 
+Status process_comparison(FramePipeline& comparison, const FrameResult& main, const cv::Mat& bgr,
+                          const device::FingertipSample& fingertips, const SceneSnapshot& scene,
+                          bool picture, FrameResult* out) {
+  comparison.use_model_sizes(main.models);
+  const bool same_key = main.key.alpha.size() == bgr.size();
+  return comparison.process(bgr, fingertips, scene, out, !picture, same_key ? &main.key : nullptr);
+}
+
 FramePipelineParams comparison_params(const FramePipelineParams& main) {
   FramePipelineParams alt = main;
   alt.registration.silhouette_term = !alt.registration.silhouette_term;

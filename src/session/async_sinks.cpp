@@ -91,14 +91,9 @@ void AsyncSinks::make_comparison(Slot& slot) {
     throw SpidarError("comparison: a frame left pending without its image, fingertips, scene or result");
   const auto t0 = std::chrono::steady_clock::now();
   if (auto st = comparison_->context->make_current(); !st) throw SpidarError("comparison: " + st.error().message);
-  pipeline::FramePipeline& p = *comparison_->pipeline;
-  const pipeline::FrameResult& main = *e.result;
-  p.use_model_sizes(main.models);  // the sizes the main fit used on this frame
-  // The same image keyed with the same params (comparison_params keeps them): the main matte.
-  const bool same_key = main.key.alpha.size() == e.bgr->size();
   const bool picture = e.compare_pending == PendingComparison::kFitAndPicture;
-  if (auto st = p.process(*e.bgr, *e.measured, *e.scene, &comparison_->result, !picture,
-                          same_key ? &main.key : nullptr);
+  if (auto st = pipeline::process_comparison(*comparison_->pipeline, *e.result, *e.bgr, *e.measured, *e.scene,
+                                             picture, &comparison_->result);
       !st)
     throw SpidarError("comparison: " + st.error().message);
   if (picture) e.compared = &comparison_->result;

@@ -175,11 +175,8 @@ Session::Step Session::step() {
       if (!alt_) {
         e.compare_pending = render ? PendingComparison::kFitAndPicture : PendingComparison::kFit;
       } else {
-        // The same image keyed with the same params: the main pipeline's matte.
-        const bool same_key = alt_->params().chroma_key == pipe_->params().chroma_key;
-        if (pipe_->params().personalise_shape) alt_->use_model_sizes(result_->models);
-        if (auto st = alt_->process(frame_.bgr, measured_, snapshot_, &alt_result_, !render,
-                                    same_key ? &result_->key : nullptr);
+        if (auto st = pipeline::process_comparison(*alt_, *result_, frame_.bgr, measured_, snapshot_, render,
+                                                   &alt_result_);
             !st)
           throw SpidarError(st.error().message);
         if (render) e.compared = &alt_result_;

@@ -176,4 +176,12 @@ class FramePipeline {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The comparison's fit of the frame `main` holds (comparison: a pipeline of comparison_params),
+/// with the sizes the main fit used on it (use_model_sizes) and its matte (the same image keyed
+/// with the same params), into `out`; its picture too when `picture`, else registration only.
+/// The context `comparison` was created with must be current. Error as process().
+Status process_comparison(FramePipeline& comparison, const FrameResult& main, const cv::Mat& bgr,
+                          const device::FingertipSample& fingertips, const SceneSnapshot& scene,
+                          bool picture, FrameResult* out);
+
 }  // namespace spidar::pipeline
