@@ -34,7 +34,7 @@ test-asan: deps
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan -j $(JOBS)
 
-# ThreadSanitizer build of the threaded tests (servo loop, lock-free hand-off).
+# ThreadSanitizer build of the threaded tests (servo loop, lock-free hand-off, the session's threads).
 test-tsan: deps
 	cmake --preset tsan >/dev/null
 	cmake --build --preset tsan -j $(JOBS)
