@@ -78,7 +78,11 @@ struct RegistrationParams {
   /// Used under the band length's conditions (a solid band, ends inside the image, the gate).
   double bracelet_thickness_sigma = 0.0;
   double bracelet_thickness_tolerance = 0.15;  ///< no cost within this share of the detected thickness
-  double joint_ball_sigma_px = 4.0;   ///< σ of a joint-ball target [px]
+  /// σ of a joint-ball target [px]. The targets come from the silhouette around each model joint
+  /// (eq. 21) and are only as good as its neighbourhood: 8 rather than 4 lets the fingertips and
+  /// the silhouette term hold the joints where the balls disagree (docs/measurements.md, "The
+  /// joint-balls' σ").
+  double joint_ball_sigma_px = 8.0;
   double joint_ball_alpha = 0.5;      ///< α of eq. 21 (dimensionless, 0..1)
   double ball_radius_scale = 1.0;     ///< ball radius = scale × the bone's projected radius
   double matte_threshold = 0.5;       ///< a neighbour is "on the silhouette" if alpha ≥ this
