@@ -9,6 +9,7 @@
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/coverage.hpp"
 #include "spidar/registration/fingertip_reach.hpp"
+#include "spidar/registration/wrist_depth.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/registration/shape_estimator.hpp"
 #include "spidar/render/hand_shapes.hpp"
@@ -89,6 +90,7 @@ struct FramePipeline::Impl {
   std::array<render::HandSkin, 2> skins;
   std::array<hand::HandParams, 2> previous;
   bool have_previous = false;
+  std::uint64_t warm_frames = 0;  ///< frames fitted from a previous one since the last cold start
   /// The silhouette term's coverage direction: both hands' outlines at the previous fits and the
   /// silhouette pixels each owns (registration/coverage.hpp).
   std::array<registration::ProjectedHand, 2> outlines;
@@ -166,6 +168,7 @@ FramePipeline::~FramePipeline() = default;
 void FramePipeline::reset() {
   Impl& s = *impl_;
   s.have_previous = false;
+  s.warm_frames = 0;
   // A cold start forgets the sizes learnt too: a session's warm-up frame (a blank screen) must
   // not stay among the estimator's keyframes, or a replay, which has no warm-up, would not
   // reach the live run's sizes.
@@ -280,6 +283,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   // Successive adjustment of both hands.
   t0 = Clock::now();
   out->restarts = 0;
+  out->depth_switches = 0;
   out->reaches = 0;
   // A size re-estimate running on its own thread takes effect here, a fixed number of frames after
   // it started (ShapeEstimatorParams::apply_after_frames), so the fits stay reproducible.
@@ -376,6 +380,26 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
         }
         ++out->restarts;
       }
+      // The wrist's other depth along its band's ray (registration/wrist_depth.hpp): fitted from
+      // there every other_depth_every-th warm frame, kept when it explains the evidence clearly
+      // better (the prior left out of the comparison: it holds the basin the warm fit is in).
+      if (p.other_depth_every > 0 && s.warm_frames % static_cast<std::uint64_t>(p.other_depth_every) ==
+                                         static_cast<std::uint64_t>(h) % static_cast<std::uint64_t>(p.other_depth_every)) {
+        if (auto start = registration::other_wrist_depth(s.models[h], q, obs, s.camera)) {
+          registration::FitReport other;
+          const hand::HandParams q2 = fit_from(*start, nullptr, p.other_depth_rounds, &other);
+          const double data_now = report.terms.total() - report.terms.prior;
+          const double data_other = other.terms.total() - other.terms.prior;
+          other.iterations += report.iterations;
+          if (q2.q.allFinite() && data_other < p.other_depth_keep * data_now) {
+            q = q2;
+            report = other;
+            ++out->depth_switches;
+          } else {
+            report.iterations = other.iterations;
+          }
+        }
+      }
     }
     // A digit stalled short of its string: try again from it re-posed on its own (its prior mean
     // moved along, or the prior would hold the old basin), and keep the re-fit if it explains the
@@ -398,6 +422,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     out->shapes[h] = s.estimator_of(h).estimate(s.index_in_estimator(h));
   }
   s.previous = out->hands;
+  if (s.have_previous) ++s.warm_frames;
   s.have_previous = true;
   tm.registration_ms = ms_since(t0);
   if (registration_only) {

@@ -51,6 +51,18 @@ struct FramePipelineParams {
   /// Restart a warm-started fit from the fingertips when its fingertip cost per fingertip stays
   /// above this (dimensionless: 25 = each fingertip 5 σ from the strings, ~7.5 mm at 1.5 mm).
   double restart_fingertip_cost = 25.0;
+  /// Every N-th warm frame of each hand (the two hands on different frames), its fit is also tried
+  /// from the wrist's other depth along the band's ray (registration/wrist_depth.hpp) for
+  /// other_depth_rounds rounds, and kept when its data terms cost less than other_depth_keep
+  /// times the warm fit's: a hand fitted at the wrong one of the two depths the fingertips and the
+  /// wrist pixel allow agrees with the strings, so the restart above never fires; 0 = never.
+  /// Measured (demo, 2026-11-26, night): the long-narrow user's fit no longer collapses after a
+  /// late regrasp (seeds 1–6: IoU 0.838–0.859 against 2 runs of 6 at 0.777–0.809, joints 9.0 →
+  /// 7.5 px), the default user alike (0.866, seeds 1–4), registration 1.62 → 2.15 ms per frame
+  /// (median of the runs' medians); every 6th frame let one collapse through.
+  int other_depth_every = 3;
+  int other_depth_rounds = 2;
+  double other_depth_keep = 0.7;
   /// A fit whose cap misses its string by more than this [m] is tried again from each such digit
   /// re-posed on its own (registration/fingertip_reach.hpp: the straight-finger local minimum),
   /// and the re-fit kept if it explains the evidence better; 0 = never.
@@ -95,6 +107,7 @@ struct FrameResult {
   std::array<registration::ShapeEstimate, 2> shapes;
   std::array<registration::FitReport, 2> fits;
   int restarts = 0;  ///< hands whose fit was restarted this frame
+  int depth_switches = 0;  ///< hands whose fit was kept from the wrist's other depth this frame
   int reaches = 0;   ///< hands whose fit was kept from a digit re-posed to its string this frame
   std::array<vision::BraceletObservation, 2> bracelets;
   vision::ChromaKeyResult key;
