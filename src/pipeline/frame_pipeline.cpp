@@ -1,5 +1,6 @@
 #include "spidar/pipeline/frame_pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <opencv2/core.hpp>
@@ -383,15 +384,13 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       // The wrist's other depth along its band's ray (registration/wrist_depth.hpp): fitted from
       // there every other_depth_every-th warm frame, kept when it explains the evidence clearly
       // better (the prior left out of the comparison: it holds the basin the warm fit is in).
-      if (p.other_depth_every > 0 && s.warm_frames % static_cast<std::uint64_t>(p.other_depth_every) ==
-                                         static_cast<std::uint64_t>(h) % static_cast<std::uint64_t>(p.other_depth_every)) {
+      const auto every = static_cast<std::uint64_t>(std::max(p.other_depth_every, 0));
+      if (every > 0 && s.warm_frames % every == static_cast<std::uint64_t>(h) % every) {
         if (auto start = registration::other_wrist_depth(s.models[h], q, obs, s.camera)) {
           registration::FitReport other;
           const hand::HandParams q2 = fit_from(*start, nullptr, p.other_depth_rounds, &other);
-          const double data_now = report.terms.total() - report.terms.prior;
-          const double data_other = other.terms.total() - other.terms.prior;
           other.iterations += report.iterations;
-          if (q2.q.allFinite() && data_other < p.other_depth_keep * data_now) {
+          if (q2.q.allFinite() && other.terms.evidence() < p.other_depth_keep * report.terms.evidence()) {
             q = q2;
             report = other;
             ++out->depth_switches;

@@ -164,7 +164,7 @@ bool refit_reaching(const SuccessiveAdjustment& solver, const hand::HandModel& m
   }
   FitReport again = solver.fit(model, observation, image, prior != nullptr ? &prior2 : nullptr, &q2);
   const int iterations = report->iterations + again.iterations;
-  const bool better = again.cost_final - again.terms.prior < report->cost_final - report->terms.prior;
+  const bool better = again.terms.evidence() < report->terms.evidence();
   if (better) {
     again.cost_initial = report->cost_initial;
     *report = again;

@@ -72,6 +72,9 @@ struct ImageEvidence {
 struct TermCosts {
   double fingertip = 0, wrist = 0, joint_ball = 0, silhouette = 0, prior = 0;
   double total() const { return fingertip + wrist + joint_ball + silhouette + prior; }
+  /// The evidence's share, without the prior: what compares fits started from different poses
+  /// (each prior holds the basin its own start is in).
+  double evidence() const { return total() - prior; }
 };
 
 struct FitReport {
