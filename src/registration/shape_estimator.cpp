@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "spidar/core/realtime.hpp"
@@ -209,12 +210,23 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     const Eigen::Vector3d d = hand_sizes(b, starts, h);
     return resized(models[h], d.x(), d.y(), d.z());
   };
-  Eigen::Vector3d beta(estimate.length_m, estimate.width_m, estimate.thickness);
-  Eigen::Matrix3d H = H0;
-  bool changed = false;
-  for (int it = 0; it < p.iterations; ++it) {
+  const Eigen::Vector3d beta_start(estimate.length_m, estimate.width_m, estimate.thickness);
+  Eigen::Vector3d beta = beta_start;
+  // The sizes are taken only where the objective — Σ_k ‖r_k‖² at each keyframe's pose re-fitted
+  // at those sizes, plus the sizes' prior — is the lowest visited: a Gauss-Newton step that
+  // raises it (J_β is a linearisation, and the joint-balls' rows are left out of the width's
+  // column) is halved back toward the best sizes instead of being followed. `iterations` steps
+  // (or halvings), each evaluated: iterations + 1 evaluations.
+  struct Best {
+    double cost = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d beta;
+    Eigen::Matrix3d H;
+    std::vector<hand::HandParams> poses;  ///< the keyframes' re-fitted poses at beta
+  } best;
+  for (int it = 0; it <= p.iterations; ++it) {
     Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    double cost = (beta - beta0).dot(H0 * (beta - beta0));
     for (std::size_t i = 0; i < job.keyframes.size(); ++i) {
       Keyframe& kf = job.keyframes[i];
       const auto hk = static_cast<std::size_t>(kf.hand);
@@ -272,8 +284,30 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       const MatX JbtJ = JtJb.transpose();
       S += Jb.transpose() * Jb - JbtJ * A_ldlt.solve(JtJb);
       g -= Jb.transpose() * r - JbtJ * A_ldlt.solve(J.transpose() * r);
+      cost += r.squaredNorm();
     }
-    H = S + H0;
+    if (it == 0) estimate.objective_start = cost;
+    const bool better = cost < best.cost;
+    if (!better) ++estimate.steps_rejected;
+    if (better) {
+      best.cost = cost;
+      best.beta = beta;
+      best.H = S + H0;
+      best.poses.clear();
+      for (const Keyframe& kf : job.keyframes) best.poses.push_back(kf.q);
+    }
+    if (it == p.iterations) break;  // the last step evaluated, not stepped from
+    if (!better) {
+      // Back toward the best sizes (their models are valid: every β visited was).
+      beta = best.beta + 0.5 * (beta - best.beta);
+      auto m = std::vector<hand::HandModel>{};
+      for (std::size_t h = 0; h < models.size(); ++h)
+        if (auto mh = model_at(h, beta)) m.push_back(std::move(mh).value());
+      if (m.size() != models.size()) break;
+      models = std::move(m);
+      continue;
+    }
+    const Eigen::Matrix3d& H = best.H;
     const Eigen::Vector3d rhs = g + H0 * (beta0 - beta);
     // Solve over the sizes still free (frozen ones and, without silhouettes, the thickness stay).
     const std::array<bool, 3> free{!estimate.length_frozen, !estimate.width_frozen,
@@ -303,17 +337,30 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       next_models.push_back(std::move(m).value());
     }
     if (next_models.size() != models.size()) break;  // outside the valid sizes: keep the last valid models
-    const bool moved = (next - beta).cwiseAbs().maxCoeff() > 1e-7;
     models = std::move(next_models);
     beta = next;
-    changed = changed || moved;
     if (step.norm() < 1e-6) break;
   }
   ++estimate.solves;
+  if (!std::isfinite(best.cost)) {  // no evaluation (no iterations): nothing changes
+    job.changed = false;
+    return job;
+  }
+  // The best sizes visited, with their models and the keyframes' poses fitted at them.
+  if (best.beta != beta) {
+    std::vector<hand::HandModel> m;
+    for (std::size_t h = 0; h < models.size(); ++h)
+      if (auto mh = model_at(h, best.beta)) m.push_back(std::move(mh).value());
+    if (m.size() == models.size()) models = std::move(m);
+  }
+  for (std::size_t i = 0; i < job.keyframes.size() && i < best.poses.size(); ++i) job.keyframes[i].q = best.poses[i];
+  beta = best.beta;
+  estimate.objective = best.cost;
+  const bool changed = (beta - beta_start).cwiseAbs().maxCoeff() > 1e-7;
   estimate.length_m = beta.x();
   estimate.width_m = beta.y();
   estimate.thickness = beta.z();
-  const Eigen::Matrix3d cov = H.inverse();
+  const Eigen::Matrix3d cov = best.H.inverse();
   estimate.sigma_length_m = std::sqrt(std::max(cov(0, 0), 0.0));
   estimate.sigma_width_m = std::sqrt(std::max(cov(1, 1), 0.0));
   estimate.sigma_thickness = std::sqrt(std::max(cov(2, 2), 0.0));

@@ -324,7 +324,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                                           {"width_frozen", e.width_frozen},
                                           {"thickness_frozen", e.thickness_frozen},
                                           {"keyframes", e.keyframes},
-                                          {"solves", e.solves}};
+                                          {"solves", e.solves},
+                                          {"steps_rejected", e.steps_rejected}};
     }
     shape["personalised"] = s.personalised;
     reg["hand_shape"] = shape;
