@@ -142,7 +142,7 @@ int run_mr_demo(const DemoOptions& o) {
   // The window on the frame thread (its GL context lives there); scoring, video, keyframes and
   // the progress line on the output thread, off the pipeline's critical path.
   session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 10);
-  off_path.compare(camera, models, sp.pipeline);
+  off_path.compare(camera, models, sp.pipeline, run->warm_up_frame());
   off_path.compose_others(sp.pipeline.compositor);
   run->add_sink(window);
   run->add_sink(off_path);

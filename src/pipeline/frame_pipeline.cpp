@@ -527,4 +527,12 @@ Status FramePipeline::picture(const cv::Mat& bgr, const SceneSnapshot& world, Fr
   return Ok{};
 }
 
+Status warm_up(FramePipeline& pipeline, const WarmUpFrame& frame) {
+  FrameResult scratch;
+  if (auto st = pipeline.process(frame.bgr, frame.fingertips, frame.scene, &scratch); !st)
+    return Error{"warm-up frame: " + st.error().message};
+  pipeline.reset();
+  return Ok{};
+}
+
 }  // namespace spidar::pipeline

@@ -27,9 +27,11 @@ AsyncSinks::~AsyncSinks() {
 }
 
 void AsyncSinks::compare(const vision::Camera& camera, const std::array<hand::HandModel, 2>& models,
-                         const pipeline::FramePipelineParams& main) {
+                         const pipeline::FramePipelineParams& main,
+                         std::optional<pipeline::WarmUpFrame> warm_up) {
   if (started_) throw std::logic_error("async sinks: compare after on_start");
   comparison_ = std::make_unique<Comparison>();
+  comparison_->warm_up = std::move(warm_up);
   comparison_->camera = camera;
   comparison_->models = models;
   comparison_->params = pipeline::comparison_params(main);
@@ -79,6 +81,11 @@ void AsyncSinks::start_comparison() {
                                               comparison_->params);
   if (!pipe) throw SpidarError("comparison: " + pipe.error().message);
   comparison_->pipeline = std::move(pipe).value();
+  if (comparison_->warm_up) {
+    if (auto st = pipeline::warm_up(*comparison_->pipeline, *comparison_->warm_up); !st)
+      throw SpidarError("comparison: " + st.error().message);
+    comparison_->warm_up.reset();
+  }
 }
 
 void AsyncSinks::make_comparison(Slot& slot) {

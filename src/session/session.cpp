@@ -48,44 +48,58 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
 
 Session::~Session() { stop_threads(); }
 
-void Session::warm_up() {
-  // A blank blue screen with the fingertips where the script starts; both fits are then reset.
+pipeline::WarmUpFrame Session::warm_up_frame() const {
+  pipeline::WarmUpFrame w;
   const auto rgb = sim::SyntheticCameraParams{}.screen_rgb;
   const vision::Intrinsics& k = camera_.intrinsics();
-  const cv::Mat blank(k.height, k.width, CV_8UC3,
-                      cv::Scalar(255.0 * rgb[2], 255.0 * rgb[1], 255.0 * rgb[0]));
+  w.bgr = cv::Mat(k.height, k.width, CV_8UC3, cv::Scalar(255.0 * rgb[2], 255.0 * rgb[1], 255.0 * rgb[0]));
   std::vector<Vec3> goals(8);
   scene_.task->goals(0.0, goals);
-  device::FingertipSample tips;
-  tips.finger_count = 8;
-  for (int f = 0; f < 8; ++f) tips.p_W[f] = {goals[f].x(), goals[f].y(), goals[f].z()};
-  SceneSnapshot s0;
-  scene_.world->snapshot(s0, false);
-  pipeline::FrameResult warm;
+  w.fingertips.finger_count = 8;
+  for (int f = 0; f < 8; ++f) w.fingertips.p_W[f] = {goals[f].x(), goals[f].y(), goals[f].z()};
+  scene_.world->snapshot(w.scene, false);
+  return w;
+}
+
+void Session::warm_up() {
+  // A blank blue screen with the fingertips where the script starts; both fits are then reset.
+  const pipeline::WarmUpFrame w = warm_up_frame();
   for (pipeline::FramePipeline* p : {pipe_.get(), alt_.get()}) {
     if (p == nullptr) continue;
-    if (auto st = p->process(blank, tips, s0, &warm); !st) throw SpidarError(st.error().message);
-    p->reset();
+    if (auto st = pipeline::warm_up(*p, w); !st) throw SpidarError(st.error().message);
   }
   ++warm_ups_;
 }
 
 void Session::start() {
   if (started_) return;
+  // Whatever takes time on a first use happens before the clock starts (the haptic side's open):
+  // the pipelines' warm-up, the sinks' start (the output thread's GL contexts and their warm-ups)
+  // and the camera's (its first frame). After the clock starts the camera's exposures run, and
+  // any of this there would skip or drop the first frames.
   if (params_.warm_up) warm_up();
-  if (haptic_) {
-    haptic_->start();  // throws with the haptic side stopped again
-    t_start_ns_ = haptic_->t_open_ns();
-  } else {
-    t_start_ns_ = core::monotonic_ns();
-    scene_.world->snapshot(snapshot_, false);  // the shapes the recorded poses apply to
-  }
   started_ = true;
   try {
     for (FrameSink* k : sinks_) k->on_start();
   } catch (...) {
     stop_threads();
     throw;
+  }
+  if (auto st = rig_.camera().prepare(); !st) {
+    stop_threads();
+    throw SpidarError("camera: " + st.error().message);
+  }
+  if (haptic_) {
+    try {
+      haptic_->start();  // throws with the haptic side stopped again
+    } catch (...) {
+      stop_threads();
+      throw;
+    }
+    t_start_ns_ = haptic_->t_open_ns();
+  } else {
+    t_start_ns_ = core::monotonic_ns();
+    scene_.world->snapshot(snapshot_, false);  // the shapes the recorded poses apply to
   }
   if (auto st = rig_.camera().start(t_start_ns_); !st) {
     stop_threads();

@@ -15,7 +15,8 @@ class SyntheticSource final : public FrameSource {
         bending_wrists_(bending_wrists) {}
   ~SyntheticSource() override { stop(); }
 
-  Status start(std::int64_t t0_ns) override {
+  Status prepare() override {
+    if (thread_) return Ok{};
     truth_buf_.resize(1000);
     // The ground truth comes from the simulated device: where it holds the user's fingertips.
     sim::TruthAt truth_at = [this](std::int64_t t_ns, std::span<Vec3> out) {
@@ -31,10 +32,14 @@ class SyntheticSource final : public FrameSource {
     if (bending_wrists_) cp.elbows_W = sim::user_elbows(task_);
     sim::CameraThreadParams ctp;
     ctp.fps = fps_;
-    ctp.t0_ns = t0_ns;
-    auto r = sim::CameraThread::start(camera_, truth_, cp, task_, truth_at, ctp);
+    auto r = sim::CameraThread::prepare(camera_, truth_, cp, task_, truth_at, ctp);
     if (!r) return r.error();
     thread_ = std::move(r).value();
+    return Ok{};
+  }
+  Status start(std::int64_t t0_ns) override {
+    if (auto st = prepare(); !st) return st;
+    thread_->begin(t0_ns);
     return Ok{};
   }
   bool take(CameraFrame* out) override {

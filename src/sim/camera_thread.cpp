@@ -26,7 +26,7 @@ void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to) {
   to->film_ms = from.film_ms;
 }
 
-Result<std::unique_ptr<CameraThread>> CameraThread::start(
+Result<std::unique_ptr<CameraThread>> CameraThread::prepare(
     const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
     const SyntheticCameraParams& film_params, const RubiksTask& task, TruthAt truth_at,
     const CameraThreadParams& params) {
@@ -49,10 +49,32 @@ Result<std::unique_ptr<CameraThread>> CameraThread::start(
   return c;
 }
 
+Result<std::unique_ptr<CameraThread>> CameraThread::start(
+    const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
+    const SyntheticCameraParams& film_params, const RubiksTask& task, TruthAt truth_at,
+    const CameraThreadParams& params) {
+  auto c = prepare(camera, truth, film_params, task, std::move(truth_at), params);
+  if (c) c.value()->begin(params.t0_ns);
+  return c;
+}
+
+void CameraThread::begin(std::int64_t t0_ns) {
+  {
+    std::lock_guard lock(gate_mutex_);
+    if (t0_ns_) return;
+    t0_ns_ = t0_ns;
+  }
+  gate_.notify_all();
+}
+
 CameraThread::~CameraThread() { stop(); }
 
 void CameraThread::stop() {
-  stop_.store(true, std::memory_order_release);
+  {
+    std::lock_guard lock(gate_mutex_);
+    stop_.store(true, std::memory_order_release);
+  }
+  gate_.notify_all();
   if (thread_.joinable()) thread_.join();
 }
 
@@ -73,18 +95,35 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
   auto film = SyntheticCamera::create(*ctx.value(), camera, truth, film_params);
   if (!film) return ready(Error{"camera thread: " + film.error().message});
   UserHands user(truth, task);
+  // One frame filmed before the clock starts, at the script's first nominal poses, and thrown
+  // away: the GL driver compiles its shaders at the first draw (98 ms of the first frame here),
+  // which would otherwise skip the first exposures.
+  {
+    const std::array<hand::HandParams, 2> q0{task.nominal(0.0, hand::Side::kLeft),
+                                             task.nominal(0.0, hand::Side::kRight)};
+    SyntheticFrame scratch;
+    if (auto st = film.value()->film(HandPoses{&q0[0], &q0[1]}, &scratch); !st)
+      return ready(Error{"camera thread: warm-up frame: " + st.error().message});
+  }
   ready(Ok{});
+  std::int64_t t0_ns = 0;
+  {
+    std::unique_lock lock(gate_mutex_);
+    gate_.wait(lock, [this] { return t0_ns_.has_value() || stop_.load(std::memory_order_acquire); });
+    if (!t0_ns_) return;  // stopped before it began
+    t0_ns = *t0_ns_;
+  }
 
   const auto period_ns = static_cast<std::int64_t>(1e9 / params_.fps);
   std::array<Vec3, 8> caps;
   std::uint64_t index = 0;
-  std::int64_t t_exp = params_.t0_ns;
+  std::int64_t t_exp = t0_ns;
   while (!stop_.load(std::memory_order_acquire)) {
     core::sleep_until_ns(t_exp + params_.readout_ns);
     if (stop_.load(std::memory_order_acquire)) break;
     const std::int64_t t_start = core::monotonic_ns();
     if (truth_at_(t_exp, caps)) {
-      const double t_script = core::ns_to_s(t_exp - params_.t0_ns);
+      const double t_script = core::ns_to_s(t_exp - t0_ns);
       user.update(t_script, caps);
       std::shared_ptr<FilmedFrame> frame = pool_.take();  // nobody holds it: its buffers are reused
       FilmedFrame& out = *frame;

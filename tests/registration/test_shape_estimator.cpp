@@ -199,7 +199,7 @@ TEST(ShapeEstimator, TheJointBallsShortenALongModel) {
 // sizes that raises it (J_β linearises the keyframes' re-fitted poses, and the joint-balls' rows
 // are left out of the width's column) is halved back instead of being followed. In the demo the
 // right hand's width otherwise ran to its +15 % bound in the regrasps and the releases, the
-// objective rising with every step (docs/measurements.md, 2026-11-27). Hands far from the
+// objective rising with every step (docs/measurements.md, 2026-11-26, late night). Hands far from the
 // model's sizes, with and without the joint-balls, each solve checked.
 TEST(ShapeEstimator, AReEstimateKeepsTheLowestObjectiveItVisited) {
   int rejected = 0;

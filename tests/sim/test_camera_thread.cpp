@@ -73,6 +73,54 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
   EXPECT_LE(last_index + 1, cam.filmed() + cam.skipped());
 }
 
+// A prepared camera (CameraThread::prepare: its GL context made and one frame filmed and thrown
+// away before the session's clock starts) films nothing until begin(); the exposures then start
+// at the t0 begin() gives, however long ago prepare() was, and none was skipped for the time
+// the preparation took. Stopping a camera that never began ends its thread.
+TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
+  const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
+                                             hand::default_hand_model(hand::Side::kRight)};
+  RubiksTask task({});
+  std::atomic<std::int64_t> t0{0};
+  std::atomic<int> asked_before_begin{0};
+  TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
+    if (t0.load() == 0) ++asked_before_begin;
+    nominal_caps(truth, task, 1.0 + core::ns_to_s(t_ns - t0.load()), out);
+    return true;
+  };
+  CameraThreadParams params;
+  params.fps = 30;
+  {
+    auto never = CameraThread::prepare(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+    ASSERT_TRUE(never.ok()) << never.error().message;
+    never.value()->stop();  // returns: the thread ended without beginning
+    EXPECT_EQ(never.value()->filmed(), 0u);
+    EXPECT_EQ(never.value()->skipped(), 0u);
+  }
+  auto thread = CameraThread::prepare(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+  ASSERT_TRUE(thread.ok()) << thread.error().message;
+  CameraThread& cam = *thread.value();
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));  // longer than 4 frame periods
+  EXPECT_FALSE(cam.take());
+  EXPECT_EQ(cam.filmed(), 0u);
+  EXPECT_EQ(cam.skipped(), 0u);
+  t0 = core::monotonic_ns();
+  cam.begin(t0.load());
+  int taken = 0;
+  for (int i = 0; i < 2000 && taken == 0; ++i) {  // waits for a frame, not for a time
+    if (cam.take()) ++taken;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  cam.stop();
+  ASSERT_EQ(taken, 1) << cam.error();
+  EXPECT_EQ(asked_before_begin.load(), 0);
+  // Its first exposure is at t0 or a whole number of periods after it (if the taker was late).
+  const std::int64_t period_ns = static_cast<std::int64_t>(1e9 / params.fps);
+  const FilmedFrame& f = cam.frame();
+  EXPECT_EQ(f.t_exposure_ns, t0.load() + static_cast<std::int64_t>(f.index) * period_ns);
+  EXPECT_LE(f.index + 1, cam.filmed() + cam.skipped());
+}
+
 // A frame taken and held (CameraThread::shared) is not filmed over while the camera goes on: its
 // index, exposure and image stay as they were when it was taken, however many frames come after.
 TEST(CameraThread, AHeldFrameIsNotFilmedOver) {

@@ -189,6 +189,19 @@ class FramePipeline {
   std::unique_ptr<Impl> impl_;
 };
 
+/// A frame to process before a session's clock starts: the screen without hands, the
+/// fingertips where the task begins and the scene as it starts.
+struct WarmUpFrame {
+  cv::Mat bgr;                     ///< CV_8UC3, the camera's size
+  device::FingertipSample fingertips;
+  SceneSnapshot scene;
+};
+
+/// Processes `frame` once (the GL driver compiles its shaders at the first draw, the buffers are
+/// allocated) and resets the pipeline, so that the first real frame is not the one that pays for
+/// it. The context the pipeline was created with must be current. Error as process().
+Status warm_up(FramePipeline& pipeline, const WarmUpFrame& frame);
+
 /// The comparison's fit of the frame `main` holds (comparison: a pipeline of comparison_params),
 /// with the sizes the main fit used on it (use_model_sizes) and its matte (the same image keyed
 /// with the same params), into `out`; its picture too when `picture`, else registration only.

@@ -73,7 +73,7 @@ struct ShapeEstimatorParams {
   /// Gauss-Newton steps per re-estimate, each evaluated at the keyframes' re-fitted poses: one
   /// that raises the objective is halved back toward the best sizes visited, which are the ones
   /// kept (ShapeEstimate::objective). Measured (demo, seeds 1–2, five users and the blocks scene,
-  /// 2026-11-27): the widths' error 5–23 % → 1–14 % (default user 18.5 → 1.2–2.0 %), IoU alike.
+  /// 2026-11-26, late night): the widths' error 5–23 % → 1–14 % (default user 18.5 → 1.2–2.0 %), IoU alike.
   int iterations = 4;
   double freeze_sigma_length_m = 0.0003;  ///< freeze the length once its σ is below this [m]
   double freeze_sigma_width_m = 0.0003;   ///< ... the width [m]

@@ -42,9 +42,12 @@ class AsyncSinks final : public FrameSink {
   /// asked (then FrameEvent::compared points at it), with a FramePipeline of the comparison's
   /// params (pipeline::comparison_params of `main`, the main pipeline's) and a headless GL
   /// context of its own (created in on_start there); it reuses the main result's matte. Call
-  /// before on_start.
+  /// before on_start. With `warm_up` (Session::warm_up_frame), the comparison's pipeline processes
+  /// it in on_start (pipeline::warm_up): its first frame in the run is not the one that compiles
+  /// the GL programs (160 ms, which held the frame thread's first frames).
   void compare(const vision::Camera& camera, const std::array<hand::HandModel, 2>& models,
-               const pipeline::FramePipelineParams& main);
+               const pipeline::FramePipelineParams& main,
+               std::optional<pipeline::WarmUpFrame> warm_up = std::nullopt);
   /// Composes the other mode's composite (FrameResult::other, other_alpha: the comparison of the
   /// two compositors) of every frame's result and comparison that lacks it, on the output thread
   /// before the sinks see the frame: for a session whose pipelines leave it out
@@ -89,6 +92,7 @@ class AsyncSinks final : public FrameSink {
     std::unique_ptr<render::Context> context;
     std::unique_ptr<pipeline::FramePipeline> pipeline;
     pipeline::FrameResult result;  ///< the newest frame's (the sinks read it during on_frame)
+    std::optional<pipeline::WarmUpFrame> warm_up;
   };
   void start_comparison();
   void make_comparison(Slot& slot);

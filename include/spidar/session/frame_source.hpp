@@ -43,6 +43,11 @@ struct CameraFrame {
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
+  /// Makes the source ready before the session's clock starts, so that start() costs nothing:
+  /// the simulated camera makes its thread and GL context and films one frame it throws away
+  /// (the driver's first draw compiles its shaders: 100 ms, which would otherwise skip the first
+  /// exposures). Optional: start() prepares a source not prepared.
+  virtual Status prepare() { return Ok{}; }
   /// Starts the source's thread; `t0_ns` is the session's start (script time 0) [ns, monotonic].
   virtual Status start(std::int64_t t0_ns) = 0;
   /// The newest frame since the last call into `out`; false if none arrived.

@@ -105,6 +105,10 @@ class Session {
   std::uint64_t frames() const { return frames_; }
   /// Warm-ups done: 1 after start() with SessionParams::warm_up, else 0.
   int warm_ups() const { return warm_ups_; }
+  /// The frame the warm-up processes (the blue screen without hands, the fingertips where the
+  /// task begins, the scene as it starts): for pipelines of the session's sinks to warm up with
+  /// too (AsyncSinks::compare).
+  pipeline::WarmUpFrame warm_up_frame() const;
   std::uint64_t camera_frames() const;
 
   Rig& rig() { return rig_; }

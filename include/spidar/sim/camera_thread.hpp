@@ -8,10 +8,12 @@
 /// interpolated), the user's hand posture for them (UserHands), then the synthetic camera.
 #include <array>
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <thread>
@@ -44,7 +46,7 @@ using TruthAt = std::function<bool(std::int64_t t_ns, std::span<Vec3> out)>;
 
 struct CameraThreadParams {
   double fps = 30.0;
-  std::int64_t t0_ns = 0;        ///< script time 0 (host monotonic) [ns]
+  std::int64_t t0_ns = 0;        ///< script time 0 (host monotonic) [ns]: start() only (prepare() + begin())
   std::int64_t readout_ns = 2'000'000;  ///< wait after the exposure before filming [ns]
   /// The thread's niceness (core::set_nice, best effort): the simulated camera is hardware, which
   /// films at its rate whatever the host does, so it goes before the frame thread and the outputs
@@ -54,7 +56,18 @@ struct CameraThreadParams {
 
 class CameraThread {
  public:
-  /// Starts the thread; returns once its GL context and camera exist (or the error why not).
+  /// Starts the thread; returns once its GL context and camera exist and it has filmed one frame
+  /// (at the task's first nominal poses, thrown away: the GL driver compiles its shaders at the
+  /// first draw), or with the error why not. It films nothing until begin().
+  static Result<std::unique_ptr<CameraThread>> prepare(const vision::Camera& camera,
+                                                       const std::array<hand::HandModel, 2>& truth,
+                                                       const SyntheticCameraParams& film_params,
+                                                       const RubiksTask& task, TruthAt truth_at,
+                                                       const CameraThreadParams& params);
+  /// Starts the exposures: the first at `t0_ns` (script time 0, host monotonic) [ns]; later calls
+  /// do nothing.
+  void begin(std::int64_t t0_ns);
+  /// prepare(), then begin(params.t0_ns).
   static Result<std::unique_ptr<CameraThread>> start(const vision::Camera& camera,
                                                      const std::array<hand::HandModel, 2>& truth,
                                                      const SyntheticCameraParams& film_params,
@@ -101,6 +114,10 @@ class CameraThread {
   std::atomic<std::uint64_t> filmed_{0};
   std::atomic<std::uint64_t> skipped_{0};
   std::atomic<bool> stop_{false};
+  /// The exposures' start (begin()), or a stop, releases the prepared thread.
+  std::mutex gate_mutex_;
+  std::condition_variable gate_;
+  std::optional<std::int64_t> t0_ns_;
   std::string error_;
   std::thread thread_;
 };
