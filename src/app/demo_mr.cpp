@@ -140,8 +140,11 @@ int run_mr_demo(const DemoOptions& o) {
       },
       [&](const session::SessionSummary&) { progress.finish(); });
   // The window on the frame thread (its GL context lives there); scoring, video, keyframes and
-  // the progress line on the output thread, off the pipeline's critical path.
-  session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 10);
+  // the progress line on the output thread, off the pipeline's critical path, at nice 5: below
+  // the frame thread (−5), but not so far below another process's nice 0 that it starves and the
+  // frame thread waits for its slots (one core busy, seeds 1–3: 7.0–9.8 % of the frames dropped
+  // at nice 10, 0.55–2.2 % at 5; quiet, latency p95 28–29 ms at 5; docs/measurements.md).
+  session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 5);
   off_path.compare(camera, models, sp.pipeline, run->warm_up_frame());
   off_path.compose_others(sp.pipeline.compositor);
   run->add_sink(window);
