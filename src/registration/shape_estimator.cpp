@@ -210,6 +210,17 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     const Eigen::Vector3d d = hand_sizes(b, starts, h);
     return resized(models[h], d.x(), d.y(), d.z());
   };
+  // Every hand's model at β into `models`; false (models unchanged) when β is not a valid size.
+  auto set_models_at = [&](const Eigen::Vector3d& b) {
+    std::vector<hand::HandModel> next;
+    for (std::size_t h = 0; h < models.size(); ++h) {
+      auto m = model_at(h, b);
+      if (!m) return false;
+      next.push_back(std::move(m).value());
+    }
+    models = std::move(next);
+    return true;
+  };
   const Eigen::Vector3d beta_start(estimate.length_m, estimate.width_m, estimate.thickness);
   Eigen::Vector3d beta = beta_start;
   // The sizes are taken only where the objective — Σ_k ‖r_k‖² at each keyframe's pose re-fitted
@@ -300,11 +311,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     if (!better) {
       // Back toward the best sizes (their models are valid: every β visited was).
       beta = best.beta + 0.5 * (beta - best.beta);
-      auto m = std::vector<hand::HandModel>{};
-      for (std::size_t h = 0; h < models.size(); ++h)
-        if (auto mh = model_at(h, beta)) m.push_back(std::move(mh).value());
-      if (m.size() != models.size()) break;
-      models = std::move(m);
+      if (!set_models_at(beta)) break;
       continue;
     }
     const Eigen::Matrix3d& H = best.H;
@@ -330,14 +337,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     }
     if (!step.allFinite()) break;
     const Eigen::Vector3d next = (beta + step).cwiseMax(lo).cwiseMin(hi);
-    std::vector<hand::HandModel> next_models;
-    for (std::size_t h = 0; h < models.size(); ++h) {
-      auto m = model_at(h, next);
-      if (!m) break;
-      next_models.push_back(std::move(m).value());
-    }
-    if (next_models.size() != models.size()) break;  // outside the valid sizes: keep the last valid models
-    models = std::move(next_models);
+    if (!set_models_at(next)) break;  // outside the valid sizes: keep the last valid models
     beta = next;
     if (step.norm() < 1e-6) break;
   }
@@ -347,12 +347,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     return job;
   }
   // The best sizes visited, with their models and the keyframes' poses fitted at them.
-  if (best.beta != beta) {
-    std::vector<hand::HandModel> m;
-    for (std::size_t h = 0; h < models.size(); ++h)
-      if (auto mh = model_at(h, best.beta)) m.push_back(std::move(mh).value());
-    if (m.size() == models.size()) models = std::move(m);
-  }
+  if (best.beta != beta) (void)set_models_at(best.beta);  // valid: visited
   for (std::size_t i = 0; i < job.keyframes.size() && i < best.poses.size(); ++i) job.keyframes[i].q = best.poses[i];
   beta = best.beta;
   estimate.objective = best.cost;
