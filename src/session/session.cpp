@@ -79,31 +79,21 @@ void Session::start() {
   // any of this there would skip or drop the first frames.
   if (params_.warm_up) warm_up();
   started_ = true;
+  // Any failure from here stops what started (the haptic side, the camera) and re-throws.
   try {
     for (FrameSink* k : sinks_) k->on_start();
+    if (auto st = rig_.camera().prepare(); !st) throw SpidarError("camera: " + st.error().message);
+    if (haptic_) {
+      haptic_->start();  // throws with the haptic side stopped again
+      t_start_ns_ = haptic_->t_open_ns();
+    } else {
+      t_start_ns_ = core::monotonic_ns();
+      scene_.world->snapshot(snapshot_, false);  // the shapes the recorded poses apply to
+    }
+    if (auto st = rig_.camera().start(t_start_ns_); !st) throw SpidarError("camera: " + st.error().message);
   } catch (...) {
     stop_threads();
     throw;
-  }
-  if (auto st = rig_.camera().prepare(); !st) {
-    stop_threads();
-    throw SpidarError("camera: " + st.error().message);
-  }
-  if (haptic_) {
-    try {
-      haptic_->start();  // throws with the haptic side stopped again
-    } catch (...) {
-      stop_threads();
-      throw;
-    }
-    t_start_ns_ = haptic_->t_open_ns();
-  } else {
-    t_start_ns_ = core::monotonic_ns();
-    scene_.world->snapshot(snapshot_, false);  // the shapes the recorded poses apply to
-  }
-  if (auto st = rig_.camera().start(t_start_ns_); !st) {
-    stop_threads();
-    throw SpidarError("camera: " + st.error().message);
   }
 }
 
