@@ -11,6 +11,7 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "live_exit.hpp"
 #include "live_gui.hpp"
 #include "spidar/session/live_session.hpp"
 #include "signal_scope.hpp"
@@ -118,14 +119,7 @@ Action add_run(CLI::App& app) {
     const auto j = summary_json(*session, ended_by, wall);
     require_finite_json(j, "run's summary");
     std::cout << j.dump(2) << "\n";
-    // A recording that could not be written whole (a full disk, an I/O error): exit 2 naming the file.
-    if (const session::SessionRecorder* r = session->recorder(); r != nullptr && !r->error().empty()) {
-      std::cerr << "spidar-mr: error: --record: " << r->error() << " (the recording is incomplete)\n";
-      return kExitBadInput;
-    }
-    if (session->servo().stats().faults != 0) return kExitFault;
-    if (ended_by == "device stopped" || !session->error().empty()) return kExitFault;
-    return 0;
+    return live_exit_code(*session, ended_by);
   };
 }
 

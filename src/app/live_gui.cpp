@@ -1,5 +1,7 @@
 #include "live_gui.hpp"
 
+#include "live_exit.hpp"
+
 #include <GL/gl.h>
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -566,12 +568,7 @@ int run_gui(const session::LiveConfig& cfg, const session::LiveSessionOptions& o
       summary["hands"].push_back({{"offset_m", c.offset_W}, {"yaw_rad", c.yaw}, {"closeness", c.closeness}});
   }
   std::cout << summary.dump() << "\n";
-  if (!session->error().empty()) std::cerr << "spidar-mr run: " << session->error() << "\n";
-  if (const session::SessionRecorder* r = session->recorder(); r != nullptr && !r->error().empty()) {
-    std::cerr << "spidar-mr: error: --record: " << r->error() << " (the recording is incomplete)\n";
-    return kExitBadInput;
-  }
-  return st.faults != 0 || ended_by == "device stopped" || !session->error().empty() ? 1 : 0;
+  return live_exit_code(*session, ended_by);
 }
 
 }  // namespace spidar::app

@@ -76,7 +76,7 @@ TEST(Outputs, ReplayOfARecordingWithNoFingertipSamplesWritesNoNull) {
   const fs::path rec = dir / "rec";
   const spidar::test::Run made = run_cli("run --config configs/lab-example.yaml --headless --seconds 1.5 --record " + rec.string(),
                            "timeout 120 ");
-  ASSERT_EQ(made.code, 0) << made.err;
+  ASSERT_EQ(made.code, 0) << made.err << made.out;
   const std::string tips = slurp(rec / "fingertips.csv");
   std::ofstream(rec / "fingertips.csv", std::ios::binary) << tips.substr(0, tips.find('\n') + 1);
   auto session = nlohmann::json::parse(slurp(rec / "session.json"));
