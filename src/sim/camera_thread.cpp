@@ -1,5 +1,6 @@
 #include "spidar/sim/camera_thread.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <utility>
@@ -32,6 +33,9 @@ Result<std::unique_ptr<CameraThread>> CameraThread::prepare(
     const CameraThreadParams& params) {
   if (!(params.fps > 0 && params.fps <= 1000)) return Error{"camera thread: fps must be in (0, 1000]"};
   if (!truth_at) return Error{"camera thread: no ground-truth source given"};
+  for (const auto& [name, ns] : {std::pair{"readout_ns", params.readout_ns}, std::pair{"truth_wait_ns", params.truth_wait_ns}})
+    if (ns < 0 || ns > 1'000'000'000)
+      return Error{std::string("camera thread: ") + name + " must be in [0, 1e9] ns, got " + std::to_string(ns)};
   std::unique_ptr<CameraThread> c(new CameraThread());
   c->params_ = params;
   c->truth_at_ = std::move(truth_at);
@@ -119,7 +123,7 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
   std::uint64_t index = 0;
   std::int64_t t_exp = t0_ns;
   while (!stop_.load(std::memory_order_acquire)) {
-    core::sleep_until_ns(t_exp + params_.readout_ns);
+    core::sleep_until_ns(t_exp + std::min(params_.truth_wait_ns, params_.readout_ns));
     if (stop_.load(std::memory_order_acquire)) break;
     const std::int64_t t_start = core::monotonic_ns();
     if (truth_at_(t_exp, caps)) {
@@ -138,6 +142,7 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
         break;
       }
       out.film_ms = core::ns_to_s(core::monotonic_ns() - t_start) * 1e3;
+      core::sleep_until_ns(t_exp + params_.readout_ns);  // not before the sensor has read it out
       {
         std::lock_guard lock(newest_mutex_);
         newest_ = std::move(frame);  // a newer frame replaces one not taken (back to the pool)

@@ -3,9 +3,11 @@
 // demo's frames.csv `dropped_before` column sums to at most the report's figures).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <thread>
 #include <vector>
@@ -119,6 +121,56 @@ TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
   const FilmedFrame& f = cam.frame();
   EXPECT_EQ(f.t_exposure_ns, t0.load() + static_cast<std::int64_t>(f.index) * period_ns);
   EXPECT_LE(f.index + 1, cam.filmed() + cam.skipped());
+}
+
+// The posing and filming run during the sensor's readout, not after it: the truth is asked for
+// once the fingertip sample at the exposure can be there (truth_wait_ns after it), and no frame is
+// published before its readout has ended (readout_ns after the exposure), however fast the
+// filming. A long readout (200 ms) makes both visible at any speed; a negative one is refused.
+TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
+  const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
+                                             hand::default_hand_model(hand::Side::kRight)};
+  RubiksTask task({});
+  CameraThreadParams params;
+  params.fps = 4;
+  params.readout_ns = 200'000'000;
+  params.truth_wait_ns = 1'000'000;
+  params.t0_ns = core::monotonic_ns() + 200'000'000;  // after the thread's start and warm-up frame
+  const std::int64_t t0 = params.t0_ns;
+  std::vector<std::int64_t> asked_after;  // monotonic time of each truth request minus its exposure
+  std::mutex m;
+  TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
+    const std::int64_t now = core::monotonic_ns();
+    {
+      const std::lock_guard lock(m);
+      asked_after.push_back(now - t_ns);
+    }
+    nominal_caps(truth, task, 1.0 + core::ns_to_s(t_ns - t0), out);
+    return true;
+  };
+  auto thread = CameraThread::start(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+  ASSERT_TRUE(thread.ok()) << thread.error().message;
+  CameraThread& cam = *thread.value();
+  std::vector<std::int64_t> published_after;  // when take() first saw a frame, minus its exposure
+  for (int i = 0; i < 4000 && published_after.size() < 3; ++i) {  // waits for frames, not for a time
+    if (cam.take()) published_after.push_back(core::monotonic_ns() - cam.frame().t_exposure_ns);
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  cam.stop();
+  ASSERT_EQ(published_after.size(), 3u) << cam.error();
+  for (std::int64_t d : published_after) EXPECT_GE(d, params.readout_ns) << "published before its readout";
+  const std::lock_guard lock(m);
+  ASSERT_GE(asked_after.size(), 3u);
+  for (std::int64_t d : asked_after) EXPECT_GE(d, params.truth_wait_ns) << "truth asked before its sample";
+  // The truth was asked for before the readout ended (a frame filmed after it would add the
+  // filming to the latency): at least one of them, whatever the machine's load.
+  EXPECT_LT(*std::min_element(asked_after.begin(), asked_after.end()), params.readout_ns);
+
+  CameraThreadParams bad = params;
+  bad.readout_ns = -1;
+  auto refused = CameraThread::prepare(vision::default_rig_camera(), truth, {}, task, truth_at, bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("readout_ns"), std::string::npos) << refused.error().message;
 }
 
 // A frame taken and held (CameraThread::shared) is not filmed over while the camera goes on: its

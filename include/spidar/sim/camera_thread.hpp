@@ -47,7 +47,13 @@ using TruthAt = std::function<bool(std::int64_t t_ns, std::span<Vec3> out)>;
 struct CameraThreadParams {
   double fps = 30.0;
   std::int64_t t0_ns = 0;        ///< script time 0 (host monotonic) [ns]: start() only (prepare() + begin())
-  std::int64_t readout_ns = 2'000'000;  ///< wait after the exposure before filming [ns]
+  /// The sensor's readout [ns]: a frame is published no earlier than this after its exposure.
+  std::int64_t readout_ns = 2'000'000;
+  /// Wait after the exposure before posing and filming [ns]: the simulated device's fingertip
+  /// sample at the exposure (one servo period, 1 ms, and a margin) is then there to interpolate.
+  /// The posing and filming (the simulation's own cost, which a real sensor does not have) run
+  /// during the readout, not after it.
+  std::int64_t truth_wait_ns = 1'200'000;
   /// The thread's niceness (core::set_nice, best effort): the simulated camera is hardware, which
   /// films at its rate whatever the host does, so it goes before the frame thread and the outputs
   /// that share the CPU with it. Needs CAP_SYS_NICE below 0; without it, a normal share.
