@@ -15,6 +15,7 @@
 #include "live_gui.hpp"
 #include "spidar/session/live_session.hpp"
 #include "signal_scope.hpp"
+#include "spidar/core/clock.hpp"
 #include "spidar/core/config.hpp"
 
 namespace spidar::app {
@@ -106,7 +107,7 @@ Action add_run(CLI::App& app) {
         ended_by = session->camera_ended() ? "camera ended" : "device stopped";
         break;
       }
-      if (!session->step()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      if (!session->step()) session->wait_for_frame(core::monotonic_ns() + 5'000'000);
       if (session->seconds() >= next_report) {
         next_report += 1.0;
         const auto& h = session->history();

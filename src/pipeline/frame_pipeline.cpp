@@ -7,6 +7,7 @@
 
 #include "spidar/hand/joint_limits.hpp"
 #include "spidar/hand/kinematics.hpp"
+#include "spidar/core/side_task.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/coverage.hpp"
 #include "spidar/registration/fingertip_reach.hpp"
@@ -102,6 +103,14 @@ struct FramePipeline::Impl {
   /// One estimator for both hands (ShapeEstimatorParams::shared_hands), or one per hand.
   std::vector<registration::ShapeEstimator> shape;
   std::array<hand::HandDimensions, 2> skin_dims;
+  /// The helper thread of FramePipelineParams::side_by_side (made at the first frame, by the
+  /// thread that processes it).
+  core::SideTask side;
+  /// This frame's predicted bracelets (find_bracelets): where the previous fits put them [px].
+  std::array<Vec2, 2> predicted_wrist_px{Vec2::Zero(), Vec2::Zero()};
+
+  Status key_and_evidence(const cv::Mat& bgr, const vision::ChromaKeyResult* matte, FrameResult* out);
+  Status find_bracelets(const cv::Mat& bgr, FrameResult* out);
 
   Impl(const FramePipelineParams& p, vision::ChromaKeyer k,
        const std::array<hand::HandModel, 2>& given)
@@ -194,17 +203,14 @@ void FramePipeline::use_model_sizes(const std::array<hand::HandModel, 2>& models
   }
 }
 
-Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample& tips,
-                              const SceneSnapshot& world, FrameResult* out,
-                              bool registration_only, const vision::ChromaKeyResult* matte) {
-  if (out == nullptr) return Error{"frame pipeline: no output given"};
-  Impl& s = *impl_;
+/// The chroma key (or the matte given for this image) and, for the silhouette term, its
+/// distance transform and which hand owns which silhouette pixel at the previous fits. Writes
+/// out->key, out->timings.{key,distance}_ms, s.distance, s.outlines and s.owned only.
+Status FramePipeline::Impl::key_and_evidence(const cv::Mat& bgr, const vision::ChromaKeyResult* matte,
+                                             FrameResult* out) {
+  Impl& s = *this;
   const FramePipelineParams& p = s.params;
-  if (auto st = check_frame(bgr, s.camera); !st) return st;
-  const auto t_start = Clock::now();
   FrameTimings& tm = out->timings;
-
-  // Chroma key (or the one given for this image).
   auto t0 = Clock::now();
   if (matte != nullptr) {
     if (matte->alpha.size() != bgr.size() || matte->silhouette.size() != bgr.size())
@@ -215,12 +221,41 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   }
   tm.key_ms = ms_since(t0);
 
-  // Bracelets, predicted from the previous frame's wrists.
   t0 = Clock::now();
+  if (p.registration.silhouette_term && p.registration.silhouette_inward) {
+    vision::SilhouetteDistanceOptions o;
+    o.max_distance_px = p.silhouette_margin_px;
+    o.downsample = p.silhouette_downsample;
+    if (auto st = vision::silhouette_distance(out->key.silhouette, &s.distance, o); !st) return st;
+  }
+  if (p.registration.silhouette_term) {
+    if (s.have_previous) {
+      for (int h = 0; h < 2; ++h) {
+        const double forearm_radius =
+            registration::bracelet_radius_m(p.registration, s.models[h].shape.dimensions.width);
+        registration::project_hand(s.models[h], s.previous[h], s.camera, forearm_radius, &s.outlines[h]);
+      }
+      registration::coverage_evidence(out->key.silhouette, {&s.outlines[0], &s.outlines[1]},
+                                      p.registration, &s.owned);
+    } else {
+      for (auto& pixels : s.owned) pixels.clear();
+    }
+  }
+  tm.distance_ms = ms_since(t0);
+  return Ok{};
+}
+
+/// Both bracelets, each searched for where the previous fit puts it. Writes out->bracelets,
+/// out->timings.bracelet_ms, s.bracelet_ws and s.predicted_wrist_px only.
+Status FramePipeline::Impl::find_bracelets(const cv::Mat& bgr, FrameResult* out) {
+  Impl& s = *this;
+  const FramePipelineParams& p = s.params;
+  const auto t0 = Clock::now();
   // Predicted bracelets: where the previous fit puts each hand's bracelet (registration's
   // bracelet_offset_m from the wrist toward the elbow).
   vision::BraceletPrediction prediction;
-  std::array<Vec2, 2> predicted{};
+  std::array<Vec2, 2>& predicted = s.predicted_wrist_px;
+  predicted.fill(Vec2::Zero());
   if (s.have_previous) {
     for (int h = 0; h < 2; ++h) {
       const Pose X_WH = hand::hand_pose(s.previous[h]);
@@ -248,41 +283,40 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       }
     }
   }
-  auto bracelets = vision::detect_bracelets(bgr, p.bracelet, s.have_previous ? &prediction : nullptr,
-                                            &s.bracelet_ws);
-  if (!bracelets) return bracelets.error();
-  out->bracelets = *bracelets;
-  tm.bracelet_ms = ms_since(t0);
+  auto found = vision::detect_bracelets(bgr, p.bracelet, s.have_previous ? &prediction : nullptr,
+                                        &s.bracelet_ws);
+  if (!found) return found.error();
+  out->bracelets = *found;
+  out->timings.bracelet_ms = ms_since(t0);
+  return Ok{};
+}
 
-  // Silhouette distance (only for the optional silhouette term).
-  t0 = Clock::now();
+Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample& tips,
+                              const SceneSnapshot& world, FrameResult* out,
+                              bool registration_only, const vision::ChromaKeyResult* matte) {
+  if (out == nullptr) return Error{"frame pipeline: no output given"};
+  Impl& s = *impl_;
+  const FramePipelineParams& p = s.params;
+  if (auto st = check_frame(bgr, s.camera); !st) return st;
+  const auto t_start = Clock::now();
+  FrameTimings& tm = out->timings;
+
+  // The image's two independent stages side by side (FramePipelineParams::side_by_side): the
+  // matte and the silhouette evidence built on it on the helper thread, the bracelets on this one.
+  // Each writes only its own outputs; both read the previous fits, which neither changes.
+  Status key_status = Ok{}, bracelet_status = Ok{};
+  auto matte_and_evidence = [&] { key_status = s.key_and_evidence(bgr, matte, out); };
+  auto bracelets = [&] { bracelet_status = s.find_bracelets(bgr, out); };
+  core::run_side_by_side(p.side_by_side ? &s.side : nullptr, matte_and_evidence, bracelets);
+  if (!key_status) return key_status;
+  if (!bracelet_status) return bracelet_status;
   registration::ImageEvidence image;
   image.camera = &s.camera;
   image.alpha = out->key.alpha;
-  if (p.registration.silhouette_term && p.registration.silhouette_inward) {
-    vision::SilhouetteDistanceOptions o;
-    o.max_distance_px = p.silhouette_margin_px;
-    o.downsample = p.silhouette_downsample;
-    if (auto st = vision::silhouette_distance(out->key.silhouette, &s.distance, o); !st) return st;
-    image.distance = &s.distance;
-  }
-  if (p.registration.silhouette_term) {
-    if (s.have_previous) {
-      for (int h = 0; h < 2; ++h) {
-        const double forearm_radius =
-            registration::bracelet_radius_m(p.registration, s.models[h].shape.dimensions.width);
-        registration::project_hand(s.models[h], s.previous[h], s.camera, forearm_radius, &s.outlines[h]);
-      }
-      registration::coverage_evidence(out->key.silhouette, {&s.outlines[0], &s.outlines[1]},
-                                      p.registration, &s.owned);
-    } else {
-      for (auto& pixels : s.owned) pixels.clear();
-    }
-  }
-  tm.distance_ms = ms_since(t0);
+  if (p.registration.silhouette_term && p.registration.silhouette_inward) image.distance = &s.distance;
 
   // Successive adjustment of both hands.
-  t0 = Clock::now();
+  auto t0 = Clock::now();
   out->restarts = 0;
   out->depth_switches = 0;
   out->reaches = 0;
@@ -303,7 +337,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     // broken detection than a jump of the hand: it is not used (gate scaled to the image width).
     const double gate = p.bracelet_gate * s.camera.width();
     if (out->bracelets[h].found &&
-        (gate <= 0 || !s.have_previous || (out->bracelets[h].wrist_px - predicted[h]).norm() <= gate)) {
+        (gate <= 0 || !s.have_previous || (out->bracelets[h].wrist_px - s.predicted_wrist_px[h]).norm() <= gate)) {
       obs.wrist_px = out->bracelets[h].wrist_px;
       obs.wrist_confidence = out->bracelets[h].confidence;
       // A whole band's length says how far along its ray the wrist is (residuals.hpp, the band

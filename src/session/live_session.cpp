@@ -124,6 +124,7 @@ std::optional<DeviceCycleRecord> LiveSession::newest_device_cycle() const {
 }
 
 bool LiveSession::step() { return session_->step() == Session::Step::kFrame; }
+void LiveSession::wait_for_frame(std::int64_t deadline_ns) { session_->wait_for_frame(deadline_ns); }
 
 void LiveSession::stop() {
   if (!session_) return;

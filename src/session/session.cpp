@@ -10,6 +10,11 @@
 #include "spidar/sim/synthetic_camera.hpp"
 
 namespace spidar::session {
+namespace {
+/// The longest the frame thread waits for a frame before it looks at the run's state again (an
+/// interruption, the seconds, a stopped servo loop) [ns].
+constexpr std::int64_t kFrameWaitNs = 5'000'000;
+}  // namespace
 
 Session::Session(Rig& rig, Scene& scene, render::Context& context, const SessionParams& params)
     : rig_(rig), scene_(scene), context_(context), params_(params) {}
@@ -133,7 +138,12 @@ bool Session::take_inputs(std::int64_t t_exposure_ns, ServoTiming* servo) {
     }
     return true;
   }
-  const std::size_t ns = haptic_->loop().newest_samples(servo_buf_.data(), servo_buf_.size());
+  // Back to the exposure and to the last frame's newest sample (the servo timing since then).
+  const std::int64_t back_to = last_servo_t_ > 0 ? std::min(t_exposure_ns, last_servo_t_) : 0;
+  const device::ServoLoop& loop = haptic_->loop();
+  const std::size_t ns = device::read_back_to(
+      [&loop](device::FingertipSample* out, std::size_t max) { return loop.newest_samples(out, max); }, back_to,
+      std::span(servo_buf_));
   const auto measured = device::interpolate_samples({servo_buf_.data(), ns}, t_exposure_ns);
   if (!measured) return false;
   measured_ = *measured;
@@ -144,6 +154,14 @@ bool Session::take_inputs(std::int64_t t_exposure_ns, ServoTiming* servo) {
 }
 
 std::uint64_t Session::camera_frames() const { return rig_.camera().delivered(); }
+
+void Session::wait_for_frame(std::int64_t deadline_ns) {
+  if (!started_ || threads_stopped_) {
+    core::sleep_until_ns(std::min(deadline_ns, core::monotonic_ns() + kFrameWaitNs));
+    return;
+  }
+  rig_.camera().wait_for_frame(deadline_ns);
+}
 
 Session::Step Session::step() {
   if (!started_ || threads_stopped_) return Step::kNoFrame;
@@ -225,9 +243,9 @@ SessionSummary Session::run(const std::function<std::optional<std::string>()>& i
     }
     const Step st = step();
     if (st == Step::kPastEnd) break;
-    if (st == Step::kNoFrame) {  // wait for the next frame
+    if (st == Step::kNoFrame) {  // wait for the next frame (woken when it is published)
       if (params_.seconds > 0 && seconds() > params_.seconds + 1.0) break;
-      std::this_thread::sleep_for(std::chrono::microseconds(500));
+      wait_for_frame(core::monotonic_ns() + kFrameWaitNs);
     }
   }
   return stop(ended_by);

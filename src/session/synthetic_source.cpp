@@ -20,7 +20,10 @@ class SyntheticSource final : public FrameSource {
     truth_buf_.resize(1000);
     // The ground truth comes from the simulated device: where it holds the user's fingertips.
     sim::TruthAt truth_at = [this](std::int64_t t_ns, std::span<Vec3> out) {
-      const std::size_t n = dev_.truth_samples(truth_buf_.data(), truth_buf_.size());
+      const device::SimulatedSpidar& dev = dev_;
+      const std::size_t n = device::read_back_to(
+          [&dev](device::FingertipSample* o, std::size_t max) { return dev.truth_samples(o, max); }, t_ns,
+          std::span(truth_buf_));
       const auto s = device::interpolate_samples({truth_buf_.data(), n}, t_ns);
       if (!s) return false;
       for (std::size_t f = 0; f < out.size() && f < 8; ++f)
@@ -50,6 +53,9 @@ class SyntheticSource final : public FrameSource {
     out->t_exposure_ns = f.t_exposure_ns;
     out->filmed = &f;
     return true;
+  }
+  void wait_for_frame(std::int64_t deadline_ns) override {
+    if (thread_ && !stopped_) thread_->wait_for_frame(deadline_ns);
   }
   bool ended() const override { return stopped_ && thread_ && !thread_->error().empty(); }
   std::string error() const override { return stopped_ && thread_ ? thread_->error() : std::string(); }

@@ -2,6 +2,7 @@
 // camera filming the interactively controlled hands.
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <future>
 #include <mutex>
 #include <thread>
@@ -30,6 +31,14 @@ class ThreadedSource : public FrameSource {
     out->filmed_hold.reset();
     return true;
   }
+  void wait_for_frame(std::int64_t deadline_ns) override {
+    std::unique_lock lock(mutex_);
+    while (!fresh_ && !done_.load(std::memory_order_acquire)) {
+      const std::int64_t left = deadline_ns - core::monotonic_ns();
+      if (left <= 0) break;
+      arrived_.wait_for(lock, std::chrono::nanoseconds(left));
+    }
+  }
   bool ended() const override { return done_.load(std::memory_order_acquire); }
   std::string error() const override {
     std::lock_guard lock(mutex_);
@@ -51,17 +60,25 @@ class ThreadedSource : public FrameSource {
       fresh_ = true;
     }
     delivered_.fetch_add(1, std::memory_order_acq_rel);
+    arrived_.notify_all();
   }
   void fail(const std::string& message) {
     std::lock_guard lock(mutex_);
     error_ = message;
   }
-  void finish() { done_.store(true, std::memory_order_release); }
+  void finish() {
+    {
+      std::lock_guard lock(mutex_);  // a waiter between its check and its wait misses no wake-up
+      done_.store(true, std::memory_order_release);
+    }
+    arrived_.notify_all();
+  }
   bool stopping() const { return stop_.load(std::memory_order_acquire); }
   std::thread thread_;
 
  private:
   mutable std::mutex mutex_;
+  std::condition_variable arrived_;  ///< a frame published or the source finished (mutex_)
   cv::Mat latest_;
   std::int64_t latest_t_ = 0;
   bool fresh_ = false;

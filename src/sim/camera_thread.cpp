@@ -82,6 +82,16 @@ void CameraThread::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
+bool CameraThread::wait_for_frame(std::int64_t deadline_ns) {
+  std::unique_lock lock(newest_mutex_);
+  while (!newest_ && !ended_) {
+    const std::int64_t left = deadline_ns - core::monotonic_ns();
+    if (left <= 0) break;
+    arrived_.wait_for(lock, std::chrono::nanoseconds(left));
+  }
+  return newest_ != nullptr;
+}
+
 bool CameraThread::take() {
   std::lock_guard lock(newest_mutex_);
   if (!newest_) return false;
@@ -93,6 +103,17 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
                        const SyntheticCameraParams& film_params, const RubiksTask& task,
                        std::function<void(Status)> ready) {
   (void)core::set_nice(params_.nice);  // best effort (see CameraThreadParams::nice)
+  // However the thread ends, a frame thread waiting for a frame is woken.
+  struct WakeWaitersAtEnd {
+    CameraThread& c;
+    ~WakeWaitersAtEnd() {
+      {
+        std::lock_guard lock(c.newest_mutex_);
+        c.ended_ = true;
+      }
+      c.arrived_.notify_all();
+    }
+  } wake_at_end{*this};
   // The GL context lives (and is current) on this thread only.
   auto ctx = render::Context::create_headless();
   if (!ctx) return ready(Error{"camera thread: OpenGL: " + ctx.error().message});
@@ -147,6 +168,7 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
         std::lock_guard lock(newest_mutex_);
         newest_ = std::move(frame);  // a newer frame replaces one not taken (back to the pool)
       }
+      arrived_.notify_all();
       filmed_.fetch_add(1, std::memory_order_acq_rel);
     } else {
       // No fingertips yet at this exposure (the device's first samples come later on a busy

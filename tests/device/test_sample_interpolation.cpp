@@ -1,6 +1,8 @@
 // Fingertip samples at a camera frame's exposure time, and the simulated device's ground truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <span>
 #include <vector>
 
 #include "device_test_support.hpp"
@@ -44,6 +46,61 @@ TEST(SampleInterpolation, LinearBetweenNeighbours) {
     EXPECT_NEAR(x->tension[1], 3.0, 1e-12);
     EXPECT_EQ(x->command[0], 100 + static_cast<int>(k));  // the command in effect at t
     EXPECT_EQ(x->cycle, static_cast<std::uint64_t>(k));
+  }
+}
+
+// read_back_to reads as few samples as reach back to the time asked for, and the interpolation
+// on them equals the one on the whole history, for every time the history covers.
+TEST(SampleInterpolation, ReadBackToReadsOnlyWhatReachesTheTimeAndInterpolatesAsTheWholeRing) {
+  const auto ring = linear_samples(1000);  // 1 s of samples, 1 ms apart, newest first
+  std::vector<std::size_t> asked;
+  auto read = [&](FingertipSample* out, std::size_t max) {
+    asked.push_back(max);
+    const std::size_t n = std::min(max, ring.size());
+    std::copy(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(n), out);
+    return n;
+  };
+  std::vector<FingertipSample> buf(1000);
+  const std::int64_t newest = ring.front().t_ns;
+  // 3.5 ms ago: the first 32 are enough.
+  std::size_t n = read_back_to(read, newest - 3'500'000, std::span(buf), 32);
+  EXPECT_EQ(n, 32u);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{32}));
+  // 100.5 ms ago: 32, 128.
+  asked.clear();
+  n = read_back_to(read, newest - 100'500'000, std::span(buf), 32);
+  EXPECT_EQ(n, 128u);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{32, 128}));
+  // Older than the ring: all of the buffer, then no more tries.
+  asked.clear();
+  n = read_back_to(read, newest - 5'000'000'000, std::span(buf), 32);
+  EXPECT_EQ(n, 1000u);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{32, 128, 512, 1000}));
+  // A source with fewer samples than asked for: what it has, in one try.
+  asked.clear();
+  auto short_read = [&](FingertipSample* out, std::size_t max) {
+    asked.push_back(max);
+    const std::size_t n5 = std::min<std::size_t>(max, 5);
+    std::copy(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(n5), out);
+    return n5;
+  };
+  EXPECT_EQ(read_back_to(short_read, newest - 100'000'000, std::span(buf), 32), 5u);
+  EXPECT_EQ(asked.size(), 1u);
+  // An empty source.
+  auto none = [](FingertipSample*, std::size_t) { return std::size_t{0}; };
+  EXPECT_EQ(read_back_to(none, newest, std::span(buf), 32), 0u);
+  // The interpolation on what was read equals the one on the whole ring.
+  for (std::int64_t ago : {0LL, 700'000LL, 31'200'000LL, 32'000'000LL, 250'300'000LL, 998'900'000LL}) {
+    const std::int64_t t = newest - ago;
+    n = read_back_to(read, t, std::span(buf), 32);
+    const auto part = interpolate_samples(std::span<const FingertipSample>(buf.data(), n), t);
+    const auto whole = interpolate_samples(ring, t);
+    ASSERT_EQ(part.has_value(), whole.has_value()) << ago;
+    ASSERT_TRUE(whole.has_value()) << ago;
+    EXPECT_EQ(part->t_ns, whole->t_ns) << ago;
+    EXPECT_EQ(part->p_W, whole->p_W) << ago;
+    EXPECT_EQ(part->tension, whole->tension) << ago;
+    EXPECT_EQ(part->cycle, whole->cycle) << ago;
   }
 }
 

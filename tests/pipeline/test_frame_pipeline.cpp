@@ -270,6 +270,51 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
   ASSERT_TRUE(context_->make_current().ok());
 }
 
+// The matte and silhouette evidence on a helper thread beside the bracelets on the caller
+// (FramePipelineParams::side_by_side) give exactly the serial pipeline's fits, mattes, bracelets
+// and pictures, frame after frame (each stage writes only its own outputs).
+TEST_F(FramePipelineTest, SideBySideStagesGiveTheSerialResults) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  p.registration.silhouette_term = true;  // the evidence stage on the helper does its whole work
+  p.registration.silhouette_inward = true;
+  sim::RubiksTask task({});
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(1.5, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  FramePipelineParams serial_params = p;
+  p.side_by_side = true;
+  serial_params.side_by_side = false;
+  auto side = FramePipeline::create(*context_, camera_, models_, p).value();
+  auto serial = FramePipeline::create(*context_, camera_, models_, serial_params).value();
+  sim::UserHands user(truth_models_, task);
+  sim::SyntheticFrame frame;
+  FrameResult a, b;
+  int found = 0;
+  for (double t = 1.5; t < 2.3; t += 1.0 / 30) {
+    const auto sample = pose_user(user, task, t);
+    const auto& truth = user.params();
+    ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+    ASSERT_TRUE(side->process(frame.bgr, sample, scene_, &a).ok()) << t;
+    ASSERT_TRUE(serial->process(frame.bgr, sample, scene_, &b).ok()) << t;
+    EXPECT_EQ(cv::norm(a.key.alpha, b.key.alpha, cv::NORM_INF), 0.0) << t;
+    EXPECT_EQ(cv::norm(a.key.silhouette, b.key.silhouette, cv::NORM_INF), 0.0) << t;
+    for (int h = 0; h < 2; ++h) {
+      EXPECT_EQ(a.bracelets[h].found, b.bracelets[h].found) << t;
+      if (a.bracelets[h].found && b.bracelets[h].found) {
+        ++found;
+        EXPECT_EQ((a.bracelets[h].wrist_px - b.bracelets[h].wrist_px).norm(), 0.0) << t;
+      }
+      ASSERT_EQ((a.hands[h].q - b.hands[h].q).norm(), 0.0) << "hand " << h << " at " << t;
+    }
+    EXPECT_EQ(cv::norm(a.composite, b.composite, cv::NORM_INF), 0.0) << t;
+    EXPECT_GT(a.timings.key_ms, 0.0);
+    EXPECT_GT(a.timings.bracelet_ms, 0.0);
+  }
+  EXPECT_GT(found, 20);  // the bracelets were seen: the stage on the caller did its work
+}
+
 // A fit that cannot agree with the strings is no evidence on the hand's sizes: with the right
 // hand's caps three times as far apart as the hand has them (past any pose of the hand: at twice,
 // fingers re-posed to their strings, registration/fingertip_reach.hpp, reach some of them within

@@ -23,23 +23,34 @@
 namespace spidar::sim {
 namespace {
 
-/// The script's nominal fingertips of both hands at script time t (what the simulated device's
-/// ground truth gives a camera thread), into out[0..7].
-void nominal_caps(const std::array<hand::HandModel, 2>& truth, const RubiksTask& task, double t,
-                  std::span<Vec3> out) {
-  for (int h = 0; h < 2; ++h) {
-    const hand::HandModel& m = truth[static_cast<std::size_t>(h)];
-    const hand::HandPoints pts = hand::forward_kinematics(m, task.nominal(t, m.side));
-    for (int f = 0; f < hand::kFingertipCount; ++f) out[static_cast<std::size_t>(4 * h + f)] = pts.p_W_fingertip[f];
+/// What every camera here films: the default hands at the Rubik's task's nominal poses, on the
+/// default rig camera.
+struct Filmed {
+  std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
+                                       hand::default_hand_model(hand::Side::kRight)};
+  RubiksTask task{{}};
+
+  /// The script's nominal fingertips of both hands at script time t (what the simulated device's
+  /// ground truth gives a camera thread), into out[0..7].
+  void caps(double t, std::span<Vec3> out) const {
+    for (int h = 0; h < 2; ++h) {
+      const hand::HandModel& m = truth[static_cast<std::size_t>(h)];
+      const hand::HandPoints pts = hand::forward_kinematics(m, task.nominal(t, m.side));
+      for (int f = 0; f < hand::kFingertipCount; ++f) out[static_cast<std::size_t>(4 * h + f)] = pts.p_W_fingertip[f];
+    }
   }
-}
+  Result<std::unique_ptr<CameraThread>> start(TruthAt truth_at, const CameraThreadParams& params) const {
+    return CameraThread::start(vision::default_rig_camera(), truth, {}, task, std::move(truth_at), params);
+  }
+  Result<std::unique_ptr<CameraThread>> prepare(TruthAt truth_at, const CameraThreadParams& params) const {
+    return CameraThread::prepare(vision::default_rig_camera(), truth, {}, task, std::move(truth_at), params);
+  }
+};
 
 // The ground truth has no fingertips for the first 0.2 s (as when the device's first samples
 // come late on a busy machine): those exposures are skipped, not lost from the counts.
 TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
-  const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
-                                             hand::default_hand_model(hand::Side::kRight)};
-  RubiksTask task({});
+  const Filmed filmed;
   CameraThreadParams params;
   params.fps = 30;
   params.t0_ns = core::monotonic_ns();
@@ -50,10 +61,10 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
       ++refused;
       return false;
     }
-    nominal_caps(truth, task, core::ns_to_s(t_ns - t0), out);
+    filmed.caps(core::ns_to_s(t_ns - t0), out);
     return true;
   };
-  auto thread = CameraThread::start(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+  auto thread = filmed.start(truth_at, params);
   ASSERT_TRUE(thread.ok()) << thread.error().message;
   CameraThread& cam = *thread.value();
   std::uint64_t last_index = 0;
@@ -80,26 +91,24 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
 // at the t0 begin() gives, however long ago prepare() was, and none was skipped for the time
 // the preparation took. Stopping a camera that never began ends its thread.
 TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
-  const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
-                                             hand::default_hand_model(hand::Side::kRight)};
-  RubiksTask task({});
+  const Filmed filmed;
   std::atomic<std::int64_t> t0{0};
   std::atomic<int> asked_before_begin{0};
   TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
     if (t0.load() == 0) ++asked_before_begin;
-    nominal_caps(truth, task, 1.0 + core::ns_to_s(t_ns - t0.load()), out);
+    filmed.caps(1.0 + core::ns_to_s(t_ns - t0.load()), out);
     return true;
   };
   CameraThreadParams params;
   params.fps = 30;
   {
-    auto never = CameraThread::prepare(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+    auto never = filmed.prepare(truth_at, params);
     ASSERT_TRUE(never.ok()) << never.error().message;
     never.value()->stop();  // returns: the thread ended without beginning
     EXPECT_EQ(never.value()->filmed(), 0u);
     EXPECT_EQ(never.value()->skipped(), 0u);
   }
-  auto thread = CameraThread::prepare(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+  auto thread = filmed.prepare(truth_at, params);
   ASSERT_TRUE(thread.ok()) << thread.error().message;
   CameraThread& cam = *thread.value();
   std::this_thread::sleep_for(std::chrono::milliseconds(150));  // longer than 4 frame periods
@@ -129,9 +138,7 @@ TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
 // filming. A readout of a second (longer than any stall of a loaded machine, and than the frame
 // period: the frames overlap) makes both visible at any speed; a negative one is refused.
 TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
-  const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
-                                             hand::default_hand_model(hand::Side::kRight)};
-  RubiksTask task({});
+  const Filmed filmed;
   CameraThreadParams params;
   params.fps = 4;
   params.readout_ns = 1'000'000'000;
@@ -146,10 +153,10 @@ TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
       const std::lock_guard lock(m);
       asked_after.push_back(now - t_ns);
     }
-    nominal_caps(truth, task, 1.0 + core::ns_to_s(t_ns - t0), out);
+    filmed.caps(1.0 + core::ns_to_s(t_ns - t0), out);
     return true;
   };
-  auto thread = CameraThread::start(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+  auto thread = filmed.start(truth_at, params);
   ASSERT_TRUE(thread.ok()) << thread.error().message;
   CameraThread& cam = *thread.value();
   std::vector<std::int64_t> published_after;  // when take() first saw a frame, minus its exposure
@@ -169,26 +176,65 @@ TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
 
   CameraThreadParams bad = params;
   bad.readout_ns = -1;
-  auto refused = CameraThread::prepare(vision::default_rig_camera(), truth, {}, task, truth_at, bad);
+  auto refused = filmed.prepare(truth_at, bad);
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.error().message.find("readout_ns"), std::string::npos) << refused.error().message;
+}
+
+// The frame thread sleeps in wait_for_frame until a frame is published (it is woken, not polling):
+// each wait with a far deadline returns with a frame to take; a camera that has not begun gives
+// none by the deadline; a stopped one wakes its waiter at once.
+TEST(CameraThread, WaitForFrameWakesAtThePublicationAndEndsWithTheThread) {
+  const Filmed filmed;
+  std::atomic<std::int64_t> t0{0};
+  TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
+    filmed.caps(1.0 + core::ns_to_s(t_ns - t0.load()), out);
+    return true;
+  };
+  CameraThreadParams params;
+  params.fps = 20;
+  auto thread = filmed.prepare(truth_at, params);
+  ASSERT_TRUE(thread.ok()) << thread.error().message;
+  CameraThread& cam = *thread.value();
+  EXPECT_FALSE(cam.wait_for_frame(core::monotonic_ns() + 100'000'000));  // not begun: no frame
+  EXPECT_FALSE(cam.take());
+  t0 = core::monotonic_ns();
+  cam.begin(t0.load());
+  constexpr std::int64_t kFar = 60'000'000'000;  // a minute: only a frame ends these waits
+  std::uint64_t last = 0;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(cam.wait_for_frame(core::monotonic_ns() + kFar)) << cam.error();
+    ASSERT_TRUE(cam.take());
+    if (k > 0) {
+      EXPECT_GT(cam.frame().index, last);
+    }
+    last = cam.frame().index;
+  }
+  // Stopped from another thread while the frame thread waits: the waiter is woken.
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    cam.stop();
+  });
+  for (int k = 0; k < 100 && cam.wait_for_frame(core::monotonic_ns() + kFar); ++k) (void)cam.take();
+  const std::int64_t t_woken = core::monotonic_ns();
+  stopper.join();
+  EXPECT_FALSE(cam.wait_for_frame(core::monotonic_ns() + kFar));  // ended: returns, no frame
+  EXPECT_LT(core::monotonic_ns() - t_woken, kFar / 2);
 }
 
 // A frame taken and held (CameraThread::shared) is not filmed over while the camera goes on: its
 // index, exposure and image stay as they were when it was taken, however many frames come after.
 TEST(CameraThread, AHeldFrameIsNotFilmedOver) {
-  const std::array<hand::HandModel, 2> truth{hand::default_hand_model(hand::Side::kLeft),
-                                             hand::default_hand_model(hand::Side::kRight)};
-  RubiksTask task({});
+  const Filmed filmed;
   CameraThreadParams params;
   params.fps = 60;
   params.t0_ns = core::monotonic_ns();
   const std::int64_t t0 = params.t0_ns;
   TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
-    nominal_caps(truth, task, 1.0 + core::ns_to_s(t_ns - t0), out);  // hands in view, moving
+    filmed.caps(1.0 + core::ns_to_s(t_ns - t0), out);  // hands in view, moving
     return true;
   };
-  auto thread = CameraThread::start(vision::default_rig_camera(), truth, {}, task, truth_at, params);
+  auto thread = filmed.start(truth_at, params);
   ASSERT_TRUE(thread.ok()) << thread.error().message;
   CameraThread& cam = *thread.value();
   EXPECT_EQ(cam.shared(), nullptr);  // nothing taken yet
@@ -210,8 +256,8 @@ TEST(CameraThread, AHeldFrameIsNotFilmedOver) {
     std::this_thread::sleep_for(std::chrono::milliseconds(3));
   }
   // Let the camera film a few more frames over whatever it may still reuse.
-  const std::uint64_t filmed = cam.filmed();
-  for (int i = 0; i < 4000 && cam.filmed() < filmed + 5; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(3));
+  const std::uint64_t so_far = cam.filmed();
+  for (int i = 0; i < 4000 && cam.filmed() < so_far + 5; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(3));
   cam.stop();
   ASSERT_EQ(held.size(), 4u) << cam.error();
   for (const Held& h : held) {

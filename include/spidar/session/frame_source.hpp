@@ -52,6 +52,11 @@ class FrameSource {
   virtual Status start(std::int64_t t0_ns) = 0;
   /// The newest frame since the last call into `out`; false if none arrived.
   virtual bool take(CameraFrame* out) = 0;
+  /// Blocks until a frame may be ready to take(), the source stops, or `deadline_ns` [ns,
+  /// monotonic] passes, whichever is first; spurious returns are allowed. Sources that know when
+  /// they publish wake the frame thread at once (a condition variable); this default polls every
+  /// 0.5 ms.
+  virtual void wait_for_frame(std::int64_t deadline_ns);
   /// True once the source has ended (end of a file) or failed (error() says why).
   virtual bool ended() const = 0;
   virtual std::string error() const = 0;

@@ -54,6 +54,8 @@ class LiveSession {
   /// Processes the newest camera frame if one arrived since the last call; false if none did.
   /// Throws SpidarError if the pipeline fails.
   bool step();
+  /// Blocks until a frame may be ready for step(), or `deadline_ns` [ns, monotonic].
+  void wait_for_frame(std::int64_t deadline_ns);
   /// False once the servo loop ended (a device fault) or the camera ended (end of a file) or
   /// failed (error() says why).
   bool running() const { return session_->running(); }

@@ -86,6 +86,10 @@ class Session {
   /// Processes the newest camera frame if one arrived since the last call. An exception (the
   /// pipeline or a sink) stops the threads (device in its safe state) and propagates.
   Step step();
+  /// Blocks until the camera may have a frame for step(), or `deadline_ns` [ns, monotonic]
+  /// (FrameSource::wait_for_frame): the frame thread wakes when the frame is published rather
+  /// than at its next poll.
+  void wait_for_frame(std::int64_t deadline_ns);
 
   /// Steps until the servo loop stops (a fault), the camera ends, a frame is past `seconds`, no
   /// frame came for `seconds` + 1 s, or `interrupted()` names a reason (e.g. "SIGINT"); then

@@ -86,6 +86,9 @@ class CameraThread {
   /// The newest frame if one arrived since the last call (then `frame()` holds it). Frames filmed
   /// in between and never taken go back to the pool.
   bool take();
+  /// Blocks until a frame is ready to take(), the thread stops, or `deadline_ns` [ns, monotonic]
+  /// passes; true if a frame is ready.
+  bool wait_for_frame(std::int64_t deadline_ns);
   /// The frame the last successful take() gave (an empty frame before the first).
   const FilmedFrame& frame() const { return current_ ? *current_ : empty_; }
   /// The same frame, shared: the camera films into other frames (core::RecyclingPool) while anyone
@@ -114,6 +117,8 @@ class CameraThread {
   /// frame thread took last (its thread only).
   core::RecyclingPool<FilmedFrame> pool_;
   std::mutex newest_mutex_;
+  std::condition_variable arrived_;  ///< a frame published, or the thread ended (newest_mutex_)
+  bool ended_ = false;               ///< under newest_mutex_
   std::shared_ptr<FilmedFrame> newest_;
   std::shared_ptr<const FilmedFrame> current_;
   FilmedFrame empty_;

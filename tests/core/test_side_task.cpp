@@ -1,0 +1,148 @@
+#include "spidar/core/side_task.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <future>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace spidar::core {
+namespace {
+
+TEST(SideTask, RunsTheTaskOnAnotherThreadWhileTheCallerWorks) {
+  SideTask side;
+  // The task waits for the caller's part: run one after the other on one thread, it would wait
+  // out its (generous) timeout and see nothing.
+  std::mutex m;
+  std::condition_variable cv;
+  bool caller_done = false, task_saw_caller = false;
+  std::thread::id task_thread;
+  auto task = [&] {
+    task_thread = std::this_thread::get_id();
+    std::unique_lock lock(m);
+    task_saw_caller = cv.wait_for(lock, std::chrono::seconds(30), [&] { return caller_done; });
+  };
+  run_side_by_side(&side, task, [&] {
+    {
+      std::lock_guard lock(m);
+      caller_done = true;
+    }
+    cv.notify_all();
+  });
+  EXPECT_TRUE(task_saw_caller);
+  EXPECT_NE(task_thread, std::this_thread::get_id());
+  EXPECT_EQ(side.tasks_run(), 1u);
+  EXPECT_FALSE(side.busy());
+}
+
+TEST(SideTask, ManyTasksInARowEachRunOnceOnTheSameHelper) {
+  SideTask side;
+  std::vector<int> side_counts(2000, 0), own_counts(2000, 0);
+  std::thread::id helper;
+  bool one_helper = true;
+  for (int i = 0; i < 2000; ++i) {
+    run_side_by_side(
+        &side,
+        [&] {
+          ++side_counts[static_cast<std::size_t>(i)];
+          if (i == 0) helper = std::this_thread::get_id();
+          one_helper = one_helper && std::this_thread::get_id() == helper;
+        },
+        [&] { ++own_counts[static_cast<std::size_t>(i)]; });
+  }
+  for (int i = 0; i < 2000; ++i) {
+    ASSERT_EQ(side_counts[static_cast<std::size_t>(i)], 1) << "task " << i;
+    ASSERT_EQ(own_counts[static_cast<std::size_t>(i)], 1) << "task " << i;
+  }
+  EXPECT_TRUE(one_helper);
+  EXPECT_EQ(side.tasks_run(), 2000u);
+}
+
+TEST(SideTask, ATasksExceptionComesBackFromWaitAndTheHelperGoesOn) {
+  SideTask side;
+  auto throws = [] { throw std::runtime_error("bracelets: no red pixels"); };
+  side.start(throws);
+  try {
+    side.wait();
+    FAIL() << "wait() did not re-throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "bracelets: no red pixels");
+  }
+  int ran = 0;
+  auto fine = [&] { ++ran; };
+  side.start(fine);
+  EXPECT_NO_THROW(side.wait());
+  EXPECT_EQ(ran, 1);
+  // Both sides throwing: the caller's exception is the one seen, and the helper is waited for.
+  EXPECT_THROW(run_side_by_side(&side, throws, [] { throw std::logic_error("caller"); }), std::logic_error);
+  EXPECT_FALSE(side.busy());
+  EXPECT_EQ(side.tasks_run(), 3u);
+}
+
+TEST(SideTask, StartingBeforeWaitingIsRefusedAndWaitWithNothingStartedReturns) {
+  SideTask side;
+  EXPECT_NO_THROW(side.wait());
+  std::promise<void> release;
+  std::shared_future<void> gate = release.get_future().share();
+  auto blocked = [gate] { gate.wait(); };
+  side.start(blocked);
+  EXPECT_TRUE(side.busy());
+  auto other = [] {};
+  EXPECT_THROW(side.start(other), std::logic_error);
+  release.set_value();
+  side.wait();
+  EXPECT_FALSE(side.busy());
+}
+
+TEST(SideTask, WithoutAHelperBothPartsRunInOrderOnTheCaller) {
+  std::vector<std::string> order;
+  std::thread::id where;
+  run_side_by_side(
+      static_cast<SideTask*>(nullptr), [&] { order.push_back("a"); where = std::this_thread::get_id(); },
+      [&] { order.push_back("b"); });
+  EXPECT_EQ(order, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(where, std::this_thread::get_id());
+}
+
+TEST(SideTask, TheHelperRunsAtTheNiceValueOfTheThreadThatFirstStartedIt) {
+  // A thread of its own, made nicer (raising nice needs no privilege), makes the helper.
+  const int target = std::min(getpriority(PRIO_PROCESS, 0) + 3, 19);
+  int helper_nice = -100, own_nice = -100;
+  std::thread owner([&] {
+    const auto tid = static_cast<id_t>(gettid());
+    ASSERT_EQ(setpriority(PRIO_PROCESS, tid, target), 0);
+    own_nice = getpriority(PRIO_PROCESS, tid);
+    SideTask side;
+    auto read_nice = [&] { helper_nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())); };
+    side.start(read_nice);
+    side.wait();
+  });
+  owner.join();
+  EXPECT_EQ(own_nice, target);
+  EXPECT_EQ(helper_nice, target);
+}
+
+TEST(SideTask, DestroyingItWithATaskStillRunningFinishesTheTaskFirst) {
+  std::atomic<bool> finished{false};
+  {
+    SideTask side;
+    auto slow = [&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      finished = true;
+    };
+    side.start(slow);
+  }  // the destructor joins the helper after the task
+  EXPECT_TRUE(finished.load());
+}
+
+}  // namespace
+}  // namespace spidar::core
