@@ -561,10 +561,15 @@ Status FramePipeline::picture(const cv::Mat& bgr, const SceneSnapshot& world, Fr
   return Ok{};
 }
 
-Status warm_up(FramePipeline& pipeline, const WarmUpFrame& frame) {
+Status warm_up(FramePipeline& pipeline, const WarmUpFrame& frame, std::span<FrameResult* const> into) {
   FrameResult scratch;
-  if (auto st = pipeline.process(frame.bgr, frame.fingertips, frame.scene, &scratch); !st)
-    return Error{"warm-up frame: " + st.error().message};
+  std::vector<FrameResult*> outs(into.begin(), into.end());
+  if (outs.empty()) outs.push_back(&scratch);
+  for (FrameResult* out : outs) {
+    if (out == nullptr) return Error{"warm-up frame: no result given"};
+    if (auto st = pipeline.process(frame.bgr, frame.fingertips, frame.scene, out); !st)
+      return Error{"warm-up frame: " + st.error().message};
+  }
   pipeline.reset();
   return Ok{};
 }

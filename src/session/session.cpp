@@ -23,6 +23,8 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
                                          const vision::Camera& camera,
                                          const std::array<hand::HandModel, 2>& models,
                                          const SessionParams& params, device::Device* drive) {
+  if (params.warm_results < 1 || params.warm_results > 32)
+    throw SpidarError("session: warm_results must be in 1..32, got " + std::to_string(params.warm_results));
   std::unique_ptr<Session> s(new Session(rig, scene, context, params));
   s->camera_ = camera;
   // --- the haptic side: servo loop ↔ bridge ↔ physics thread (none when playing back) ---
@@ -69,10 +71,16 @@ pipeline::WarmUpFrame Session::warm_up_frame() const {
 void Session::warm_up() {
   // A blank blue screen with the fingertips where the script starts; both fits are then reset.
   const pipeline::WarmUpFrame w = warm_up_frame();
-  for (pipeline::FramePipeline* p : {pipe_.get(), alt_.get()}) {
-    if (p == nullptr) continue;
-    if (auto st = pipeline::warm_up(*p, w); !st) throw SpidarError(st.error().message);
+  // The main pipeline into the pool's results, all held at once (SessionParams::warm_results).
+  std::vector<std::shared_ptr<pipeline::FrameResult>> held;
+  std::vector<pipeline::FrameResult*> into;
+  for (int k = 0; k < params_.warm_results; ++k) {
+    held.push_back(results_.take());
+    into.push_back(held.back().get());
   }
+  if (auto st = pipeline::warm_up(*pipe_, w, into); !st) throw SpidarError(st.error().message);
+  if (alt_)
+    if (auto st = pipeline::warm_up(*alt_, w); !st) throw SpidarError(st.error().message);
   ++warm_ups_;
 }
 
@@ -88,12 +96,14 @@ void Session::start() {
   try {
     for (FrameSink* k : sinks_) k->on_start();
     if (auto st = rig_.camera().prepare(); !st) throw SpidarError("camera: " + st.error().message);
+    // The scene as it starts, for frames the camera delivers before the physics thread's first
+    // snapshot (the first exposure is 5 ms after the start, sim::CameraThreadParams).
+    scene_.world->snapshot(snapshot_, false);
     if (haptic_) {
       haptic_->start();  // throws with the haptic side stopped again
       t_start_ns_ = haptic_->t_open_ns();
     } else {
-      t_start_ns_ = core::monotonic_ns();
-      scene_.world->snapshot(snapshot_, false);  // the shapes the recorded poses apply to
+      t_start_ns_ = core::monotonic_ns();  // snapshot_: the shapes the recorded poses apply to
     }
     if (auto st = rig_.camera().start(t_start_ns_); !st) throw SpidarError("camera: " + st.error().message);
   } catch (...) {
@@ -147,8 +157,8 @@ bool Session::take_inputs(std::int64_t t_exposure_ns, ServoTiming* servo) {
   const auto measured = device::interpolate_samples({servo_buf_.data(), ns}, t_exposure_ns);
   if (!measured) return false;
   measured_ = *measured;
-  haptic_->physics().snapshots().update();
-  snapshot_ = haptic_->physics().snapshots().front();
+  // The newest the physics thread published; before its first, the scene as it started.
+  if (haptic_->physics().snapshots().update()) snapshot_ = haptic_->physics().snapshots().front();
   *servo = servo_timing_since({servo_buf_.data(), ns}, params_.servo.rate_hz, &last_servo_t_);
   return true;
 }
@@ -177,8 +187,11 @@ Session::Step Session::step() {
                        : frame_.measured != nullptr ? frame_.t_recorded_s
                                                     : core::ns_to_s(t_exp - t_start_ns_);
     if ((params_.seconds > 0 && t_s > params_.seconds) ||
-        (params_.end_with_script && scene_.task->finished(t_s)))
+        (params_.end_with_script && scene_.task->finished(t_s))) {
+      // The frame that ends the run is not dropped (SessionSummary::camera_frames).
+      if (!delivered_before_end_) delivered_before_end_ = rig_.camera().delivered() - 1;
       return Step::kPastEnd;
+    }
     t_last_s_ = t_s;
     // The frame thread's context (a sink on this thread may have made its own current).
     if (auto st = context_.make_current(); !st) throw SpidarError("frame thread: " + st.error().message);
@@ -267,7 +280,7 @@ SessionSummary Session::stop(const std::string& ended_by) {
   s.wall_s = wall_s;
   s.t_last_s = t_last_s_;
   s.frames = frames_;
-  s.camera_frames = rig_.camera().delivered();
+  s.camera_frames = delivered_before_end_.value_or(rig_.camera().delivered());
   s.camera_skipped = rig_.camera().skipped();
   if (haptic_) {
     s.servo = haptic_->loop().stats();

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <future>
 #include <utility>
+#include <vector>
 
 #include "spidar/core/clock.hpp"
 #include "spidar/core/realtime.hpp"
@@ -33,9 +34,12 @@ Result<std::unique_ptr<CameraThread>> CameraThread::prepare(
     const CameraThreadParams& params) {
   if (!(params.fps > 0 && params.fps <= 1000)) return Error{"camera thread: fps must be in (0, 1000]"};
   if (!truth_at) return Error{"camera thread: no ground-truth source given"};
-  for (const auto& [name, ns] : {std::pair{"readout_ns", params.readout_ns}, std::pair{"truth_wait_ns", params.truth_wait_ns}})
+  for (const auto& [name, ns] : {std::pair{"readout_ns", params.readout_ns}, std::pair{"truth_wait_ns", params.truth_wait_ns},
+                                 std::pair{"first_exposure_ns", params.first_exposure_ns}})
     if (ns < 0 || ns > 1'000'000'000)
       return Error{std::string("camera thread: ") + name + " must be in [0, 1e9] ns, got " + std::to_string(ns)};
+  if (params.warm_frames < 0 || params.warm_frames > 64)
+    return Error{"camera thread: warm_frames must be in 0..64, got " + std::to_string(params.warm_frames)};
   std::unique_ptr<CameraThread> c(new CameraThread());
   c->params_ = params;
   c->truth_at_ = std::move(truth_at);
@@ -120,16 +124,23 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
   auto film = SyntheticCamera::create(*ctx.value(), camera, truth, film_params);
   if (!film) return ready(Error{"camera thread: " + film.error().message});
   UserHands user(truth, task);
-  // One frame filmed before the clock starts, at the script's first nominal poses, and thrown
-  // away: the GL driver compiles its shaders at the first draw (98 ms of the first frame here),
-  // which would otherwise skip the first exposures.
+  // Frames filmed before the clock starts, at the script's first nominal poses, and thrown away:
+  // the GL driver compiles its shaders at the first draw (98 ms of the first frame here), and the
+  // pool's frames (CameraThreadParams::warm_frames) get their images; either would otherwise
+  // skip or drop the first exposures.
   {
     const std::array<hand::HandParams, 2> q0{task.nominal(0.0, hand::Side::kLeft),
                                              task.nominal(0.0, hand::Side::kRight)};
     SyntheticFrame scratch;
     if (auto st = film.value()->film(HandPoses{&q0[0], &q0[1]}, &scratch); !st)
       return ready(Error{"camera thread: warm-up frame: " + st.error().message});
-  }
+    std::vector<std::shared_ptr<FilmedFrame>> held;
+    for (int k = 0; k < params_.warm_frames; ++k) {
+      held.push_back(pool_.take());
+      if (auto st = film.value()->film(HandPoses{&q0[0], &q0[1]}, &held.back()->frame); !st)
+        return ready(Error{"camera thread: warm-up frame: " + st.error().message});
+    }
+  }  // back to the pool
   ready(Ok{});
   std::int64_t t0_ns = 0;
   {
@@ -142,7 +153,7 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
   const auto period_ns = static_cast<std::int64_t>(1e9 / params_.fps);
   std::array<Vec3, 8> caps;
   std::uint64_t index = 0;
-  std::int64_t t_exp = t0_ns;
+  std::int64_t t_exp = t0_ns + params_.first_exposure_ns;
   while (!stop_.load(std::memory_order_acquire)) {
     core::sleep_until_ns(t_exp + std::min(params_.truth_wait_ns, params_.readout_ns));
     if (stop_.load(std::memory_order_acquire)) break;

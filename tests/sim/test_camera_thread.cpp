@@ -86,6 +86,52 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
   EXPECT_LE(last_index + 1, cam.filmed() + cam.skipped());
 }
 
+// The device's first sample comes just after the session's clock starts (t0): the first exposure
+// is first_exposure_ns later, so it has its ground truth (at t0 itself it had none and every run
+// dropped its first frame). A readout of a second keeps a loaded machine from making it late.
+TEST(CameraThread, TheFirstExposureComesAfterTheDevicesFirstSample) {
+  const Filmed filmed;
+  for (const std::int64_t phase : {std::int64_t{5'000'000}, std::int64_t{0}}) {
+    CameraThreadParams params;
+    params.fps = 30;
+    params.readout_ns = 1'000'000'000;
+    params.first_exposure_ns = phase;
+    params.t0_ns = core::monotonic_ns() + 100'000'000;
+    const std::int64_t t0 = params.t0_ns;
+    std::mutex m;
+    std::vector<std::pair<std::int64_t, bool>> asked;  // exposure time, truth given
+    TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
+      const bool have = t_ns > t0;  // the device's first sample is just after t0
+      if (have) filmed.caps(1.0 + core::ns_to_s(t_ns - t0), out);
+      const std::lock_guard lock(m);
+      asked.emplace_back(t_ns, have);
+      return have;
+    };
+    auto thread = filmed.start(truth_at, params);
+    ASSERT_TRUE(thread.ok()) << thread.error().message;
+    CameraThread& cam = *thread.value();
+    ASSERT_TRUE(cam.wait_for_frame(core::monotonic_ns() + 60'000'000'000)) << cam.error();
+    ASSERT_TRUE(cam.take());
+    cam.stop();
+    const std::lock_guard lock(m);
+    ASSERT_FALSE(asked.empty());
+    EXPECT_EQ(asked.front().first, t0 + phase);
+    EXPECT_EQ(asked.front().second, phase > 0) << "phase " << phase;
+    EXPECT_EQ(cam.frame().index, phase > 0 ? 0u : 1u);
+  }
+  CameraThreadParams bad;
+  bad.first_exposure_ns = -1;
+  TruthAt any = [](std::int64_t, std::span<Vec3>) { return false; };
+  auto refused = filmed.prepare(any, bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("first_exposure_ns"), std::string::npos) << refused.error().message;
+  bad = {};
+  bad.warm_frames = 65;
+  refused = filmed.prepare(any, bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("warm_frames"), std::string::npos) << refused.error().message;
+}
+
 // A prepared camera (CameraThread::prepare: its GL context made and one frame filmed and thrown
 // away before the session's clock starts) films nothing until begin(); the exposures then start
 // at the t0 begin() gives, however long ago prepare() was, and none was skipped for the time
@@ -125,10 +171,11 @@ TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
   cam.stop();
   ASSERT_EQ(taken, 1) << cam.error();
   EXPECT_EQ(asked_before_begin.load(), 0);
-  // Its first exposure is at t0 or a whole number of periods after it (if the taker was late).
+  // Its first exposure is first_exposure_ns after t0, or a whole number of periods after that (if
+  // the taker was late).
   const std::int64_t period_ns = static_cast<std::int64_t>(1e9 / params.fps);
   const FilmedFrame& f = cam.frame();
-  EXPECT_EQ(f.t_exposure_ns, t0.load() + static_cast<std::int64_t>(f.index) * period_ns);
+  EXPECT_EQ(f.t_exposure_ns, t0.load() + params.first_exposure_ns + static_cast<std::int64_t>(f.index) * period_ns);
   EXPECT_LE(f.index + 1, cam.filmed() + cam.skipped());
 }
 

@@ -12,6 +12,7 @@
 /// pipeline per frame thread, whose GL context must be current.
 #include <array>
 #include <memory>
+#include <span>
 #include <opencv2/core/mat.hpp>
 
 #include "spidar/core/result.hpp"
@@ -203,10 +204,12 @@ struct WarmUpFrame {
   SceneSnapshot scene;
 };
 
-/// Processes `frame` once (the GL driver compiles its shaders at the first draw, the buffers are
+/// Processes `frame` (the GL driver compiles its shaders at the first draw, the buffers are
 /// allocated) and resets the pipeline, so that the first real frame is not the one that pays for
-/// it. The context the pipeline was created with must be current. Error as process().
-Status warm_up(FramePipeline& pipeline, const WarmUpFrame& frame);
+/// it: once into a scratch result, or once into each of `into` (a session's pooled results, whose
+/// images are then allocated and touched before its clock starts). The context the pipeline was
+/// created with must be current. Error as process().
+Status warm_up(FramePipeline& pipeline, const WarmUpFrame& frame, std::span<FrameResult* const> into = {});
 
 /// The comparison's fit of the frame `main` holds (comparison: a pipeline of comparison_params),
 /// with the sizes the main fit used on it (use_model_sizes) and its matte (the same image keyed

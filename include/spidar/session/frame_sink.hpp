@@ -71,7 +71,10 @@ struct SessionSummary {
   double wall_s = 0;                   ///< since the device was opened [s]
   double t_last_s = 0;                 ///< FrameEvent::t_s of the last frame before the end [s]
   std::uint64_t frames = 0;            ///< processed
-  std::uint64_t camera_frames = 0;     ///< delivered by the camera (processed or dropped)
+  /// Delivered by the camera (processed or dropped) up to the frame that ended the run: a frame
+  /// past SessionParams::seconds or the script's end, which ends it, is not counted, nor any
+  /// filmed after it.
+  std::uint64_t camera_frames = 0;
   std::uint64_t camera_skipped = 0;    ///< exposures the camera itself did not deliver (FrameSource::skipped)
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;

@@ -41,6 +41,11 @@ struct SessionParams {
   /// workspaces cost ~130 ms on the first frame; in the run they would drop the camera's first
   /// frames); the fits are reset after it, so the first real frame is a cold start.
   bool warm_up = true;
+  /// With warm_up, the frame results the session's pool holds at a time (the frame thread's and
+  /// those the sinks still hold: 4 in the demo) are processed from the warm-up frame too, so their
+  /// images exist before the clock starts (a new result's page faults cost 10–30 ms on this VM,
+  /// in the first frames). 1..32.
+  int warm_results = 4;
   /// Frames past this time (FrameEvent::t_s) end the run [s]; 0: no limit.
   double seconds = 0;
   /// The run also ends once the scene's scripted user is done (sim::RubiksTask::finished).
@@ -163,6 +168,8 @@ class Session {
   /// (FrameEvent::result_hold), so that the output thread reads it while the next is filled,
   /// without a copy of its eleven images per frame.
   core::RecyclingPool<pipeline::FrameResult> results_;
+  /// The camera's delivered count before the frame past the end (Step::kPastEnd), once one came.
+  std::optional<std::uint64_t> delivered_before_end_;
   std::shared_ptr<pipeline::FrameResult> result_;
   pipeline::FrameResult alt_result_;
 };

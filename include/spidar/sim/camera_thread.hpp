@@ -47,6 +47,11 @@ using TruthAt = std::function<bool(std::int64_t t_ns, std::span<Vec3> out)>;
 struct CameraThreadParams {
   double fps = 30.0;
   std::int64_t t0_ns = 0;        ///< script time 0 (host monotonic) [ns]: start() only (prepare() + begin())
+  /// The first exposure this long after t0 [ns], the next ones a period apart. The simulated
+  /// device's first sample comes just after t0 (the session's clock starts when it opens), so an
+  /// exposure at t0 itself has no ground truth and was always skipped (a dropped first frame in
+  /// every run). [0, 1e9].
+  std::int64_t first_exposure_ns = 5'000'000;
   /// The sensor's readout [ns]: a frame is published no earlier than this after its exposure.
   std::int64_t readout_ns = 2'000'000;
   /// Wait after the exposure before posing and filming [ns]: the simulated device's fingertip
@@ -58,6 +63,11 @@ struct CameraThreadParams {
   /// films at its rate whatever the host does, so it goes before the frame thread and the outputs
   /// that share the CPU with it. Needs CAP_SYS_NICE below 0; without it, a normal share.
   int nice = -10;
+  /// Frames filmed into the pool before the clock starts (prepare), all held at once and then
+  /// let go: the frames the session holds at a time (the frame thread's and the output thread's,
+  /// 6 in the demo) have their images allocated and touched before the first exposure instead of
+  /// during the first ones (a new frame's page faults cost 10–20 ms on this VM). 0..64.
+  int warm_frames = 6;
 };
 
 class CameraThread {
