@@ -20,51 +20,57 @@ namespace {
 
 TEST(SideTask, RunsTheTaskOnAnotherThreadWhileTheCallerWorks) {
   SideTask side;
-  // The task waits for the caller's part: run one after the other on one thread, it would wait
-  // out its (generous) timeout and see nothing.
+  // The task waits for the caller's part, which first waits for the task to have begun: run one
+  // after the other on one thread, the task would wait out its (generous) timeout and see nothing.
   std::mutex m;
   std::condition_variable cv;
-  bool caller_done = false, task_saw_caller = false;
+  bool task_began = false, caller_done = false, task_saw_caller = false, caller_saw_task = false;
   std::thread::id task_thread;
   auto task = [&] {
     task_thread = std::this_thread::get_id();
     std::unique_lock lock(m);
+    task_began = true;
+    cv.notify_all();
     task_saw_caller = cv.wait_for(lock, std::chrono::seconds(30), [&] { return caller_done; });
   };
   run_side_by_side(&side, task, [&] {
-    {
-      std::lock_guard lock(m);
-      caller_done = true;
-    }
+    std::unique_lock lock(m);
+    caller_saw_task = cv.wait_for(lock, std::chrono::seconds(30), [&] { return task_began; });
+    caller_done = true;
     cv.notify_all();
   });
+  EXPECT_TRUE(caller_saw_task);
   EXPECT_TRUE(task_saw_caller);
   EXPECT_NE(task_thread, std::this_thread::get_id());
   EXPECT_EQ(side.tasks_run(), 1u);
+  EXPECT_EQ(side.tasks_run_by_caller(), 0u);
   EXPECT_FALSE(side.busy());
 }
 
-TEST(SideTask, ManyTasksInARowEachRunOnceOnTheSameHelper) {
+// Each task runs exactly once, on the helper or (when the helper had not begun it by the caller's
+// wait) on the caller; with no part of its own the caller mostly takes the task back itself.
+TEST(SideTask, ManyTasksInARowEachRunOnceOnTheHelperOrTheCaller) {
   SideTask side;
   std::vector<int> side_counts(2000, 0), own_counts(2000, 0);
-  std::thread::id helper;
-  bool one_helper = true;
+  std::vector<std::thread::id> ran_on(2000);
   for (int i = 0; i < 2000; ++i) {
+    const auto k = static_cast<std::size_t>(i);
     run_side_by_side(
         &side,
         [&] {
-          ++side_counts[static_cast<std::size_t>(i)];
-          if (i == 0) helper = std::this_thread::get_id();
-          one_helper = one_helper && std::this_thread::get_id() == helper;
+          ++side_counts[k];
+          ran_on[k] = std::this_thread::get_id();
         },
-        [&] { ++own_counts[static_cast<std::size_t>(i)]; });
+        [&] { ++own_counts[k]; });
   }
-  for (int i = 0; i < 2000; ++i) {
-    ASSERT_EQ(side_counts[static_cast<std::size_t>(i)], 1) << "task " << i;
-    ASSERT_EQ(own_counts[static_cast<std::size_t>(i)], 1) << "task " << i;
+  std::size_t on_caller = 0;
+  for (std::size_t k = 0; k < 2000; ++k) {
+    ASSERT_EQ(side_counts[k], 1) << "task " << k;
+    ASSERT_EQ(own_counts[k], 1) << "task " << k;
+    on_caller += ran_on[k] == std::this_thread::get_id() ? 1 : 0;
   }
-  EXPECT_TRUE(one_helper);
   EXPECT_EQ(side.tasks_run(), 2000u);
+  EXPECT_EQ(side.tasks_run_by_caller(), on_caller);
 }
 
 TEST(SideTask, ATasksExceptionComesBackFromWaitAndTheHelperGoesOn) {
@@ -86,6 +92,12 @@ TEST(SideTask, ATasksExceptionComesBackFromWaitAndTheHelperGoesOn) {
   EXPECT_THROW(run_side_by_side(&side, throws, [] { throw std::logic_error("caller"); }), std::logic_error);
   EXPECT_FALSE(side.busy());
   EXPECT_EQ(side.tasks_run(), 3u);
+  // Thrown by a task the caller took back (nothing of its own to do first), likewise.
+  for (int k = 0; k < 50; ++k) {
+    side.start(throws);
+    EXPECT_THROW(side.wait(), std::runtime_error);
+  }
+  EXPECT_EQ(side.tasks_run(), 53u);
 }
 
 TEST(SideTask, StartingBeforeWaitingIsRefusedAndWaitWithNothingStartedReturns) {
@@ -98,7 +110,7 @@ TEST(SideTask, StartingBeforeWaitingIsRefusedAndWaitWithNothingStartedReturns) {
   EXPECT_TRUE(side.busy());
   auto other = [] {};
   EXPECT_THROW(side.start(other), std::logic_error);
-  release.set_value();
+  release.set_value();  // before wait(): the caller may run the task itself
   side.wait();
   EXPECT_FALSE(side.busy());
 }
@@ -122,16 +134,23 @@ TEST(SideTask, TheHelperRunsAtTheNiceValueOfTheThreadThatFirstStartedIt) {
     ASSERT_EQ(setpriority(PRIO_PROCESS, tid, target), 0);
     own_nice = getpriority(PRIO_PROCESS, tid);
     SideTask side;
-    auto read_nice = [&] { helper_nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())); };
+    // Read on the helper: the caller waits for it to have run (not taking it back itself).
+    std::atomic<bool> read{false};
+    auto read_nice = [&] {
+      helper_nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid()));
+      read = true;
+    };
     side.start(read_nice);
+    while (!read.load()) std::this_thread::yield();
     side.wait();
+    EXPECT_EQ(side.tasks_run_by_caller(), 0u);
   });
   owner.join();
   EXPECT_EQ(own_nice, target);
   EXPECT_EQ(helper_nice, target);
 }
 
-TEST(SideTask, DestroyingItWithATaskStillRunningFinishesTheTaskFirst) {
+TEST(SideTask, DestroyingItWithATaskStartedRunsTheTaskFirst) {
   std::atomic<bool> finished{false};
   {
     SideTask side;
@@ -140,7 +159,7 @@ TEST(SideTask, DestroyingItWithATaskStillRunningFinishesTheTaskFirst) {
       finished = true;
     };
     side.start(slow);
-  }  // the destructor joins the helper after the task
+  }  // the destructor waits for the task (or runs it), then joins the helper
   EXPECT_TRUE(finished.load());
 }
 

@@ -3,13 +3,19 @@
 /// on a two-core machine: start() hands a task to the helper, the caller does its own part, and
 /// wait() joins (and re-throws what the task threw).
 ///
+/// Never slower than doing both in turn, whatever the machine: if the helper has not begun the
+/// task by the time the caller waits (a sleeping CPU of a VM can take milliseconds to wake, a
+/// busy machine may not schedule the helper at all), the caller takes the task back and runs it
+/// itself. A task runs exactly once, on one of the two threads.
+///
 /// The helper thread is made at the first start(), by the thread that calls it, so that it
 /// inherits that thread's scheduling (on Linux a thread's nice value and policy are inherited at
 /// creation): the frame thread's helper runs at the frame thread's priority. It sleeps on a
-/// condition variable between tasks, so waking it costs a futex wake, not a thread creation.
+/// condition variable between tasks.
 ///
 /// Not copyable or movable (the helper refers to it). One owner thread calls start() and wait();
 /// the task must not call either. The task object must live until wait() returns.
+#include <atomic>
 #include <condition_variable>
 #include <exception>
 #include <mutex>
@@ -25,33 +31,38 @@ class SideTask {
   SideTask(const SideTask&) = delete;
   SideTask& operator=(const SideTask&) = delete;
 
-  /// Runs `task()` on the helper thread. The previous task must have been waited for; throws
+  /// Offers `task()` to the helper thread. The previous task must have been waited for; throws
   /// std::logic_error otherwise. `task` is held by reference: keep it alive until wait().
   template <class F>
   void start(F& task) {
     start_erased(&task, [](void* f) { (*static_cast<F*>(f))(); });
   }
-  /// Blocks until the started task has finished; re-throws its exception, if any. A no-op when
-  /// nothing was started.
+  /// Returns once the started task has run: on the helper (waiting for it to finish), or here if
+  /// the helper had not begun it. Re-throws the task's exception, if any. A no-op when nothing
+  /// was started.
   void wait();
   /// True while a task is started and not yet waited for.
   bool busy() const { return started_; }
-  /// Tasks run so far (for tests and reports).
-  unsigned long long tasks_run() const;
+  /// Tasks run so far, and of those the ones the caller ran itself (for tests and reports).
+  unsigned long long tasks_run() const { return run_.load(std::memory_order_acquire); }
+  unsigned long long tasks_run_by_caller() const { return run_by_caller_.load(std::memory_order_acquire); }
 
  private:
+  enum State : int { kIdle, kOffered, kRunning, kDone };
   void start_erased(void* task, void (*call)(void*));
   void loop();
+  /// Runs the offered task on this thread; its exception into error_.
+  void run_task();
 
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
   std::condition_variable wake_, done_;
-  void* task_ = nullptr;
+  std::atomic<int> state_{kIdle};
+  void* task_ = nullptr;               // written before state_ becomes kOffered
   void (*call_)(void*) = nullptr;
-  bool pending_ = false;   // a task handed over, not finished (guarded by mutex_)
-  bool quit_ = false;      // guarded by mutex_
-  bool started_ = false;   // owner thread only
-  unsigned long long run_ = 0;  // guarded by mutex_
-  std::exception_ptr error_;    // guarded by mutex_
+  std::exception_ptr error_;           // written by the runner before state_ becomes kDone
+  bool quit_ = false;                  // guarded by mutex_
+  bool started_ = false;               // owner thread only
+  std::atomic<unsigned long long> run_{0}, run_by_caller_{0};
   std::thread thread_;
 };
 
