@@ -58,8 +58,8 @@ class ThreadedSource : public FrameSource {
       bgr.copyTo(latest_);
       latest_t_ = t_ns;
       fresh_ = true;
+      delivered_.fetch_add(1, std::memory_order_acq_rel);  // counted before anyone can take it
     }
-    delivered_.fetch_add(1, std::memory_order_acq_rel);
     arrived_.notify_all();
   }
   void fail(const std::string& message) {

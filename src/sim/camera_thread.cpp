@@ -177,10 +177,11 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
       core::sleep_until_ns(t_exp + params_.readout_ns);  // not before the sensor has read it out
       {
         std::lock_guard lock(newest_mutex_);
+        // Counted before anyone can take it: filmed() is never behind the frames taken.
+        filmed_.fetch_add(1, std::memory_order_acq_rel);
         newest_ = std::move(frame);  // a newer frame replaces one not taken (back to the pool)
       }
       arrived_.notify_all();
-      filmed_.fetch_add(1, std::memory_order_acq_rel);
     } else {
       // No fingertips yet at this exposure (the device's first samples come later on a busy
       // machine): an exposure let pass too, so a frame's index gap is always filmed + skipped.
