@@ -132,7 +132,13 @@ void SessionRecorder::run() {
 
 void SessionRecorder::drain() {
   if (device_ != nullptr) {
-    const std::size_t n = device_->ring().newest(dev_buf_.data(), dev_buf_.size());
+    // Only back to the last record written (the ring holds 4096: copied whole every 10 ms it
+    // cost more than the writing).
+    const RecordingDevice::Ring& ring = device_->ring();
+    const std::uint64_t last_seq = last_dev_seq_;
+    const std::size_t n = core::read_newest_until(
+        [&ring](DeviceCycleRecord* out, std::size_t max) { return ring.newest(out, max); }, std::span(dev_buf_),
+        [last_seq](const DeviceCycleRecord& r) { return r.seq <= last_seq; });
     for (std::size_t k = n; k-- > 0;) {
       const DeviceCycleRecord& r = dev_buf_[k];
       if (r.seq <= last_dev_seq_) continue;
@@ -142,7 +148,12 @@ void SessionRecorder::drain() {
     }
   }
   if (servo_ != nullptr) {
-    const std::size_t n = servo_->newest_samples(sample_buf_.data(), sample_buf_.size());
+    const device::ServoLoop& servo = *servo_;
+    const bool have = have_cycle_;
+    const std::uint64_t last_cycle = last_cycle_;
+    const std::size_t n = core::read_newest_until(
+        [&servo](device::FingertipSample* out, std::size_t max) { return servo.newest_samples(out, max); },
+        std::span(sample_buf_), [have, last_cycle](const device::FingertipSample& x) { return have && x.cycle <= last_cycle; });
     for (std::size_t k = n; k-- > 0;) {
       const device::FingertipSample& s = sample_buf_[k];
       if (have_cycle_ && s.cycle <= last_cycle_) continue;

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <memory>
+#include <span>
+#include <vector>
 #include <thread>
 
 #include "spidar/core/seqlock.hpp"
@@ -90,6 +93,43 @@ TEST(SampleRing, ConcurrentReadersSeeConsecutiveIntactSamples) {
     }
   }
   writer.join();
+}
+
+// read_newest_until reads only as far back as the reader needs: values after the last one it
+// handled, in growing tries, and everything (up to its buffer) the first time.
+TEST(SampleRing, ReadNewestUntilStopsWhereTheReaderLeftOff) {
+  auto ring = std::make_unique<SampleRing<std::uint64_t, 4096>>();
+  for (std::uint64_t v = 1; v <= 3000; ++v) ring->push(v);
+  std::vector<std::uint64_t> buf(4096);
+  std::vector<std::size_t> asked;
+  auto read = [&](std::uint64_t* out, std::size_t max) {
+    asked.push_back(max);
+    return ring->newest(out, max);
+  };
+  // Handled up to 2990: the first 32 reach it.
+  std::size_t n = read_newest_until(read, std::span(buf), [](std::uint64_t v) { return v <= 2990; });
+  EXPECT_EQ(n, 32u);
+  EXPECT_EQ(buf[0], 3000u);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{32}));
+  // Handled up to 2900: 32, then 128.
+  asked.clear();
+  n = read_newest_until(read, std::span(buf), [](std::uint64_t v) { return v <= 2900; });
+  EXPECT_EQ(n, 128u);
+  EXPECT_LE(buf[n - 1], 2900u);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{32, 128}));
+  // Nothing handled yet: all the ring has, in tries that stop when it has no more.
+  asked.clear();
+  n = read_newest_until(read, std::span(buf), [](std::uint64_t) { return false; });
+  EXPECT_EQ(n, 3000u);
+  EXPECT_EQ(buf[n - 1], 1u);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{32, 128, 512, 2048, 4096}));
+  // A buffer smaller than the need: full, then no more tries.
+  std::vector<std::uint64_t> small(100);
+  asked.clear();
+  EXPECT_EQ(read_newest_until(read, std::span(small), [](std::uint64_t) { return false; }), 100u);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{32, 100}));
+  std::vector<std::uint64_t> none;
+  EXPECT_EQ(read_newest_until(read, std::span(none), [](std::uint64_t) { return false; }), 0u);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <optional>
+#include <span>
 #include <type_traits>
 
 namespace spidar::core {
@@ -79,6 +80,23 @@ class Latest {
  private:
   detail::SeqSlot<T> slot_;
 };
+
+/// Reads newest-first values through `read(out, max)` (SampleRing::newest, or a wrapper of it)
+/// into `buf`, only as many as reach back to what the reader already has: first `first`, then
+/// four times as many at each try, until the oldest read satisfies `reached` (e.g. it is at or
+/// before a time, or a sequence number already handled), the source has no more, or `buf` is
+/// full. Returns how many it read (newest first in buf). A ring of a second of samples copied
+/// whole to use its newest few costs more than the use.
+template <typename T, typename Read, typename Reached>
+std::size_t read_newest_until(Read&& read, std::span<T> buf, Reached&& reached, std::size_t first = 32) {
+  if (buf.empty()) return 0;
+  std::size_t want = first < 1 ? 1 : (first > buf.size() ? buf.size() : first);
+  for (;;) {
+    const std::size_t n = read(buf.data(), want);
+    if (n < want || reached(buf[n - 1]) || want == buf.size()) return n;
+    want = want * 4 > buf.size() ? buf.size() : want * 4;
+  }
+}
 
 /// The last N values of T in publication order, written by one thread, read by any.
 template <typename T, std::size_t N>

@@ -2,11 +2,11 @@
 /// Fingertip samples at a given time, e.g. a camera frame's exposure: the servo loop publishes a
 /// sample per cycle (host time of its encoder reading); the frame pipeline interpolates the two
 /// samples around the exposure time, linearly in positions, forces and tensions.
-#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <span>
 
+#include "spidar/core/seqlock.hpp"
 #include "spidar/device/servo_types.hpp"
 
 namespace spidar::device {
@@ -33,12 +33,8 @@ std::optional<FingertipSample> interpolate_samples(std::span<const FingertipSamp
 template <class Read>
 std::size_t read_back_to(Read&& read, std::int64_t t_ns, std::span<FingertipSample> buf,
                          std::size_t first = 32) {
-  std::size_t want = std::min(std::max<std::size_t>(first, 1), buf.size());
-  for (;;) {
-    const std::size_t n = read(buf.data(), want);
-    if (n < want || buf[n - 1].t_ns <= t_ns || want == buf.size()) return n;
-    want = std::min(want * 4, buf.size());
-  }
+  return core::read_newest_until(read, buf, [t_ns](const FingertipSample& s) { return s.t_ns <= t_ns; },
+                                 first);
 }
 
 }  // namespace spidar::device
