@@ -10,6 +10,7 @@
 #include "spidar/core/realtime.hpp"
 #include "spidar/core/result.hpp"
 #include "spidar/registration/fingertip_reach.hpp"
+#include "spidar/registration/palm_breadth.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/vision/silhouette.hpp"
 
@@ -27,7 +28,8 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "freeze_sigma_length_m", "freeze_sigma_width_m", "freeze_sigma_thickness",
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
                     "max_fingertip_cost", "shared_hands", "keyframe_prior_scale",
-                    "keyframe_prior", "joint_balls"});
+                    "keyframe_prior", "joint_balls", "palm_breadth_sigma_px", "palm_breadth_at",
+                    "palm_breadth_min_facing"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
@@ -63,6 +65,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       {"reach_min_miss_m", &ShapeEstimatorParams::reach_min_miss_m, 0.0, 0.05, true},
       {"max_fingertip_cost", &ShapeEstimatorParams::max_fingertip_cost, 0.0, 1e6},
       {"keyframe_prior_scale", &ShapeEstimatorParams::keyframe_prior_scale, 0.0, 1e3},
+      {"palm_breadth_sigma_px", &ShapeEstimatorParams::palm_breadth_sigma_px, 0.0, 1e3, true},
   };
   struct IntField {
     const char* key;
@@ -93,6 +96,16 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       child->fail("expected a value in " + std::string(f.zero_ok ? "[" : "(") + std::to_string(f.lo) +
                   ", " + std::to_string(f.hi) + "], got " + std::to_string(v));
     p.*f.v = v;
+  }
+  // The palm chord's settings (palm_breadth.hpp), in [0, 1].
+  for (auto [key, v] : {std::pair{"palm_breadth_at", &p.palm_chord.at},
+                        std::pair{"palm_breadth_min_facing", &p.palm_chord.min_facing}}) {
+    const auto child = node.find(key);
+    if (!child) continue;
+    const double x = child->as_double();
+    if (!(std::isfinite(x) && x >= 0.0 && x <= 1.0))
+      child->fail("expected a value in [0, 1], got " + std::to_string(x));
+    *v = x;
   }
   return p;
 }
@@ -156,6 +169,9 @@ ShapeEstimate ShapeEstimator::estimate(int hand) const {
   e.sigma_thickness *= scale.z();
   e.keyframes = static_cast<int>(std::count_if(keyframes_.begin(), keyframes_.end(),
                                                [&](const Keyframe& k) { return k.hand == hand; }));
+  e.palm_chords = static_cast<int>(std::count_if(keyframes_.begin(), keyframes_.end(), [&](const Keyframe& k) {
+    return k.hand == hand && k.chord.has_value();
+  }));
   return e;
 }
 
@@ -262,9 +278,18 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       std::vector<ResidualTerm> terms;
       stacked_residuals(problem, targets, kf.q, &r, &J, &terms);
       MatX Jb = MatX::Zero(r.size(), 3);
+      // The palm's chord (palm_breadth.hpp): its model value at the keyframe's pose and sizes.
+      const bool chord = kf.chord && camera != nullptr && p.palm_breadth_sigma_px > 0;
+      auto chord_of = [&](const hand::HandModel& m) {
+        return (model_palm_chord_px(m, kf.q, *camera, kf.chord->at, kf.chord->across_px) - kf.chord->measured_px) /
+               p.palm_breadth_sigma_px;
+      };
+      const double r_chord = chord ? chord_of(model) : 0.0;
+      Eigen::Vector3d J_chord = Eigen::Vector3d::Zero();
       bool ok = true;
       for (int c = 0; c < nb && ok; ++c) {
         VecX rp, rm;
+        std::array<double, 2> chord_pm{};
         for (int sgn : {1, -1}) {
           Eigen::Vector3d b = beta;
           b[c] += sgn * step_h[c];
@@ -276,9 +301,11 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
           const hand::HandModel mm = std::move(m).value();
           const ResidualProblem pk{&mm, &kf.observation, &evidence, &prior, &fit_params};
           stacked_residuals(pk, targets, kf.q, sgn > 0 ? &rp : &rm, nullptr);
+          if (chord) chord_pm[sgn > 0 ? 0 : 1] = chord_of(mm);
         }
         ok = ok && rp.size() == r.size() && rm.size() == r.size();
         if (ok) Jb.col(c) = (rp - rm) / (2.0 * step_h[c]);
+        if (ok) J_chord[c] = (chord_pm[0] - chord_pm[1]) / (2.0 * step_h[c]);
       }
       // The joint-balls inform the length only: their targets sit a ball's radius in from the
       // silhouette's edge, and that radius is the capsule's, which the width scales. (The band's
@@ -296,6 +323,12 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       S += Jb.transpose() * Jb - JbtJ * A_ldlt.solve(JtJb);
       g -= Jb.transpose() * r - JbtJ * A_ldlt.solve(J.transpose() * r);
       cost += r.squaredNorm();
+      // The chord's row: the pose is the keyframe's fit (its other evidence), held here.
+      if (chord && std::isfinite(r_chord) && J_chord.allFinite()) {
+        S += J_chord * J_chord.transpose();
+        g -= J_chord * r_chord;
+        cost += r_chord * r_chord;
+      }
     }
     if (it == 0) estimate.objective_start = cost;
     const bool better = cost < best.cost;
@@ -396,7 +429,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     ++held;
     if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
   }
-  Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}};
+  Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}, {}};
   // The band's length is left out of the size estimate's refits: with it the default user's width
   // went 18 % narrow (demo, seeds 1–2), without it 4–8 % (the band measures the forearm, whose
   // breadth the model only assumes in proportion to the palm's).
@@ -406,6 +439,13 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
       image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);
   if (p_.silhouette == ShapeSilhouette::kBoth && image.coverage != nullptr) kf.owned = *image.coverage;
+  if (p_.palm_breadth_sigma_px > 0 && image.camera != nullptr && !image.alpha.empty() &&
+      image.alpha.type() == CV_32FC1) {
+    cv::Mat mask = kf.silhouette;
+    if (mask.empty()) cv::compare(image.alpha, fit_params.matte_threshold, mask, cv::CMP_GE);
+    kf.chord = measure_palm_chord(models_.at(static_cast<std::size_t>(hand)), q, *image.camera, mask,
+                                  image.coverage, fit_params.coverage_stride_px, p_.palm_chord);
+  }
   if (held < std::max(p_.keyframes, 1))
     keyframes_.push_back(std::move(kf));
   else

@@ -32,6 +32,7 @@
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/registration/palm_breadth.hpp"
 #include "spidar/registration/registration_params.hpp"
 #include "spidar/registration/shape_estimator.hpp"
 #include "spidar/registration/residuals.hpp"
@@ -294,6 +295,7 @@ int main(int argc, char** argv) {
   std::array<std::array<std::vector<double>, hand::kParamCount>, 2> param_err;
   // Joint error by digit and joint along it (fit, and the floor as above) [px sums], and counts.
   std::array<std::array<double, 4>, 5> joint_at_sum{}, joint_at_floor{}, joint_at_n{};
+  std::vector<double> chord_ratio;  // the real palm's chord / the model's, at the truth
   std::array<Vec3, 8> g;
   for (double t = a.t0; t < a.t1 && !task.finished(t); t += 1.0 / a.fps) {
     // The device's caps: at the face, pressed a fifth of the squeeze in (the displayed force
@@ -315,6 +317,13 @@ int main(int argc, char** argv) {
     const auto m = sim::measure_frame(frame, r, p.compositor.mode, r.models, truth_models, truth,
                                       camera, &ws).value();
     const double c = ceiling->iou(truth, frame.hand_only, frame.toward_elbow_W).value();
+    // The palm chord's evidence at the truth (palm_breadth.hpp): the real palm's chord against the
+    // model palm's, both at the true pose and sizes.
+    for (int h = 0; h < 2; ++h)
+      if (const auto ch = registration::measure_palm_chord(truth_models[h], truth[h], camera, frame.hand_only,
+                                                           nullptr, 1, p.shape_estimator.palm_chord))
+        chord_ratio.push_back(ch->measured_px / registration::model_palm_chord_px(truth_models[h], truth[h], camera,
+                                                                                ch->at, ch->across_px));
     for (Variant& v : variants) v.iou.push_back(v.ceiling->iou(truth, frame.hand_only, frame.toward_elbow_W).value());
     if (part_renderer) {
       SceneSnapshot hands_scene;
@@ -653,14 +662,21 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 6; ++k) std::printf("  shift %.1f r: %.2f px\n", 0.2 * k, brace_k[k] / std::max(brace_n, 1));
   std::printf("  the wrist term's point at the true pose: %.2f px (p95 %.2f)\n", mean(brace_term),
               quantile(brace_term, 0.95));
+  if (!chord_ratio.empty()) {
+    std::sort(chord_ratio.begin(), chord_ratio.end());
+    auto q = [&](double f) { return chord_ratio[static_cast<std::size_t>(f * static_cast<double>(chord_ratio.size() - 1))]; };
+    std::printf("palm chord at the truth, real / model: median %.3f (p10 %.3f, p90 %.3f), %zu chords\n", q(0.5),
+                q(0.1), q(0.9), chord_ratio.size());
+  }
   std::printf("final shape: left L %.4f W %.4f, right L %.4f W %.4f (truth L %.4f W %.4f)\n",
               r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
               r.models[1].shape.dimensions.length, r.models[1].shape.dimensions.width,
               truth_models[0].shape.dimensions.length, truth_models[0].shape.dimensions.width);
   for (int h = 0; h < 2; ++h) {
     const registration::ShapeEstimate& e = r.shapes[h];
-    std::printf("  %s: %d keyframes, %d solves, sigma L %.4f W %.4f m%s%s\n", h == 0 ? "left" : "right",
-                e.keyframes, e.solves, e.sigma_length_m, e.sigma_width_m, e.length_frozen ? ", length frozen" : "",
+    std::printf("  %s: %d keyframes (%d with a palm chord), %d solves, sigma L %.4f W %.4f m%s%s\n",
+                h == 0 ? "left" : "right", e.keyframes, e.palm_chords, e.solves, e.sigma_length_m, e.sigma_width_m,
+                e.length_frozen ? ", length frozen" : "",
                 e.width_frozen ? ", width frozen" : "");
   }
   return 0;

@@ -78,8 +78,10 @@ inline hand::HandParams perturb(const hand::HandParams& q, const hand::HandModel
 }
 
 /// A silhouette drawn from a model's own capsules and palm box (no GL): CV_8UC1, 255 = hand.
+/// `box_palm` false: the palm as the slab palm_breadth.hpp's chords assume (the box's breadth
+/// with its edges rounded by its half thickness) instead of the box's corners.
 inline void draw_capsule_mask(const hand::HandModel& model, const hand::HandParams& q,
-                              const vision::Camera& camera, cv::Mat* mask) {
+                              const vision::Camera& camera, cv::Mat* mask, bool box_palm = true) {
   if (mask->empty()) *mask = cv::Mat::zeros(camera.height(), camera.width(), CV_8UC1);
   const double f = camera.intrinsics().fx;
   const auto shapes = hand::hand_render_shapes(model, q);
@@ -94,7 +96,19 @@ inline void draw_capsule_mask(const hand::HandModel& model, const hand::HandPara
   for (const auto& box : shapes.boxes) {
     std::vector<cv::Point> pts;
     const Mat3 R = box.X_WB.R.toRotationMatrix();
-    for (int i = 0; i < 8; ++i) {
+    const Vec3& e = box.half_extents;
+    Mat3 A = R;  // right-hand H → world (the box's x is mirrored for a left hand)
+    if (model.side == hand::Side::kLeft) A.col(0) = -A.col(0);
+    for (int level = 0; !box_palm && level <= 10; ++level) {
+      const double y = -e.y() + 0.2 * e.y() * level, r = std::min(e.z(), e.x());
+      for (int i = 0; i < 32; ++i) {
+        const double phi = 2.0 * 3.14159265358979 * (i + 0.5) / 32;
+        const double x = (std::cos(phi) >= 0 ? e.x() - r : r - e.x()) + r * std::cos(phi);
+        const Vec2 uv = camera.project(box.X_WB.p + A * Vec3(x, y, r * std::sin(phi)));
+        pts.emplace_back(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())));
+      }
+    }
+    for (int i = 0; box_palm && i < 8; ++i) {
       const Vec3 s((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1);
       const Vec2 uv = camera.project(box.X_WB.p + R * s.cwiseProduct(box.half_extents));
       pts.emplace_back(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())));

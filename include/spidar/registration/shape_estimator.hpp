@@ -41,6 +41,7 @@
 #include "spidar/core/config.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/registration/coverage.hpp"
+#include "spidar/registration/palm_breadth.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 
 namespace spidar::vision {
@@ -155,6 +156,12 @@ struct ShapeEstimatorParams {
   /// 1.6–2.9 %, IoU 0.713–0.740 → 0.797–0.838; the short-wide user's 11–12 % → 0.3–1.6 %, IoU
   /// 0.598–0.656 → 0.752–0.770; the default user's IoU 0.861–0.862 → 0.854–0.856.
   bool joint_balls = true;
+  /// The palm's breadth in the image (palm_breadth.hpp) as evidence on the width: a keyframe
+  /// whose palm is seen nearly face on keeps its chord, and a re-estimate fits the model palm's
+  /// chord to it with this σ [px]; 0 = off. (The strings alone leave the width weakly seen: a
+  /// narrower hand reaches the same fingertips by spreading its fingers.)
+  double palm_breadth_sigma_px = 0.0;
+  PalmChordParams palm_chord;
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
@@ -177,6 +184,7 @@ struct ShapeEstimate {
   double objective_start = 0;
   double objective = 0;
   int steps_rejected = 0;  ///< Gauss-Newton steps that raised the objective (halved back), all re-estimates
+  int palm_chords = 0;     ///< keyframes held (of this hand) with a palm chord (palm_breadth_sigma_px)
 };
 
 class ShapeEstimator {
@@ -232,6 +240,7 @@ class ShapeEstimator {
     /// The silhouette as a matte (CV_32FC1, 0 or 1) for the joint-balls (joint_balls), made and
     /// shared like `distance`.
     std::shared_ptr<const cv::Mat> alpha;
+    std::optional<PalmChord> chord;  ///< the palm's breadth (palm_breadth_sigma_px > 0)
   };
   /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its
   /// own thread shares nothing with the estimator).
@@ -266,7 +275,8 @@ class ShapeEstimator {
 /// solve_every, min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m,
 /// freeze_sigma_thickness, max_relative_change,
 /// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, shared_hands,
-/// keyframe_prior_scale, keyframe_prior (taken or last).
+/// keyframe_prior_scale, keyframe_prior (taken or last), palm_breadth_sigma_px, palm_breadth_at,
+/// palm_breadth_min_facing.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
