@@ -12,7 +12,7 @@ namespace spidar::app {
 namespace {
 
 session::ScenarioOptions scenario_options(const DemoOptions& o) {
-  return {o.config, o.scene, o.out, o.seconds, o.rate_hz, o.seed};
+  return {o.config, o.scene, o.out, o.seconds, o.rate_hz, o.seed, o.idle_spin != 0};
 }
 
 }  // namespace
@@ -72,6 +72,11 @@ Action add_demo(CLI::App& app) {
   cmd->add_option("--out", o->out, "output directory")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "length [s] (0: the scenario's own)");
   cmd->add_option("--rate", o->rate_hz, "servo rate [Hz]")->capture_default_str();
+  cmd->add_flag_callback("--idle-spin", [o] { o->idle_spin = 1; },
+                         "keep the servo's CPU from halting before each cycle (a SCHED_IDLE thread; the "
+                         "haptic scenario's default; docs/realtime.md)");
+  cmd->add_flag_callback("--no-idle-spin", [o] { o->idle_spin = 0; }, "let the servo's CPU halt between cycles "
+                         "(the rubiks scenario's default)");
   cmd->add_option("--seed", o->seed, "random seed")->check(seed_check())->capture_default_str();
   return [o] {
     require_range(o->seconds, 0, 600, "--seconds", "s");

@@ -18,10 +18,14 @@ Action add_device_test(CLI::App& app) {
   auto a = std::make_shared<BackendArgs>();
   auto seconds = std::make_shared<double>(3.0);
   auto rate = std::make_shared<double>(1000.0);
+  auto idle_spin = std::make_shared<bool>(true);
   add_backend_options(*cmd, *a);
   cmd->add_option("--seconds", *seconds, "how long to run [s]")->capture_default_str();
   cmd->add_option("--rate", *rate, "servo rate [Hz]")->capture_default_str();
-  return [a, seconds, rate] {
+  cmd->add_flag("!--no-idle-spin", *idle_spin,
+                "let the servo's CPU halt between cycles (by default a SCHED_IDLE thread keeps it from "
+                "halting before each cycle: docs/realtime.md)");
+  return [a, seconds, rate, idle_spin] {
     if (!(*seconds > 0 && *seconds <= 3600)) {
       std::ostringstream os;
       os << "--seconds: expected more than 0 and at most 3600 s, got " << *seconds;
@@ -34,6 +38,7 @@ Action add_device_test(CLI::App& app) {
 
     device::ServoConfig servo;
     servo.rate_hz = *rate;
+    servo.idle_spin = *idle_spin;
     servo.max_seconds = *seconds;
     device::ServoLoop loop(*dev, cfg, servo, std::make_shared<device::ZeroForce>());
     SignalScope signals;  // SIGINT / SIGTERM end the run early, with its statistics printed
@@ -87,6 +92,7 @@ Action add_device_test(CLI::App& app) {
                         {"cycle_us_median", s.cycle_us_median},
                         {"cycle_us_p99", s.cycle_us_p99},
                         {"realtime_scheduling", s.realtime_scheduling},
+                        {"idle_spin", s.idle_spin},
                         {"inconsistent_solves", s.inconsistent},
                         {"faults", faults},
                         {"fault_message", s.fault_message},

@@ -31,7 +31,7 @@ nlohmann::json summary_json(const session::LiveSession& s, const std::string& en
   j["servo"] = {{"rate_hz", st.rate_hz},         {"cycles", st.cycles},
                 {"jitter_p99_us", st.jitter_p99_us}, {"overruns", st.overruns},
                 {"faults", device::fault_names(st.faults)},
-                {"realtime_scheduling", st.realtime_scheduling}};
+                {"realtime_scheduling", st.realtime_scheduling}, {"idle_spin", st.idle_spin}};
   j["registration"] = {{"iou_vs_silhouette_mean", s.view().iou_mean()},
                        {"ms_mean", s.view().registration_ms_mean()}};
   if (auto c = s.cube_status())

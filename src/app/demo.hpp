@@ -12,6 +12,9 @@ struct DemoOptions {
   std::string out = "out/demo";
   double seconds = 0;               ///< 0: the scenario's own length
   double rate_hz = 1000.0;
+  /// Keep the servo's CPU from halting (device::ServoConfig::idle_spin): 1 on, 0 off, −1 the
+  /// scenario's default (on for haptic, off for rubiks, whose frame pipeline it slows).
+  int idle_spin = -1;
   std::uint64_t seed = 1;
   // rubiks (the mixed-reality demo)
   std::string user_hand = "configs/hands.yaml";  ///< the simulated user's hands (profile "user")

@@ -78,6 +78,7 @@ int run_mr_demo(const DemoOptions& o) {
 
   session::SessionParams sp;
   sp.servo.rate_hz = o.rate_hz;
+  sp.servo.idle_spin = o.idle_spin == 1;  // off unless asked: it slows the frame pipeline
   sp.servo.force_timeout_s = 0.05;  // the physics thread's steps may come late on a busy machine
   // Late cycles and stale forces degrade the display and are counted; the safe state latches
   // only past the stall limit (ServoConfig::stall_limit_s, docs/realtime.md), as on real devices.

@@ -1,5 +1,6 @@
 #include "spidar/device/servo_loop.hpp"
 
+#include "spidar/core/idle_spinner.hpp"
 #include "spidar/core/realtime.hpp"
 
 #include <optional>
@@ -74,6 +75,9 @@ ServoLoop::ServoLoop(Device& device, const strings::DeviceConfig& config, ServoC
       commands_(config.string_count(), device.info().command_min),
       jitter_hist_(kBins, 0),
       compute_hist_(kBins, 0) {
+  if (!(servo_.idle_spin_lead_s >= 0 && servo_.idle_spin_lead_s <= 1))
+    throw SpidarError("ServoLoop: expected idle_spin_lead_s in [0, 1] s, got " +
+                      std::to_string(servo_.idle_spin_lead_s));
   if (!(servo_.deadline_periods > 0) || !(servo_.force_timeout_s > 0) ||
       !(servo_.stall_limit_s > 0 && servo_.stall_limit_s <= 1.0) ||
       !(servo_.force_lost_s > 0 && servo_.force_lost_s <= 10.0))
@@ -231,6 +235,7 @@ void ServoLoop::end_servo_thread(pthread_t servo_thread, std::int64_t window_ns)
 void ServoLoop::run() {
   if (servo_.on_thread_start) servo_.on_thread_start();
   std::optional<core::CpuLatencyRequest> cpu_latency;
+  std::unique_ptr<core::IdleSpinner> idle_spinner;  // declared after: stopped before the request ends
   if (servo_.realtime) {
     const Status rt = core::set_fifo_priority(80);
     realtime_granted_ = rt.ok();
@@ -248,7 +253,23 @@ void ServoLoop::run() {
       spdlog::warn("servo loop: {}; idle CPUs may sleep deeply between cycles, expect more jitter",
                    qos.error().message);
     }
+    // Where no cpuidle driver honours that request (a plain HLT in a VM), the servo's own CPU is
+    // kept busy at SCHED_IDLE instead (core::IdleSpinner).
+    if (servo_.idle_spin) {
+      core::IdleSpinWindow window;
+      if (servo_.idle_spin_lead_s > 0) {
+        window.deadline_ns = &next_deadline_ns_;
+        window.lead_ns = std::max<std::int64_t>(core::s_to_ns(servo_.idle_spin_lead_s), 1);
+      }
+      next_deadline_ns_.store(core::monotonic_ns() + period_ns_, std::memory_order_release);
+      if (auto sp = core::IdleSpinner::start(servo_.cpu, window)) {
+        idle_spinner = std::move(sp).value();  // stopped when this thread's loop ends
+      } else {
+        spdlog::warn("servo loop: {}; its CPU may halt between cycles, expect more jitter", sp.error().message);
+      }
+    }
   }
+  idle_spin_.store(idle_spinner != nullptr, std::memory_order_relaxed);
   if (!(faults_.load() & kSafeStateFaults)) device_.clear_safe_state();
 
   EncoderReading reading;
@@ -260,6 +281,7 @@ void ServoLoop::run() {
   const std::int64_t force_lost = core::s_to_ns(servo_.force_lost_s);
   std::int64_t stale_since = -1;  ///< host time the forces went stale, −1 while fresh
   while (!stop_.load(std::memory_order_acquire)) {
+    next_deadline_ns_.store(deadline, std::memory_order_release);  // the idle spinner's window
     core::sleep_until_ns(deadline);
     const std::int64_t wake = core::monotonic_ns();
     if (prev_wake != 0) {
@@ -402,6 +424,7 @@ ServoStats ServoLoop::stats() const {
   s.longest_repeat = longest_repeat_;
   s.inconsistent = cycle_maths_.inconsistent();
   s.realtime_scheduling = realtime_granted_;
+  s.idle_spin = idle_spin_.load(std::memory_order_relaxed);
   s.released_at_end = released_at_end_.load(std::memory_order_acquire);
   return s;
 }

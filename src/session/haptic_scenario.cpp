@@ -51,6 +51,7 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
 
   HapticSideParams hp;
   hp.servo.rate_hz = o.rate_hz;
+  hp.servo.idle_spin = o.idle_spin;
   hp.servo.force_timeout_s = 0.05;
   const device::ServoConfig& servo = hp.servo;
   HapticSide haptic(dev, cfg, *world, wp.coupling, hp);

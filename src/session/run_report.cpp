@@ -325,7 +325,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                                           {"thickness_frozen", e.thickness_frozen},
                                           {"keyframes", e.keyframes},
                                           {"solves", e.solves},
-                                          {"steps_rejected", e.steps_rejected}};
+                                          {"steps_rejected", e.steps_rejected},
+                                          {"palm_chords", e.palm_chords}};
     }
     shape["personalised"] = s.personalised;
     reg["hand_shape"] = shape;
@@ -351,6 +352,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"deadline_misses", s.servo.deadline_misses},
         {"stale_force_cycles", s.servo.stale_force_cycles},
         {"cycle_us_median", s.servo.cycle_us_median},
+        {"realtime_scheduling", s.servo.realtime_scheduling},
+        {"idle_spin", s.servo.idle_spin},
         {"faults", device::fault_names(s.servo.faults)},
         {"fault_message", s.servo.fault_message}}},
       {"physics",

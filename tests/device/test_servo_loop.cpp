@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <sched.h>
+
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <new>
 #include <random>
 #include <thread>
@@ -39,6 +42,7 @@ TEST(ServoLoop, RunsAndKeepsOrderedStatistics) {
   // watchdog has its own tests. It runs for a number of cycles, not for a time.
   cfg.deadline_periods = 1000;
   cfg.stall_limit_s = 1.0;
+  cfg.idle_spin = true;
   ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<ZeroForce>());
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_TRUE(loop.start().ok());
@@ -58,6 +62,11 @@ TEST(ServoLoop, RunsAndKeepsOrderedStatistics) {
   EXPECT_LE(s.cycle_us_median, s.cycle_us_p99);
   EXPECT_LE(s.cycle_us_p99, s.cycle_us_max + 1.0);
   EXPECT_GT(s.cycle_us_max, 0.0);
+  // Its CPU kept from halting while it ran (core::IdleSpinner; SCHED_IDLE needs no privilege),
+  // and the spinner gone with the loop.
+  EXPECT_TRUE(s.idle_spin);
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/task"))
+    EXPECT_NE(sched_getscheduler(static_cast<pid_t>(std::stol(e.path().filename().string()))), SCHED_IDLE);
 
   // The ring holds the newest samples, newest first, in cycle and time order.
   FingertipSample samples[64];

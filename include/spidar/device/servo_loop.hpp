@@ -57,6 +57,16 @@ struct ServoConfig {
   double rate_hz = 1000.0;
   bool realtime = true;           ///< try SCHED_FIFO (priority 80) and CPU pinning
   int cpu = -1;                   ///< CPU to pin to; -1: the last CPU
+  /// With `realtime`: keep the servo's CPU from halting before each cycle (core::IdleSpinner, a
+  /// SCHED_IDLE thread spinning on it from idle_spin_lead_s before each deadline). In a VM a
+  /// halted vCPU wakes hundreds of microseconds late: `device-test` jitter p99 460–650 µs quiet
+  /// without, 25–45 µs with. Off by default: on a 2-core machine that also runs a camera pipeline
+  /// it cost the demo's frames 1–2 ms of latency and gained little there (docs/realtime.md);
+  /// `device-test` and the haptic scenario turn it on.
+  bool idle_spin = false;
+  /// How long before each deadline the spinner spins [s]; 0: always (the CPU never idles, which
+  /// starves the scheduler's idle balancing: docs/realtime.md). In [0, 1].
+  double idle_spin_lead_s = 0.0005;
   /// A cycle that wakes or ends this many periods late counts as a deadline miss; > 0.
   double deadline_periods = 5.0;
   double force_timeout_s = 0.02;  ///< forces older than this are not displayed [s], > 0
@@ -111,6 +121,7 @@ struct ServoStats {
   /// bound; …" (FaultLog::describe). Empty when no fault is latched.
   std::string fault_message;
   bool realtime_scheduling = false; ///< SCHED_FIFO was granted
+  bool idle_spin = false;           ///< the servo's CPU was kept from halting (ServoConfig::idle_spin)
   /// The servo thread did not end within a stall window of the stop request (the scheduler starved
   /// it) and was moved to normal scheduling on every CPU so that it could end.
   bool released_at_end = false;
@@ -201,6 +212,8 @@ class ServoLoop {
   std::uint64_t repeated_readings_ = 0, longest_repeat_ = 0;
   FaultLog fault_log_;
   bool realtime_granted_ = false;
+  std::atomic<bool> idle_spin_{false};  ///< the servo thread runs a core::IdleSpinner
+  std::atomic<std::int64_t> next_deadline_ns_{0};  ///< the servo thread's next wake-up (the spinner's window)
   std::int64_t start_ns_ = 0;  ///< when start() was called (monotonic) [ns]
   std::atomic<bool> released_at_end_{false};
 

@@ -18,6 +18,7 @@ struct ScenarioOptions {
   double seconds = 0;                            ///< 0: the scenario's own length [s]
   double rate_hz = 1000.0;                       ///< servo rate [Hz]
   std::uint64_t seed = 1;
+  bool idle_spin = true;                         ///< device::ServoConfig::idle_spin
 };
 
 /// The left hand lifts the Rubik's cube, the right hand turns its top layer (simulated device,
