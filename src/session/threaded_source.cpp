@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/core/wait_until.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/session/frame_source.hpp"
 #include "spidar/session/interactive_hands.hpp"
@@ -33,11 +34,7 @@ class ThreadedSource : public FrameSource {
   }
   void wait_for_frame(std::int64_t deadline_ns) override {
     std::unique_lock lock(mutex_);
-    while (!fresh_ && !done_.load(std::memory_order_acquire)) {
-      const std::int64_t left = deadline_ns - core::monotonic_ns();
-      if (left <= 0) break;
-      arrived_.wait_for(lock, std::chrono::nanoseconds(left));
-    }
+    core::wait_until_ns(arrived_, lock, deadline_ns, [&] { return fresh_ || done_.load(std::memory_order_acquire); });
   }
   bool ended() const override { return done_.load(std::memory_order_acquire); }
   std::string error() const override {

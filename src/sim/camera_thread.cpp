@@ -8,6 +8,7 @@
 
 #include "spidar/core/clock.hpp"
 #include "spidar/core/realtime.hpp"
+#include "spidar/core/wait_until.hpp"
 #include "spidar/render/context.hpp"
 
 namespace spidar::sim {
@@ -88,11 +89,7 @@ void CameraThread::stop() {
 
 bool CameraThread::wait_for_frame(std::int64_t deadline_ns) {
   std::unique_lock lock(newest_mutex_);
-  while (!newest_ && !ended_) {
-    const std::int64_t left = deadline_ns - core::monotonic_ns();
-    if (left <= 0) break;
-    arrived_.wait_for(lock, std::chrono::nanoseconds(left));
-  }
+  core::wait_until_ns(arrived_, lock, deadline_ns, [&] { return newest_ != nullptr || ended_; });
   return newest_ != nullptr;
 }
 

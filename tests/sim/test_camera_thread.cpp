@@ -39,6 +39,19 @@ struct Filmed {
       for (int f = 0; f < hand::kFingertipCount; ++f) out[static_cast<std::size_t>(4 * h + f)] = pts.p_W_fingertip[f];
     }
   }
+  /// The fingertips at exposure time t_ns of a clock started at t0_ns: the script from 1 s on,
+  /// hands in view and moving.
+  void caps_at(std::int64_t t0_ns, std::int64_t t_ns, std::span<Vec3> out) const {
+    caps(1.0 + core::ns_to_s(t_ns - t0_ns), out);
+  }
+  /// A ground truth that always has them, for a clock started at *t0_ns (read at each exposure:
+  /// it may be set after the camera is prepared).
+  TruthAt nominal_from(const std::atomic<std::int64_t>* t0_ns) const {
+    return [this, t0_ns](std::int64_t t_ns, std::span<Vec3> out) {
+      caps_at(t0_ns->load(), t_ns, out);
+      return true;
+    };
+  }
   Result<std::unique_ptr<CameraThread>> start(TruthAt truth_at, const CameraThreadParams& params) const {
     return CameraThread::start(vision::default_rig_camera(), truth, {}, task, std::move(truth_at), params);
   }
@@ -102,7 +115,7 @@ TEST(CameraThread, TheFirstExposureComesAfterTheDevicesFirstSample) {
     std::vector<std::pair<std::int64_t, bool>> asked;  // exposure time, truth given
     TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
       const bool have = t_ns > t0;  // the device's first sample is just after t0
-      if (have) filmed.caps(1.0 + core::ns_to_s(t_ns - t0), out);
+      if (have) filmed.caps_at(t0, t_ns, out);
       const std::lock_guard lock(m);
       asked.emplace_back(t_ns, have);
       return have;
@@ -142,7 +155,7 @@ TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
   std::atomic<int> asked_before_begin{0};
   TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
     if (t0.load() == 0) ++asked_before_begin;
-    filmed.caps(1.0 + core::ns_to_s(t_ns - t0.load()), out);
+    filmed.caps_at(t0.load(), t_ns, out);
     return true;
   };
   CameraThreadParams params;
@@ -200,7 +213,7 @@ TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
       const std::lock_guard lock(m);
       asked_after.push_back(now - t_ns);
     }
-    filmed.caps(1.0 + core::ns_to_s(t_ns - t0), out);
+    filmed.caps_at(t0, t_ns, out);
     return true;
   };
   auto thread = filmed.start(truth_at, params);
@@ -234,10 +247,7 @@ TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
 TEST(CameraThread, WaitForFrameWakesAtThePublicationAndEndsWithTheThread) {
   const Filmed filmed;
   std::atomic<std::int64_t> t0{0};
-  TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
-    filmed.caps(1.0 + core::ns_to_s(t_ns - t0.load()), out);
-    return true;
-  };
+  const TruthAt truth_at = filmed.nominal_from(&t0);
   CameraThreadParams params;
   params.fps = 20;
   auto thread = filmed.prepare(truth_at, params);
@@ -276,11 +286,8 @@ TEST(CameraThread, AHeldFrameIsNotFilmedOver) {
   CameraThreadParams params;
   params.fps = 60;
   params.t0_ns = core::monotonic_ns();
-  const std::int64_t t0 = params.t0_ns;
-  TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
-    filmed.caps(1.0 + core::ns_to_s(t_ns - t0), out);  // hands in view, moving
-    return true;
-  };
+  const std::atomic<std::int64_t> t0{params.t0_ns};
+  const TruthAt truth_at = filmed.nominal_from(&t0);
   auto thread = filmed.start(truth_at, params);
   ASSERT_TRUE(thread.ok()) << thread.error().message;
   CameraThread& cam = *thread.value();
