@@ -138,6 +138,9 @@ TEST(Cli, DeviceTestOnTheSimulatedDeviceReportsLoopStatistics) {
   for (const auto& f : j["faults"]) EXPECT_TRUE(f == "deadline_miss" || f == "watchdog") << f;
   EXPECT_GT(j["cycles"].get<int>(), 100);
   EXPECT_LE(j["jitter_p50_us"].get<double>(), j["jitter_p99_us"].get<double>());
+  EXPECT_TRUE(j["idle_spin"].get<bool>());  // on in device-test (SCHED_IDLE needs no privilege)
+  EXPECT_FALSE(nlohmann::json::parse(run("device-test --backend sim --seconds 0.2 --no-idle-spin").out)["idle_spin"]
+                   .get<bool>());
   ASSERT_EQ(j["fingertips"].size(), 8u);
   EXPECT_EQ(j["fingertips"][3]["name"], "left_ring");
   // The last cycle's tensions and commands, from its sample: zero desired force keeps every
@@ -251,6 +254,7 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_GE(j["pipeline"]["dropped_frames"].get<int>(), 0);
   EXPECT_GE(j["pipeline"]["latency_ms_p95"].get<double>(), j["pipeline"]["latency_ms_median"].get<double>());
   EXPECT_GT(j["haptic"]["rate_hz"].get<double>(), 0.0);  // its value is the report's, not a test's
+  EXPECT_FALSE(j["haptic"]["idle_spin"].get<bool>());  // off in the mixed-reality demo unless asked
   EXPECT_GT(j["physics"]["step_ms_median"].get<double>(), 0.0);
   const auto& reg = j["registration"];
   // Measured at 320x240 on a quiet machine: IoU 0.77, fingertips 1.9 mm, joints 7.2 px; with
