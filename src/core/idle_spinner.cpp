@@ -48,7 +48,7 @@ void* IdleSpinner::spin(void* self_ptr) {
         continue;
       }
       if (now > d + w.lead_ns) {  // the deadline passed and no next one came: wait for it
-        sleep_until_ns(now + w.lead_ns);
+        sleep_until_ns(now + std::min(w.lead_ns, kMaxSleepNs));
         continue;
       }
       while (w.deadline_ns->load(std::memory_order_acquire) == d && monotonic_ns() <= d + w.lead_ns &&

@@ -71,30 +71,46 @@ TEST(IdleSpinner, ACpuThatDoesNotExistIsRefusedWithNothingRunning) {
   EXPECT_TRUE(idle_threads().empty());
 }
 
-// With a deadline it sleeps until the lead before it, spins from then, and stops spinning once the
-// deadline has passed and no next one came.
+/// Waits (at most a minute) until the spinner has stopped spinning: no round in 30 ms. A spinner
+/// starved in the middle of a round may finish it later.
+bool comes_to_rest(const IdleSpinner& s) {
+  for (const std::int64_t until = monotonic_ns() + 60'000'000'000; monotonic_ns() < until;) {
+    const std::uint64_t before = s.rounds();
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    if (s.rounds() == before) return true;
+  }
+  return false;
+}
+
+// With a deadline it sleeps until the lead before it and spins from then until the loop sets the
+// next deadline, or until the deadline has passed by the lead. The lead here is a minute long, so
+// that a spinner starved by other processes (SCHED_IDLE runs last) still gets its turn inside it.
 TEST(IdleSpinner, WithADeadlineSpinsOnlyFromItsLead) {
+  const std::int64_t lead = 60'000'000'000;
   std::atomic<std::int64_t> deadline{monotonic_ns() + 3'600'000'000'000};  // an hour away
-  const std::int64_t lead = 20'000'000;
   auto started = IdleSpinner::start(-1, {&deadline, lead});
   ASSERT_TRUE(started.ok()) << started.error().message;
   std::unique_ptr<IdleSpinner> s = std::move(started).value();
   std::this_thread::sleep_for(std::chrono::milliseconds(30));
   EXPECT_EQ(s->rounds(), 0u);  // asleep: the lead has not begun
-  const std::int64_t d = monotonic_ns() + 2 * lead;
+  // The lead begins 20 ms from now.
+  std::int64_t d = monotonic_ns() + lead + 20'000'000;
   deadline.store(d);
   ASSERT_TRUE(spun(*s));
   EXPECT_GE(monotonic_ns(), d - lead);  // it spun only once the lead had begun
-  // Past the deadline and its lead with no next one: it sleeps again (a spinner starved in the
-  // middle of a round may finish it later: it must come to rest within a minute).
-  while (monotonic_ns() < d + 2 * lead) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  bool rests = false;
-  for (const std::int64_t until = monotonic_ns() + 60'000'000'000; !rests && monotonic_ns() < until;) {
-    const std::uint64_t before = s->rounds();
-    std::this_thread::sleep_for(std::chrono::milliseconds(30));
-    rests = s->rounds() == before;
-  }
-  EXPECT_TRUE(rests);
+  // The loop woke and set its next deadline, an hour away: the spinner sleeps again.
+  deadline.store(monotonic_ns() + 3'600'000'000'000);
+  EXPECT_TRUE(comes_to_rest(*s));
+  // Spinning again, then a deadline that has passed by more than the lead with no next one (a
+  // loop held up): it sleeps.
+  d = monotonic_ns() + lead;
+  const std::uint64_t rested = s->rounds();
+  deadline.store(d);
+  for (const std::int64_t until = monotonic_ns() + 60'000'000'000; s->rounds() == rested && monotonic_ns() < until;)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_GT(s->rounds(), rested);
+  deadline.store(monotonic_ns() - 3 * lead);
+  EXPECT_TRUE(comes_to_rest(*s));
   // A lead that is not positive is refused.
   const auto bad = IdleSpinner::start(-1, {&deadline, 0});
   ASSERT_FALSE(bad.ok());
