@@ -2,7 +2,6 @@
 
 #include <pthread.h>
 #include <sched.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstring>
@@ -32,6 +31,10 @@ constexpr std::int64_t kMaxSleepNs = 1'000'000;
 
 void* IdleSpinner::spin(void* self_ptr) {
   auto* self = static_cast<IdleSpinner*>(self_ptr);
+  auto round = [self] {
+    for (int i = 0; i < kPausesPerRound; ++i) cpu_pause();
+    self->rounds_.fetch_add(1, std::memory_order_relaxed);
+  };
   // Down to SCHED_IDLE first (lowering needs no privilege; should it fail, it does not spin).
   sched_param sp{};
   sp.sched_priority = 0;
@@ -52,29 +55,25 @@ void* IdleSpinner::spin(void* self_ptr) {
         continue;
       }
       while (w.deadline_ns->load(std::memory_order_acquire) == d && monotonic_ns() <= d + w.lead_ns &&
-             !self->stop_.load(std::memory_order_relaxed)) {
-        for (int i = 0; i < kPausesPerRound; ++i) cpu_pause();
-        self->rounds_.fetch_add(1, std::memory_order_relaxed);
-      }
+             !self->stop_.load(std::memory_order_relaxed))
+        round();
       continue;
     }
-    for (int i = 0; i < kPausesPerRound; ++i) cpu_pause();
-    self->rounds_.fetch_add(1, std::memory_order_relaxed);
+    round();
   }
   self->ended_.store(true, std::memory_order_release);
   return nullptr;
 }
 
 Result<std::unique_ptr<IdleSpinner>> IdleSpinner::start(int cpu, IdleSpinWindow window) {
-  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  const auto resolved = online_cpu(cpu);
+  if (!resolved) return Error{"idle spinner: " + resolved.error().message};
   std::unique_ptr<IdleSpinner> s(new IdleSpinner());
-  s->cpu_ = cpu >= 0 ? cpu : static_cast<int>(online > 0 ? online - 1 : 0);
+  s->cpu_ = resolved.value();
   const std::string where = "idle spinner on CPU " + std::to_string(s->cpu_) + ": ";
   if (window.deadline_ns != nullptr && !(window.lead_ns > 0))
     return Error{where + "the lead before the deadline must be > 0 ns, got " + std::to_string(window.lead_ns)};
   s->window_ = window;
-  if (online > 0 && s->cpu_ >= online)
-    return Error{where + "not online (" + std::to_string(online) + " CPUs)"};
   // Created pinned to its CPU at SCHED_OTHER, not inheriting the caller's scheduling (a caller at
   // SCHED_FIFO would hand it a real-time priority), and not waited for: one starting on a CPU a
   // real-time thread holds would hold up the caller. It goes down to SCHED_IDLE itself (glibc's

@@ -66,11 +66,18 @@ CpuLatencyRequest::~CpuLatencyRequest() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-Status pin_to_cpu(int cpu) {
+Result<int> online_cpu(int cpu) {
   const long online = sysconf(_SC_NPROCESSORS_ONLN);
   const int c = cpu >= 0 ? cpu : static_cast<int>(online > 0 ? online - 1 : 0);
   if (online > 0 && c >= online)
     return Error{"CPU " + std::to_string(c) + " is not online (" + std::to_string(online) + " CPUs)"};
+  return c;
+}
+
+Status pin_to_cpu(int cpu) {
+  const auto resolved = online_cpu(cpu);
+  if (!resolved) return resolved.error();
+  const int c = resolved.value();
   cpu_set_t set;
   CPU_ZERO(&set);
   CPU_SET(c, &set);

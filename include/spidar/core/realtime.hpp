@@ -43,6 +43,9 @@ class CpuLatencyRequest {
   int fd_ = -1;
 };
 
+/// The CPU `cpu` names (0-based; −1 = the last online CPU). Error when it is not online.
+Result<int> online_cpu(int cpu);
+
 /// Pins the calling thread to `cpu` (0-based; −1 = the last online CPU). Error names the CPU.
 Status pin_to_cpu(int cpu);
 
