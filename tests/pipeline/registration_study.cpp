@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 #include <opencv2/core.hpp>
@@ -55,6 +56,8 @@ struct Args {
   std::string user_file;
   bool model_user = false;
   double model_length = 0, model_width = 0;
+  /// --model-cap x,y,z: the model's fingertip-cap offset (HandDimensions::fingertip_offset) [m]
+  std::optional<Vec3> model_cap;
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
@@ -92,6 +95,14 @@ int main(int argc, char** argv) {
     else if (k == "--user-file") a.user_file = next();
     else if (k == "--model-user") a.model_user = true;
     else if (k == "--model") std::sscanf(next().c_str(), "%lf,%lf", &a.model_length, &a.model_width);
+    else if (k == "--model-cap") {
+      Vec3 c;
+      if (std::sscanf(next().c_str(), "%lf,%lf,%lf", &c.x(), &c.y(), &c.z()) != 3) {
+        std::fprintf(stderr, "registration_study: --model-cap: expected x,y,z [m]\n");
+        return 2;
+      }
+      a.model_cap = c;
+    }
     else if (k == "--silhouette") a.silhouette = true;
     else if (k == "--no-balls") a.no_balls = true;
     else if (k == "--no-wrist") a.no_wrist = true;
@@ -145,6 +156,13 @@ int main(int argc, char** argv) {
     d.width = a.model_width;
     models = {hand::make_hand_model(hand::Side::kLeft, d).value(),
               hand::make_hand_model(hand::Side::kRight, d).value()};
+  }
+  if (a.model_cap) {
+    for (auto& m : models) {
+      hand::HandDimensions d = m.shape.dimensions;
+      d.fingertip_offset = *a.model_cap;
+      m.shape = hand::make_hand_shape(d).value();
+    }
   }
   const vision::Camera camera = vision::default_rig_camera();
   render::HandSkinParams model_skin = pipeline::FramePipelineParams{}.model_skin;
@@ -296,6 +314,9 @@ int main(int argc, char** argv) {
   // Joint error by digit and joint along it (fit, and the floor as above) [px sums], and counts.
   std::array<std::array<double, 4>, 5> joint_at_sum{}, joint_at_floor{}, joint_at_n{};
   std::vector<double> chord_ratio;  // the real palm's chord / the model's, at the truth
+  // The fits' evidence cost per hand and frame (TermCosts, without the prior): total, fingertip,
+  // wrist, joint-ball, silhouette.
+  std::array<std::vector<double>, 5> evidence_terms;
   std::array<Vec3, 8> g;
   for (double t = a.t0; t < a.t1 && !task.finished(t); t += 1.0 / a.fps) {
     // The device's caps: at the face, pressed a fifth of the squeeze in (the displayed force
@@ -558,6 +579,14 @@ int main(int argc, char** argv) {
     caps.push_back(1e3 * cap_res);
     iou.push_back(m.iou);
     tip.push_back(0.5 * (m.fingertip_mm[0] + m.fingertip_mm[1]));
+    for (int h = 0; h < 2; ++h) {
+      const registration::TermCosts& tc = r.fits[static_cast<std::size_t>(h)].terms;
+      evidence_terms[0].push_back(tc.evidence());
+      evidence_terms[1].push_back(tc.fingertip);
+      evidence_terms[2].push_back(tc.wrist);
+      evidence_terms[3].push_back(tc.joint_ball);
+      evidence_terms[4].push_back(tc.silhouette);
+    }
     joint.push_back(0.5 * (m.joint_px[0] + m.joint_px[1]));
     ceil_iou.push_back(c);
     if (m.contested_pixels > 0) {
@@ -579,6 +608,9 @@ int main(int argc, char** argv) {
       "%.2f px  contested %.2f %% (paper %.2f %%)\n",
       iou.size(), mean(iou), quantile(iou, 0.05), mean(ceil_iou), quantile(ceil_iou, 0.05),
       mean(tip), quantile(tip, 0.95), mean(joint), mean(contested), mean(contested_paper));
+  std::printf("fit evidence per hand-frame %.3f (median %.3f): fingertip %.3f wrist %.3f joint-ball %.3f silhouette %.3f\n",
+              mean(evidence_terms[0]), quantile(evidence_terms[0], 0.5), mean(evidence_terms[1]),
+              mean(evidence_terms[2]), mean(evidence_terms[3]), mean(evidence_terms[4]));
   if (!variants.empty()) std::printf("ceiling as the model's skin: %.3f (p5 %.3f)\n", mean(ceil_iou), quantile(ceil_iou, 0.05));
   for (const Variant& v : variants)
     std::printf("ceiling with %s: %.3f (p5 %.3f)\n", v.name.c_str(), mean(v.iou), quantile(v.iou, 0.05));
