@@ -35,6 +35,15 @@ std::vector<pid_t> idle_threads() {
   return out;
 }
 
+/// Whether this process has no SCHED_IDLE thread, waiting up to a second for one that has ended to
+/// leave /proc: pthread_join returns when the kernel clears the thread's id, which it does on its
+/// way out, before the task itself is gone (seen: 1 in 3 runs of the suite listed it just after).
+bool no_idle_thread_within_a_second() {
+  const std::int64_t until = monotonic_ns() + 1'000'000'000;
+  while (!idle_threads().empty() && monotonic_ns() < until) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  return idle_threads().empty();
+}
+
 /// Waits (at most a minute: only a spinner that never runs reaches it) until it has spun.
 bool spun(const IdleSpinner& s) {
   const std::int64_t until = monotonic_ns() + 60'000'000'000;
@@ -43,7 +52,7 @@ bool spun(const IdleSpinner& s) {
 }
 
 TEST(IdleSpinner, SpinsAtSchedIdlePinnedToItsCpuUntilDestroyed) {
-  ASSERT_TRUE(idle_threads().empty());
+  ASSERT_TRUE(no_idle_thread_within_a_second());
   const long online = sysconf(_SC_NPROCESSORS_ONLN);
   for (const int asked : {-1, 0}) {
     auto started = IdleSpinner::start(asked);
@@ -60,7 +69,7 @@ TEST(IdleSpinner, SpinsAtSchedIdlePinnedToItsCpuUntilDestroyed) {
     EXPECT_EQ(CPU_COUNT(&set), 1);
     EXPECT_TRUE(CPU_ISSET(cpu, &set));
     s.reset();
-    EXPECT_TRUE(idle_threads().empty()) << "the spinner's thread outlived it";
+    EXPECT_TRUE(no_idle_thread_within_a_second()) << "the spinner's thread outlived it";
   }
 }
 
@@ -144,7 +153,7 @@ TEST(IdleSpinner, StopsWhenARealTimeThreadHoldsItsCpu) {
   hog_stop = true;
   hog.join();
   EXPECT_TRUE(hog_on.load());
-  EXPECT_TRUE(idle_threads().empty());
+  EXPECT_TRUE(no_idle_thread_within_a_second());
 }
 
 }  // namespace
