@@ -1,9 +1,10 @@
 # Run after a test executable's link (spidar_gtest_discover, SPIDAR_TEST_BATCH ON): lists its
 # tests that pass the call's filter and writes one ctest test per suite into OUT.
 # Input: -D ARGS_FILE=<file setting EXE, PREFIX, FILTER, WORKDIR, TIMEOUT, TAG, PROPS, OUT>.
+# Strings are tested with STREQUAL "": a bare if(<string>) reads "N", "No" or "Off" as false.
 include("${ARGS_FILE}")
 set(cmd "${EXE}" --gtest_list_tests)
-if(FILTER)
+if(NOT FILTER STREQUAL "")
   list(APPEND cmd "--gtest_filter=${FILTER}")
 endif()
 execute_process(COMMAND ${cmd} WORKING_DIRECTORY "${WORKDIR}" TIMEOUT ${TIMEOUT}
@@ -21,7 +22,7 @@ string(REGEX MATCHALL "[^\n]+" lines "${listing}")
 foreach(line IN LISTS lines)
   if(line MATCHES "^([^ ]+)\\.( +#.*)?$")
     set(suite "${CMAKE_MATCH_1}")
-  elseif(suite AND line MATCHES "^  ([^ ]+)")
+  elseif(NOT suite STREQUAL "" AND line MATCHES "^  ([^ ]+)")
     set(test "${CMAKE_MATCH_1}")
     if(suite MATCHES "(^|/)DISABLED_" OR test MATCHES "^DISABLED_")
       continue()
@@ -39,7 +40,7 @@ foreach(suite IN LISTS suites)
   string(MAKE_C_IDENTIFIER "${suite}" key)
   string(SUBSTRING "${tests_${key}}" 1 -1 filter)
   set(name "${PREFIX}${suite}.*")
-  if(TAG)
+  if(NOT TAG STREQUAL "")
     string(APPEND name " (${TAG})")
   endif()
   string(APPEND text "add_test([==[${name}]==] [==[${EXE}]==] [==[--gtest_filter=${filter}]==])\n")

@@ -608,13 +608,14 @@ int main(int argc, char** argv) {
       "%.2f px  contested %.2f %% (paper %.2f %%)\n",
       iou.size(), mean(iou), quantile(iou, 0.05), mean(ceil_iou), quantile(ceil_iou, 0.05),
       mean(tip), quantile(tip, 0.95), mean(joint), mean(contested), mean(contested_paper));
-  std::printf("final model: L %.4f/%.4f W %.4f/%.4f cap y,z [mm] %.2f,%.2f / %.2f,%.2f (truth L %.4f W %.4f cap %.2f,%.2f)\n",
-              r.models[0].shape.dimensions.length, r.models[1].shape.dimensions.length,
-              r.models[0].shape.dimensions.width, r.models[1].shape.dimensions.width,
-              1e3 * r.models[0].shape.dimensions.fingertip_offset.y(), 1e3 * r.models[0].shape.dimensions.fingertip_offset.z(),
-              1e3 * r.models[1].shape.dimensions.fingertip_offset.y(), 1e3 * r.models[1].shape.dimensions.fingertip_offset.z(),
-              truth_models[0].shape.dimensions.length, truth_models[0].shape.dimensions.width,
-              1e3 * truth_models[0].shape.dimensions.fingertip_offset.y(), 1e3 * truth_models[0].shape.dimensions.fingertip_offset.z());
+  {
+    const hand::HandDimensions &l = r.models[0].shape.dimensions, &rt = r.models[1].shape.dimensions,
+                               &tr = truth_models[0].shape.dimensions;
+    std::printf("final model: L %.4f/%.4f W %.4f/%.4f cap y,z [mm] %.2f,%.2f / %.2f,%.2f (truth L %.4f W %.4f cap %.2f,%.2f)\n",
+                l.length, rt.length, l.width, rt.width, 1e3 * l.fingertip_offset.y(), 1e3 * l.fingertip_offset.z(),
+                1e3 * rt.fingertip_offset.y(), 1e3 * rt.fingertip_offset.z(), tr.length, tr.width,
+                1e3 * tr.fingertip_offset.y(), 1e3 * tr.fingertip_offset.z());
+  }
   std::printf("fit evidence per hand-frame %.3f (median %.3f): fingertip %.3f wrist %.3f joint-ball %.3f silhouette %.3f\n",
               mean(evidence_terms[0]), quantile(evidence_terms[0], 0.5), mean(evidence_terms[1]),
               mean(evidence_terms[2]), mean(evidence_terms[3]), mean(evidence_terms[4]));
