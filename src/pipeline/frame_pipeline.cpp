@@ -185,6 +185,15 @@ void FramePipeline::reset() {
   for (int h = 0; h < 2; ++h) s.models[h] = fit_model(s.start[h], s.params);
   s.make_estimators();
 }
+Status FramePipeline::warm_start(const std::array<hand::HandParams, 2>& fits) {
+  for (int h = 0; h < 2; ++h)
+    if (!fits[h].q.allFinite())
+      return Error{std::string("frame pipeline: warm_start: the ") + (h == 0 ? "left" : "right") +
+                   " hand's parameters are not finite"};
+  impl_->previous = fits;
+  impl_->have_previous = true;
+  return Ok{};
+}
 bool FramePipeline::has_previous() const { return impl_->have_previous; }
 Status FramePipeline::present(render::Context& context, const cv::Mat& bgr) {
   return impl_->renderer->present(context, bgr);

@@ -181,6 +181,8 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
         {"jitter_max_us", ss.jitter_max_us},
         {"overruns", ss.overruns},
         {"cycle_us_median", ss.cycle_us_median},
+        {"cycle_us_p99", ss.cycle_us_p99},
+        {"cycle_us_max", ss.cycle_us_max},
         {"realtime_scheduling", ss.realtime_scheduling},
         {"idle_spin", ss.idle_spin},
         {"faults", device::fault_names(ss.faults)},

@@ -352,6 +352,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"deadline_misses", s.servo.deadline_misses},
         {"stale_force_cycles", s.servo.stale_force_cycles},
         {"cycle_us_median", s.servo.cycle_us_median},
+        {"cycle_us_p99", s.servo.cycle_us_p99},
+        {"cycle_us_max", s.servo.cycle_us_max},
         {"realtime_scheduling", s.servo.realtime_scheduling},
         {"idle_spin", s.servo.idle_spin},
         {"faults", device::fault_names(s.servo.faults)},

@@ -36,6 +36,7 @@
 #include "spidar/registration/palm_breadth.hpp"
 #include "spidar/registration/registration_params.hpp"
 #include "spidar/registration/shape_estimator.hpp"
+#include "spidar/registration/wrist_depth.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/render/renderer.hpp"
 #include <opencv2/imgproc.hpp>
@@ -61,6 +62,7 @@ struct Args {
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
+  bool oracle = false;  ///< also fit each frame from the true pose, and compare the evidence
   double q_from = -1, q_to = 0.4;  ///< with --verbose, fit − truth parameters for frames in [q_from, q_to) [s]
   bool ceiling_scan = false;
   double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
@@ -114,6 +116,7 @@ int main(int argc, char** argv) {
     else if (k == "--t1") a.t1 = std::atof(next().c_str());
     else if (k == "--fps") a.fps = std::atof(next().c_str());
     else if (k == "--verbose") a.verbose = true;
+    else if (k == "--oracle") a.oracle = true;
     else if (k == "--q-from") a.q_from = std::atof(next().c_str());
     else if (k == "--q-to") a.q_to = std::atof(next().c_str());
     else if (k == "--ceiling-scan") a.ceiling_scan = true;
@@ -255,6 +258,9 @@ int main(int argc, char** argv) {
     }
     const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
     if (key == "silhouette_downsample") p.silhouette_downsample = std::atoi(value.c_str());
+    else if (key == "other_depth_every") p.other_depth_every = std::atoi(value.c_str());
+    else if (key == "other_depth_rounds") p.other_depth_rounds = std::atoi(value.c_str());
+    else if (key == "other_depth_keep") p.other_depth_keep = std::atof(value.c_str());
     else if (key.rfind("shape.", 0) == 0) shape_keys += "  " + key.substr(6) + ": " + value + "\n";
     else reg_keys += "  " + key + ": " + value + "\n";
   }
@@ -286,6 +292,15 @@ int main(int argc, char** argv) {
     p.initial_r_W_hand[h] =
         task.nominal(a.t0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
   auto pipe = pipeline::FramePipeline::create(context, camera, models, p).value();
+  // --oracle: a second pipeline, warm-started at the true pose every frame (no size estimate).
+  pipeline::FramePipelineParams oracle_p = p;
+  oracle_p.personalise_shape = false;
+  auto oracle = a.oracle ? pipeline::FramePipeline::create(context, camera, models, oracle_p).value() : nullptr;
+  pipeline::FrameResult oracle_r;
+  std::array<int, 2> oracle_better{}, oracle_n{};
+  std::array<double, 2> oracle_depth_sum{}, tracked_depth_sum{};
+  std::vector<double> oracle_iou, oracle_joint;  // the fits from the truth: IoU, joint error [px]
+  sim::FrameTruthWorkspace oracle_ws;
   sim::UserHands hands(truth_models, task);
 
   SceneSnapshot scene;  // a cube where the user grasps
@@ -317,6 +332,7 @@ int main(int argc, char** argv) {
   // The fits' evidence cost per hand and frame (TermCosts, without the prior): total, fingertip,
   // wrist, joint-ball, silhouette.
   std::array<std::vector<double>, 5> evidence_terms;
+  int depth_switches = 0, restarts = 0;  // the pipeline's wrist-depth switches and restarts
   std::array<Vec3, 8> g;
   for (double t = a.t0; t < a.t1 && !task.finished(t); t += 1.0 / a.fps) {
     // The device's caps: at the face, pressed a fifth of the squeeze in (the displayed force
@@ -335,6 +351,46 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s\n", st.error().message.c_str());
       return 1;
     }
+    if (oracle) {
+      if (a.personalise) oracle->use_model_sizes(r.models);
+      if (!oracle->warm_start(truth).ok() ||
+          !oracle->process(frame.bgr, s, scene, &oracle_r).ok())
+        return 1;
+      const auto mo = sim::measure_frame(frame, oracle_r, p.compositor.mode, oracle_r.models, truth_models, truth,
+                                         camera, &oracle_ws).value();
+      oracle_iou.push_back(mo.iou);
+      oracle_joint.push_back(0.5 * (mo.joint_px[0] + mo.joint_px[1]));
+      for (int h = 0; h < 2; ++h) {
+        const double d_true = camera.depth(hand::hand_pose(truth[h]).p);
+        const double e_t = r.fits[h].terms.evidence(), e_o = oracle_r.fits[h].terms.evidence();
+        const double dd_t = 1e3 * (camera.depth(hand::hand_pose(r.hands[h]).p) - d_true);
+        const double dd_o = 1e3 * (camera.depth(hand::hand_pose(oracle_r.hands[h]).p) - d_true);
+        ++oracle_n[h];
+        oracle_better[h] += e_o < e_t;
+        oracle_depth_sum[h] += std::abs(dd_o);
+        tracked_depth_sum[h] += std::abs(dd_t);
+        if (a.verbose)
+          std::printf("  oracle %d: evidence tracked %.3f (depth %+.0f mm), from the truth %.3f (depth %+.0f mm)\n",
+                      h, e_t, dd_t, e_o, dd_o);
+      }
+    }
+    depth_switches += r.depth_switches;
+    if (a.verbose) {  // the wrist's other depth the pipeline would try (registration/wrist_depth.hpp)
+      for (int h = 0; h < 2; ++h) {
+        registration::HandObservation o;
+        for (int f = 0; f < 4; ++f) {
+          o.p_W_fingertip[f] = g[4 * h + f];
+          o.fingertip_valid[f] = true;
+        }
+        if (r.bracelets[h].found) o.wrist_px = r.bracelets[h].wrist_px;
+        const auto other = registration::other_wrist_depth(r.models[h], r.hands[h], o, camera);
+        const double d_true = camera.depth(hand::hand_pose(truth[h]).p);
+        std::printf("  other depth %d: fit %+.0f mm, other %s%+.0f mm\n", h,
+                    1e3 * (camera.depth(hand::hand_pose(r.hands[h]).p) - d_true), other ? "" : "none ",
+                    other ? 1e3 * (camera.depth(hand::hand_pose(*other).p) - d_true) : 0.0);
+      }
+    }
+    restarts += r.restarts;
     const auto m = sim::measure_frame(frame, r, p.compositor.mode, r.models, truth_models, truth,
                                       camera, &ws).value();
     const double c = ceiling->iou(truth, frame.hand_only, frame.toward_elbow_W).value();
@@ -708,6 +764,17 @@ int main(int argc, char** argv) {
     std::printf("palm chord at the truth, real / model: median %.3f (p10 %.3f, p90 %.3f), %zu chords\n", q(0.5),
                 q(0.1), q(0.9), chord_ratio.size());
   }
+  std::printf("wrist depth switches %d, restarts %d\n", depth_switches, restarts);
+  if (oracle)
+    std::printf("oracle: fits warm-started at the true pose each frame: IoU mean %.3f p5 %.3f, joints %.2f px "
+                "(the objective's own minimum near the truth; tracked above)\n",
+                mean(oracle_iou), quantile(oracle_iou, 0.05), mean(oracle_joint));
+  if (oracle)
+    for (int h = 0; h < 2; ++h)
+      std::printf("oracle %s: the fit from the truth explains the evidence better in %d of %d frames; "
+                  "wrist depth |fit - truth| mean %.1f mm (tracked %.1f)\n",
+                  h == 0 ? "left" : "right", oracle_better[h], oracle_n[h],
+                  oracle_depth_sum[h] / std::max(oracle_n[h], 1), tracked_depth_sum[h] / std::max(oracle_n[h], 1));
   std::printf("final shape: left L %.4f W %.4f, right L %.4f W %.4f (truth L %.4f W %.4f)\n",
               r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
               r.models[1].shape.dimensions.length, r.models[1].shape.dimensions.width,

@@ -390,6 +390,46 @@ TEST_F(FramePipelineTest, UseModelSizesTakesAnotherFitsSizesAndKeepsItsJointBox)
   EXPECT_EQ(pipe->models()[0].shape.dimensions.length, models_[0].shape.dimensions.length);
 }
 
+// A pipeline warm-started at the true pose fits the frame from there: the first frame is not a
+// cold start, and with the user's own sizes it stays near the truth; a cold pipeline on the same
+// frame starts from its nominal rotation. Non-finite poses are refused and change nothing.
+TEST_F(FramePipelineTest, WarmStartFitsTheNextFrameFromTheGivenPoses) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  p.registration.silhouette_term = true;
+  sim::RubiksTask task({});
+  sim::UserHands user(truth_models_, task);
+  const double t = 4.0;  // holding the cube, far from the script's start
+  const auto sample = pose_user(user, task, t);
+  const auto truth = user.params();
+  sim::SyntheticFrame frame;
+  ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+
+  auto warm = FramePipeline::create(*context_, camera_, truth_models_, p).value();
+  hand::HandParams broken = truth[0];
+  broken.q[3] = std::numeric_limits<double>::quiet_NaN();
+  const auto refused = warm->warm_start({broken, truth[1]});
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("left"), std::string::npos) << refused.error().message;
+  EXPECT_FALSE(warm->has_previous());
+
+  ASSERT_TRUE(warm->warm_start(truth).ok());
+  EXPECT_TRUE(warm->has_previous());
+  FrameResult r;
+  ASSERT_TRUE(warm->process(frame.bgr, sample, scene_, &r).ok());
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_LT((r.hands[h].p_W_wrist() - truth[h].p_W_wrist()).norm(), 0.005) << "hand " << h;
+    EXPECT_LT(r.fits[h].iterations, 40) << "hand " << h << ": a warm fit, not first_frame_rounds";
+  }
+  // Without it the same frame is a cold start (first_frame_rounds from the nominal rotation).
+  auto cold = FramePipeline::create(*context_, camera_, truth_models_, p).value();
+  FrameResult c;
+  ASSERT_TRUE(cold->process(frame.bgr, sample, scene_, &c).ok());
+  EXPECT_GT(c.fits[0].iterations + c.fits[1].iterations, r.fits[0].iterations + r.fits[1].iterations);
+}
+
 TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {
   auto pipe = FramePipeline::create(*context_, camera_, models_, {}).value();
   FrameResult r;

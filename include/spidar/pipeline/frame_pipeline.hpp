@@ -180,6 +180,10 @@ class FramePipeline {
   /// Forgets the previous frame (the next one is a cold start) and the hands' size estimates
   /// (the models are again the ones given to create()).
   void reset();
+  /// The next frame's fits start from these poses (left, right), as from a previous frame's fits:
+  /// a re-initialisation by another tracker, or a study's start at the true pose. Non-finite
+  /// parameters are refused (the pipeline is left as it was).
+  Status warm_start(const std::array<hand::HandParams, 2>& fits);
   /// True once a frame was processed since creation or reset() (the next fit starts from it).
   bool has_previous() const;
   const FramePipelineParams& params() const;
