@@ -300,6 +300,8 @@ int main(int argc, char** argv) {
   std::array<int, 2> oracle_better{}, oracle_n{};
   std::array<double, 2> oracle_depth_sum{}, tracked_depth_sum{};
   std::vector<double> oracle_iou, oracle_joint;  // the fits from the truth: IoU, joint error [px]
+  // Per hand and frame: the evidence of the tracked fit and of the fit from the truth.
+  std::array<std::vector<double>, 2> oracle_e_tracked, oracle_e_truth;
   sim::FrameTruthWorkspace oracle_ws;
   sim::UserHands hands(truth_models, task);
 
@@ -366,6 +368,8 @@ int main(int argc, char** argv) {
         const double dd_t = 1e3 * (camera.depth(hand::hand_pose(r.hands[h]).p) - d_true);
         const double dd_o = 1e3 * (camera.depth(hand::hand_pose(oracle_r.hands[h]).p) - d_true);
         ++oracle_n[h];
+        oracle_e_tracked[h].push_back(e_t);
+        oracle_e_truth[h].push_back(e_o);
         oracle_better[h] += e_o < e_t;
         oracle_depth_sum[h] += std::abs(dd_o);
         tracked_depth_sum[h] += std::abs(dd_t);
@@ -770,11 +774,24 @@ int main(int argc, char** argv) {
                 "(the objective's own minimum near the truth; tracked above)\n",
                 mean(oracle_iou), quantile(oracle_iou, 0.05), mean(oracle_joint));
   if (oracle)
-    for (int h = 0; h < 2; ++h)
+    for (int h = 0; h < 2; ++h) {
       std::printf("oracle %s: the fit from the truth explains the evidence better in %d of %d frames; "
                   "wrist depth |fit - truth| mean %.1f mm (tracked %.1f)\n",
                   h == 0 ? "left" : "right", oracle_better[h], oracle_n[h],
                   oracle_depth_sum[h] / std::max(oracle_n[h], 1), tracked_depth_sum[h] / std::max(oracle_n[h], 1));
+      // Summed over windows of frames: would a tracker that compared hypotheses over time prefer it?
+      std::printf("  summed over windows of");
+      for (std::size_t w : {5u, 10u, 20u}) {
+        int better = 0, n = 0;
+        for (std::size_t i = 0; i + w <= oracle_e_truth[h].size(); i += w, ++n) {
+          double st = 0, so = 0;
+          for (std::size_t k = i; k < i + w; ++k) st += oracle_e_tracked[h][k], so += oracle_e_truth[h][k];
+          better += so < st;
+        }
+        std::printf(" %zu frames: %d of %d;", w, better, n);
+      }
+      std::printf("\n");
+    }
   std::printf("final shape: left L %.4f W %.4f, right L %.4f W %.4f (truth L %.4f W %.4f)\n",
               r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
               r.models[1].shape.dimensions.length, r.models[1].shape.dimensions.width,
