@@ -302,6 +302,10 @@ int main(int argc, char** argv) {
   std::vector<double> oracle_iou, oracle_joint;  // the fits from the truth: IoU, joint error [px]
   // Per hand and frame: the evidence of the tracked fit and of the fit from the truth.
   std::array<std::vector<double>, 2> oracle_e_tracked, oracle_e_truth;
+  // Per hand, summed over frames: each term's cost (fingertip, wrist, joint-ball, silhouette) of
+  // the tracked fit minus the fit from the truth, over the frames where the tracked fit is the
+  // cheaper, and where it is not.
+  std::array<std::array<double, 4>, 2> oracle_term_diff_cheaper{}, oracle_term_diff_dearer{};
   sim::FrameTruthWorkspace oracle_ws;
   sim::UserHands hands(truth_models, task);
 
@@ -370,6 +374,14 @@ int main(int argc, char** argv) {
         ++oracle_n[h];
         oracle_e_tracked[h].push_back(e_t);
         oracle_e_truth[h].push_back(e_o);
+        {
+          const auto& a_t = r.fits[h].terms;
+          const auto& a_o = oracle_r.fits[h].terms;
+          const std::array<double, 4> d{a_t.fingertip - a_o.fingertip, a_t.wrist - a_o.wrist,
+                                        a_t.joint_ball - a_o.joint_ball, a_t.silhouette - a_o.silhouette};
+          auto& into = e_t < e_o ? oracle_term_diff_cheaper[h] : oracle_term_diff_dearer[h];
+          for (int k = 0; k < 4; ++k) into[static_cast<std::size_t>(k)] += d[static_cast<std::size_t>(k)];
+        }
         oracle_better[h] += e_o < e_t;
         oracle_depth_sum[h] += std::abs(dd_o);
         tracked_depth_sum[h] += std::abs(dd_t);
@@ -791,6 +803,11 @@ int main(int argc, char** argv) {
         std::printf(" %zu frames: %d of %d;", w, better, n);
       }
       std::printf("\n");
+      const auto& c = oracle_term_diff_cheaper[h];
+      const auto& e = oracle_term_diff_dearer[h];
+      std::printf("  tracked − from the truth, summed [fingertip, wrist, joint-ball, silhouette]: where the "
+                  "tracked fit is cheaper %+.1f %+.1f %+.1f %+.1f; elsewhere %+.1f %+.1f %+.1f %+.1f\n",
+                  c[0], c[1], c[2], c[3], e[0], e[1], e[2], e[3]);
     }
   std::printf("final shape: left L %.4f W %.4f, right L %.4f W %.4f (truth L %.4f W %.4f)\n",
               r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
