@@ -91,6 +91,7 @@ Action add_device_test(CLI::App& app) {
                         {"longest_repeat", s.longest_repeat},
                         {"cycle_us_median", s.cycle_us_median},
                         {"cycle_us_p99", s.cycle_us_p99},
+                        {"cycle_us_max", s.cycle_us_max},
                         {"realtime_scheduling", s.realtime_scheduling},
                         {"idle_spin", s.idle_spin},
                         {"inconsistent_solves", s.inconsistent},

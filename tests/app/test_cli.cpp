@@ -127,7 +127,8 @@ TEST(Cli, DeviceTestOnTheSimulatedDeviceReportsLoopStatistics) {
   auto r = run("device-test --backend sim --rate 2000 --seconds 0.5");
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"rate_hz", "jitter_p50_us", "jitter_p99_us", "jitter_max_us", "overruns",
-                          "cycle_us_median", "repeated_readings", "faults", "fingertips"}) {
+                          "cycle_us_median", "cycle_us_p99", "cycle_us_max", "repeated_readings", "faults",
+                          "fingertips"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["repeated_readings"].get<int>(), 0);  // the simulated device always has a new one
@@ -255,6 +256,9 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_GE(j["pipeline"]["latency_ms_p95"].get<double>(), j["pipeline"]["latency_ms_median"].get<double>());
   EXPECT_GT(j["haptic"]["rate_hz"].get<double>(), 0.0);  // its value is the report's, not a test's
   EXPECT_FALSE(j["haptic"]["idle_spin"].get<bool>());  // off in the mixed-reality demo unless asked
+  // The cycle's compute time in order (median ≤ p99 ≤ max; the histogram's bins are 1 µs wide).
+  EXPECT_LE(j["haptic"]["cycle_us_median"].get<double>(), j["haptic"]["cycle_us_p99"].get<double>());
+  EXPECT_LE(j["haptic"]["cycle_us_p99"].get<double>(), j["haptic"]["cycle_us_max"].get<double>() + 1.0);
   EXPECT_GT(j["physics"]["step_ms_median"].get<double>(), 0.0);
   const auto& reg = j["registration"];
   // Measured at 320x240 on a quiet machine: IoU 0.77, fingertips 1.9 mm, joints 7.2 px; with
