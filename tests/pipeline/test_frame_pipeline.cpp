@@ -427,7 +427,9 @@ TEST_F(FramePipelineTest, WarmStartFitsTheNextFrameFromTheGivenPoses) {
   auto cold = FramePipeline::create(*context_, camera_, truth_models_, p).value();
   FrameResult c;
   ASSERT_TRUE(cold->process(frame.bgr, sample, scene_, &c).ok());
-  EXPECT_GT(c.fits[0].iterations + c.fits[1].iterations, r.fits[0].iterations + r.fits[1].iterations);
+  EXPECT_GT(c.fits[0].iterations + c.fits[1].iterations, r.fits[0].iterations + r.fits[1].iterations)
+      << "cold " << c.fits[0].iterations << "+" << c.fits[1].iterations << ", warm " << r.fits[0].iterations << "+"
+      << r.fits[1].iterations;
 }
 
 TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {
