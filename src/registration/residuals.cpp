@@ -243,7 +243,7 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
       }
     }
   }
-  if (!image->alpha.empty() && image->alpha.type() == CV_32FC1) {
+  if (!image->alpha.empty() && (image->alpha.type() == CV_32FC1 || image->alpha.type() == CV_8UC1)) {
     joint_ball_targets(*pr.model, s.points, camera, image->alpha, *pr.params, &tg->balls);
   }
   if (pr.params->silhouette_term && pr.params->silhouette_inward && image->distance &&

@@ -188,11 +188,6 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   bool any_silhouette = false;
   for (Keyframe& kf : job.keyframes) {
     if (kf.silhouette.empty()) continue;
-    if (p.joint_balls && !kf.alpha) {
-      auto a = std::make_shared<cv::Mat>();
-      kf.silhouette.convertTo(*a, CV_32FC1, 1.0 / 255.0);
-      kf.alpha = std::move(a);
-    }
     if (p.silhouette == ShapeSilhouette::kNone) continue;
     any_silhouette = true;
     if (kf.distance) continue;
@@ -263,7 +258,9 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       ImageEvidence evidence = skeleton_only;
       if (!kf.owned.empty()) evidence.coverage = &kf.owned;
       if (kf.distance && !kf.distance->empty) evidence.distance = kf.distance.get();
-      if (kf.alpha) evidence.alpha = *kf.alpha;
+      // The joint-balls read the 8-bit silhouette as the matte (0/255 sample as a 0/1 float copy
+      // would): no float copy per keyframe, whose fresh megabyte was most of the demo's page faults.
+      if (p.joint_balls) evidence.alpha = kf.silhouette;
       hand::HandParams prior = p.keyframe_prior == KeyframePrior::kTaken ? kf.q_taken : kf.q;
       FitReport fit = solver.fit(model, kf.observation, evidence, &prior, &kf.q);
       if (p.reach_min_miss_m > 0 &&
@@ -429,7 +426,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     ++held;
     if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
   }
-  Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}, {}};
+  Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}};
   // The band's length is left out of the size estimate's refits: with it the default user's width
   // went 18 % narrow (demo, seeds 1–2), without it 4–8 % (the band measures the forearm, whose
   // breadth the model only assumes in proportion to the palm's).
@@ -497,7 +494,6 @@ bool ShapeEstimator::apply(Solve&& done) {
       for (const Keyframe& d : done.keyframes)
         if (d.serial == k.serial) {
           if (!k.distance) k.distance = d.distance;
-          if (!k.alpha) k.alpha = d.alpha;
         }
   }
   return done.changed;

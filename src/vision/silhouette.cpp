@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -115,14 +116,15 @@ double SilhouetteDistance::distance_at(const Vec2& uv) const {
 }
 
 double sample_bilinear(const cv::Mat& alpha, const Vec2& uv) {
-  if (alpha.empty() || alpha.type() != CV_32FC1 || !uv.allFinite()) return 0.0;
+  const bool bytes = alpha.type() == CV_8UC1;
+  if (alpha.empty() || (alpha.type() != CV_32FC1 && !bytes) || !uv.allFinite()) return 0.0;
   const double fx = std::floor(uv.x()), fy = std::floor(uv.y());
   if (fx < -1.0 || fy < -1.0 || fx > alpha.cols || fy > alpha.rows) return 0.0;
   const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   const double ax = uv.x() - fx, ay = uv.y() - fy;
   auto at = [&](int x, int y) -> double {
     if (x < 0 || y < 0 || x >= alpha.cols || y >= alpha.rows) return 0.0;
-    return alpha.at<float>(y, x);
+    return bytes ? alpha.at<std::uint8_t>(y, x) / 255.0 : static_cast<double>(alpha.at<float>(y, x));
   };
   return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
          ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));

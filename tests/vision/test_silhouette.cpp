@@ -3,6 +3,7 @@
 
 #include <limits>
 #include <opencv2/imgproc.hpp>
+#include <cstdint>
 #include <random>
 
 #include "spidar/vision/silhouette.hpp"
@@ -135,6 +136,26 @@ TEST(Silhouette, BilinearSamplingMatchesOpenCvRemap) {
   hand(cv::Rect(0, 0, 5, 10)).setTo(1.0f);
   EXPECT_TRUE(on_silhouette(hand, Vec2(4.4, 3)));
   EXPECT_FALSE(on_silhouette(hand, Vec2(4.6, 3)));
+}
+
+// An 8-bit silhouette (255 = hand) samples exactly as its 0/1 float copy: the size estimate's
+// keyframes give the joint-balls their silhouettes without converting them.
+TEST(SampleBilinear, ABinarySilhouetteOfBytesSamplesAsItsFloatCopy) {
+  std::mt19937 rng(7);
+  std::bernoulli_distribution on(0.4);
+  cv::Mat bytes(24, 32, CV_8UC1);
+  for (int y = 0; y < bytes.rows; ++y)
+    for (int x = 0; x < bytes.cols; ++x) bytes.at<std::uint8_t>(y, x) = on(rng) ? 255 : 0;
+  cv::Mat floats;
+  bytes.convertTo(floats, CV_32FC1, 1.0 / 255.0);
+  std::uniform_real_distribution<double> ux(-2.0, 33.0), uy(-2.0, 25.0);
+  for (int i = 0; i < 500; ++i) {
+    const Vec2 p(ux(rng), uy(rng));
+    EXPECT_EQ(sample_bilinear(bytes, p), sample_bilinear(floats, p)) << p.transpose();
+    EXPECT_EQ(on_silhouette(bytes, p), on_silhouette(floats, p)) << p.transpose();
+  }
+  // Other types are no matte at all.
+  EXPECT_EQ(sample_bilinear(cv::Mat(24, 32, CV_16UC1, cv::Scalar(65535)), Vec2(5, 5)), 0.0);
 }
 
 }  // namespace

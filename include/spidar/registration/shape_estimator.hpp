@@ -233,13 +233,12 @@ class ShapeEstimator {
     hand::HandParams q_taken;  ///< the pose the frame's fit gave when it was taken
     HandObservation observation;
     std::vector<OwnedPixel> owned;  ///< ShapeEstimatorParams::silhouette only
-    cv::Mat silhouette;  ///< CV_8UC1, the matte ≥ matte_threshold (ShapeEstimatorParams::silhouette)
+    /// CV_8UC1, the matte ≥ matte_threshold, 255 = hand (ShapeEstimatorParams::silhouette, and
+    /// the joint-balls' matte with joint_balls)
+    cv::Mat silhouette;
     /// The silhouette's distance transform, made by the first re-estimate that uses it (read only
     /// from then on, so copies on a re-estimate's thread share it).
     std::shared_ptr<const vision::SilhouetteDistance> distance;
-    /// The silhouette as a matte (CV_32FC1, 0 or 1) for the joint-balls (joint_balls), made and
-    /// shared like `distance`.
-    std::shared_ptr<const cv::Mat> alpha;
     std::optional<PalmChord> chord;  ///< the palm's breadth (palm_breadth_sigma_px > 0)
   };
   /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its

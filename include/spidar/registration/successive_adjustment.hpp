@@ -61,7 +61,9 @@ struct HandObservation {
 /// The image evidence shared by both hands. Without a camera only the 3D terms and the prior act.
 struct ImageEvidence {
   const vision::Camera* camera = nullptr;
-  cv::Mat alpha;  ///< CV_32FC1 chroma-key matte, 1 = hand (joint-balls); empty = no joint-balls
+  /// The chroma-key matte for the joint-balls: CV_32FC1 in [0, 1] (1 = hand), or a CV_8UC1
+  /// silhouette (255 = hand, as vision::sample_bilinear reads it); empty = no joint-balls.
+  cv::Mat alpha;
   const vision::SilhouetteDistance* distance = nullptr;  ///< silhouette term; null = off
   /// The silhouette pixels this hand owns (coverage.hpp's coverage_evidence) for the silhouette
   /// term's coverage direction; null = that direction is off. Per hand.

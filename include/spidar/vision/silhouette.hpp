@@ -57,8 +57,10 @@ struct SilhouetteDistance {
 Status silhouette_distance(const cv::Mat& silhouette, SilhouetteDistance* out,
                            const SilhouetteDistanceOptions& options = {});
 
-/// Bilinear sample of a CV_32FC1 matte at a sub-pixel point [px]; pixels outside the image
-/// count as 0 (screen), so the value fades to 0 across the border.
+/// Bilinear sample of a matte at a sub-pixel point [px]: a CV_32FC1 matte in [0, 1], or a CV_8UC1
+/// one read as value / 255 (a binary silhouette, 255 = hand, samples exactly as its 0/1 float
+/// copy would); pixels outside the image count as 0 (screen), so the value fades to 0 across the
+/// border. 0 for any other type.
 double sample_bilinear(const cv::Mat& alpha, const Vec2& uv);
 
 /// True if the matte at uv (bilinear) is at least `threshold`.
