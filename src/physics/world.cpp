@@ -139,6 +139,17 @@ double World::time() const { return data_->time; }
 double World::timestep() const { return model_->opt.timestep; }
 int World::contact_count() const { return data_->ncon; }
 
+World::MemoryUse World::memory_use() const {
+  MemoryUse u;
+  u.stack_words = model_->nstack;
+  u.stack_words_max_used = data_->maxuse_stack;
+  u.constraint_rows = model_->njmax;
+  u.constraint_rows_max_used = data_->maxuse_efc;
+  u.contacts = model_->nconmax;
+  u.contacts_max_used = data_->maxuse_con;
+  return u;
+}
+
 std::vector<World::WarningCount> World::warning_counts() const {
   static constexpr const char* kKinds[mjNWARNING] = {"inertia",  "contact_full", "constraint_full",
                                                      "vgeom_full", "bad_qpos", "bad_qvel",

@@ -21,6 +21,7 @@
 #include "spidar/session/cube_monitor.hpp"
 #include "spidar/session/haptic_side.hpp"
 #include "spidar/sim/scripted_grasp.hpp"
+#include "physics_memory_json.hpp"
 
 namespace spidar::session {
 
@@ -192,7 +193,8 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
        {{"rate_hz", ps.rate_hz},
         {"step_ms_median", ps.step_ms_median},
         {"step_ms_p99", ps.step_ms_p99},
-        {"steps", ps.steps}}},
+        {"steps", ps.steps},
+        {"memory", physics_memory_json(ps.memory)}}},
       {"fingers", fingers}};
   require_finite_json(report, (fs::path(o.out) / "report.json").string());
   core::write_file_atomic((fs::path(o.out) / "report.json").string(), report.dump(2) + "\n");

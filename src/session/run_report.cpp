@@ -13,6 +13,7 @@
 #include "spidar/render/plot.hpp"
 #include "spidar/render/video_output.hpp"
 #include "spidar/session/finite_json.hpp"
+#include "physics_memory_json.hpp"
 
 namespace spidar::session {
 namespace {
@@ -364,6 +365,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"step_ms_p99", s.physics.step_ms_p99},
         {"late_steps", s.physics.late_steps},
         {"realtime_scheduling", s.physics.realtime_scheduling},
+        {"memory", physics_memory_json(s.physics.memory)},
         {"mujoco_warnings", s.mujoco_warnings},
         {"mujoco_warning_kinds", [&] {
            nlohmann::json j = nlohmann::json::object();

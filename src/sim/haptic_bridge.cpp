@@ -156,6 +156,7 @@ PhysicsThreadStats PhysicsThread::stats() const {
   }
   s.late_steps = late_;
   s.realtime_scheduling = realtime_;
+  s.memory = world_.memory_use();
   return s;
 }
 

@@ -69,6 +69,28 @@ TEST(World, AddsOneProxyPerFingertipToAnyScene) {
   EXPECT_EQ(load("blocks.xml", two)->proxies().size(), 2u);
 }
 
+// MuJoCo's preallocated memory and how much of it was used: after steps with the blocks resting on
+// the table, some stack, constraint rows and contacts, within the scene's <size> (blocks.xml:
+// njmax 1500, nconmax 300).
+TEST(World, MemoryUseCountsWhatTheStepsUsedWithinTheScenesSizes) {
+  auto w = load("blocks.xml");
+  const World::MemoryUse before = w->memory_use();
+  EXPECT_EQ(before.constraint_rows, 1500);
+  EXPECT_EQ(before.contacts, 300);
+  EXPECT_GT(before.stack_words, 0);
+  const auto target = parked();
+  w->place_proxies(target);
+  std::vector<Vec3> v(8, Vec3::Zero());
+  for (int k = 0; k < 200; ++k) w->step(target, v);
+  const World::MemoryUse after = w->memory_use();
+  EXPECT_GT(after.stack_words_max_used, 0);
+  EXPECT_LE(after.stack_words_max_used, after.stack_words);
+  EXPECT_GT(after.contacts_max_used, 0);  // the blocks on the table
+  EXPECT_LE(after.contacts_max_used, after.contacts);
+  EXPECT_GT(after.constraint_rows_max_used, 0);
+  EXPECT_LE(after.constraint_rows_max_used, after.constraint_rows);
+}
+
 TEST(World, FreeProxyFollowsItsFingertipWithoutFalling) {
   auto w = load("blocks.xml");
   auto target = parked();

@@ -81,6 +81,7 @@ struct PhysicsThreadStats {
   double step_ms_median = 0, step_ms_p99 = 0, step_ms_max = 0;
   std::uint64_t late_steps = 0;  ///< steps that started after their deadline
   bool realtime_scheduling = false;  ///< SCHED_FIFO was asked for and granted
+  physics::World::MemoryUse memory;  ///< MuJoCo's memory the run used (World::memory_use)
 };
 
 /// Steps the world in its own thread at up to `rate_hz` (1/timestep by default), toward the
