@@ -10,6 +10,7 @@
 #include "signal_scope.hpp"
 #include "spidar/device/serial_device.hpp"
 #include "spidar/device/servo_loop.hpp"
+#include "spidar/session/stats_json.hpp"
 
 namespace spidar::app {
 Action add_device_test(CLI::App& app) {
@@ -76,28 +77,19 @@ Action add_device_test(CLI::App& app) {
                            {"consistent", ((last.consistent >> f) & 1u) != 0}});
       }
     }
-    nlohmann::json j = {{"device", dev->info().name},
-                        {"rate_target_hz", *rate},
-                        {"rate_hz", s.rate_hz},
-                        {"cycles", s.cycles},
-                        {"seconds", s.seconds},
-                        {"jitter_p50_us", s.jitter_p50_us},
-                        {"jitter_p99_us", s.jitter_p99_us},
-                        {"jitter_max_us", s.jitter_max_us},
-                        {"overruns", s.overruns},
-                        {"deadline_misses", s.deadline_misses},
-                        {"stale_force_cycles", s.stale_force_cycles},
-                        {"repeated_readings", s.repeated_readings},
-                        {"longest_repeat", s.longest_repeat},
-                        {"cycle_us_median", s.cycle_us_median},
-                        {"cycle_us_p99", s.cycle_us_p99},
-                        {"cycle_us_max", s.cycle_us_max},
-                        {"realtime_scheduling", s.realtime_scheduling},
-                        {"idle_spin", s.idle_spin},
-                        {"inconsistent_solves", s.inconsistent},
-                        {"faults", faults},
-                        {"fault_message", s.fault_message},
-                        {"fingertips", fingers}};
+    nlohmann::json j = session::servo_timing_json(s);
+    j.update({{"device", dev->info().name},
+              {"rate_target_hz", *rate},
+              {"cycles", s.cycles},
+              {"seconds", s.seconds},
+              {"deadline_misses", s.deadline_misses},
+              {"stale_force_cycles", s.stale_force_cycles},
+              {"repeated_readings", s.repeated_readings},
+              {"longest_repeat", s.longest_repeat},
+              {"inconsistent_solves", s.inconsistent},
+              {"faults", faults},
+              {"fault_message", s.fault_message},
+              {"fingertips", fingers}});
     if (const auto* serial = dynamic_cast<const device::SerialDevice*>(dev.get())) {
       const device::SerialLinkStats l = serial->link_stats();
       j["serial_link"] = {{"frames_out", l.frames_out},     {"counts_in", l.counts_in},

@@ -20,8 +20,8 @@
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/session/cube_monitor.hpp"
 #include "spidar/session/haptic_side.hpp"
+#include "spidar/session/stats_json.hpp"
 #include "spidar/sim/scripted_grasp.hpp"
-#include "physics_memory_json.hpp"
 
 namespace spidar::session {
 
@@ -175,20 +175,13 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
         {"top_layer_misalignment_deg", units::rad_to_deg(final_status.u_misalign)},
         {"solved", cube.is_solved()},
         {"facelets", cube.facelets()}}},
-      {"haptic",
-       {{"rate_hz", ss.rate_hz},
-        {"jitter_p50_us", ss.jitter_p50_us},
-        {"jitter_p99_us", ss.jitter_p99_us},
-        {"jitter_max_us", ss.jitter_max_us},
-        {"overruns", ss.overruns},
-        {"cycle_us_median", ss.cycle_us_median},
-        {"cycle_us_p99", ss.cycle_us_p99},
-        {"cycle_us_max", ss.cycle_us_max},
-        {"realtime_scheduling", ss.realtime_scheduling},
-        {"idle_spin", ss.idle_spin},
-        {"faults", device::fault_names(ss.faults)},
-        {"fault_message", ss.fault_message},
-        {"force_jump_max_n", jump_max}}},
+      {"haptic", [&] {
+         nlohmann::json h = servo_timing_json(ss);
+         h.update({{"faults", device::fault_names(ss.faults)},
+                   {"fault_message", ss.fault_message},
+                   {"force_jump_max_n", jump_max}});
+         return h;
+       }()},
       {"physics",
        {{"rate_hz", ps.rate_hz},
         {"step_ms_median", ps.step_ms_median},

@@ -13,7 +13,7 @@
 #include "spidar/render/plot.hpp"
 #include "spidar/render/video_output.hpp"
 #include "spidar/session/finite_json.hpp"
-#include "physics_memory_json.hpp"
+#include "spidar/session/stats_json.hpp"
 
 namespace spidar::session {
 namespace {
@@ -344,21 +344,14 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"user_hand", s.user_hand},
       {"shaped_fingers", s.shaped_fingers},
       {"bending_wrists", s.bending_wrists},
-      {"haptic",
-       {{"rate_hz", s.servo.rate_hz},
-        {"jitter_p50_us", s.servo.jitter_p50_us},
-        {"jitter_p99_us", s.servo.jitter_p99_us},
-        {"jitter_max_us", s.servo.jitter_max_us},
-        {"overruns", s.servo.overruns},
-        {"deadline_misses", s.servo.deadline_misses},
-        {"stale_force_cycles", s.servo.stale_force_cycles},
-        {"cycle_us_median", s.servo.cycle_us_median},
-        {"cycle_us_p99", s.servo.cycle_us_p99},
-        {"cycle_us_max", s.servo.cycle_us_max},
-        {"realtime_scheduling", s.servo.realtime_scheduling},
-        {"idle_spin", s.servo.idle_spin},
-        {"faults", device::fault_names(s.servo.faults)},
-        {"fault_message", s.servo.fault_message}}},
+      {"haptic", [&] {
+         nlohmann::json h = servo_timing_json(s.servo);
+         h.update({{"deadline_misses", s.servo.deadline_misses},
+                   {"stale_force_cycles", s.servo.stale_force_cycles},
+                   {"faults", device::fault_names(s.servo.faults)},
+                   {"fault_message", s.servo.fault_message}});
+         return h;
+       }()},
       {"physics",
        {{"rate_hz", s.physics.rate_hz},
         {"step_ms_median", s.physics.step_ms_median},

@@ -67,9 +67,9 @@ class World {
   /// The sum of warning_counts().
   int warning_total() const;
   /// How much of MuJoCo's preallocated memory the steps so far used: its stack (`<size nstack>`,
-  /// 8-byte words; by default MuJoCo 2.2 sizes it from njmax², 48.7 M words = 390 MB for
-  /// njmax 3000, all of it touched when the data is made) and its constraint rows and contacts
-  /// (`<size njmax nconmax>`). Read it while the world is not stepping.
+  /// 8-byte words; by default MuJoCo 2.2 sizes it from njmax², 48.7 M words for njmax 3000, but
+  /// touches only what it uses) and its constraint rows and contacts (`<size njmax nconmax>`).
+  /// Read it while the world is not stepping.
   struct MemoryUse {
     long stack_words = 0, stack_words_max_used = 0;
     int constraint_rows = 0, constraint_rows_max_used = 0;
