@@ -53,9 +53,12 @@ void DeviceEmulator::check_watchdog(std::int64_t now_ns) {
   if (!armed_ || tripped_.load(std::memory_order_relaxed)) return;
   const auto timeout_ns = static_cast<std::int64_t>(options_.heartbeat_timeout_s * 1e9);
   if (now_ns - last_feed_ns_ > timeout_ns) {
-    backend_.request_safe_state();
+    // Why before what: whoever sees the backend in its safe state also sees the trip counted
+    // (SerialDevice.HeartbeatTimeoutPutsBackendInSafeState read the flag in between under TSan).
     tripped_.store(true, std::memory_order_release);
     ++counters_.watchdog_trips;
+    publish_counters();
+    backend_.request_safe_state();
   }
 }
 
