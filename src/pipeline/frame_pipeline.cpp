@@ -25,6 +25,15 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+/// The fit's settings for a start far from the hand (the first frame, a restart from the
+/// fingertips): without the digits' axes, whose across-the-bone search assumes the model's digit
+/// already lies on the real one (from a cold start it finds a neighbouring finger: demo, seed 1,
+/// the left hand's first 0.3 s at 10–13 px against 2.5–4 px without them).
+registration::RegistrationParams cold_registration_params(registration::RegistrationParams p) {
+  p.digit_axis_sigma_px = 0.0;
+  return p;
+}
+
 /// A cold-start pose: a relaxed hand with the given rotation, placed so that its fingertips'
 /// centroid lies on the measured one.
 hand::HandParams cold_start(const hand::HandModel& model, const Vec3& r_W_hand,
@@ -84,6 +93,8 @@ struct FramePipeline::Impl {
   vision::BraceletWorkspace bracelet_ws;
   vision::SilhouetteDistance distance;
   registration::SuccessiveAdjustment solver;
+  /// The same without the digits' axes, for fits from a cold start (see cold_registration_params).
+  registration::SuccessiveAdjustment cold_solver;
   render::Compositor main, other;
   SceneSnapshot scene;  ///< the world plus the fitted hands (reused)
   /// The world's meshes followed by the hand skins' (rebuilt when the world's list changes).
@@ -118,6 +129,7 @@ struct FramePipeline::Impl {
         models{fit_model(given[0], p), fit_model(given[1], p)},
         keyer(std::move(k)),
         solver(p.registration),
+        cold_solver(cold_registration_params(p.registration)),
         main(p.compositor),
         start(given) {
     make_estimators();
@@ -389,9 +401,10 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     registration::ImageEvidence hand_image = image;
     if (p.registration.silhouette_term && s.have_previous) hand_image.coverage = &s.owned[h];
     auto fit_from = [&](hand::HandParams q, const hand::HandParams* prior, int rounds,
-                        registration::FitReport* report) {
+                        registration::FitReport* report, bool from_cold = false) {
+      const registration::SuccessiveAdjustment& solver = from_cold ? s.cold_solver : s.solver;
       for (int r = 0; r < rounds; ++r) {
-        const registration::FitReport rr = s.solver.fit(s.models[h], obs, hand_image, prior, &q);
+        const registration::FitReport rr = solver.fit(s.models[h], obs, hand_image, prior, &q);
         if (r == 0) report->cost_initial = rr.cost_initial;
         report->iterations += rr.iterations;
         report->cost_final = rr.cost_final;
@@ -404,7 +417,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     hand::HandParams q;
     if (cold) {
       q = fit_from(cold_start(s.models[h], p.initial_r_W_hand[h], obs), nullptr,
-                   p.first_frame_rounds, &report);
+                   p.first_frame_rounds, &report, true);
     } else {
       const hand::HandParams prior = s.previous[h];
       q = fit_from(prior, &prior, 1, &report);
@@ -414,7 +427,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       if (fingertip_cost_per_tip(report, obs) > p.restart_fingertip_cost) {
         registration::FitReport again;
         const hand::HandParams q2 =
-            fit_from(cold_start(s.models[h], prior.r_W_hand(), obs), nullptr, p.first_frame_rounds, &again);
+            fit_from(cold_start(s.models[h], prior.r_W_hand(), obs), nullptr, p.first_frame_rounds, &again, true);
         again.iterations += report.iterations;
         if (again.cost_final < report.cost_final) {
           q = q2;

@@ -47,6 +47,7 @@ constexpr Field kFields[] = {
     {"coverage_stride_px", nullptr, &RegistrationParams::coverage_stride_px, 1.0, 64.0, false, "px"},
     {"coverage_max_px", &RegistrationParams::coverage_max_px, nullptr, 0.0, 1000.0, true, "px"},
     {"coverage_huber_px", &RegistrationParams::coverage_huber_px, nullptr, 0.0, 1000.0, true, "px"},
+    {"digit_axis_sigma_px", &RegistrationParams::digit_axis_sigma_px, nullptr, 0.0, 1000.0, false, "px"},
     {"little_coupling_sigma_rad", &RegistrationParams::little_coupling_sigma_rad, nullptr, 0.0, 100.0, true,
      "rad"},
     {"prior_sigma_wrist_m", &RegistrationParams::prior_sigma_wrist_m, nullptr, 0.0, 100.0, true,
@@ -103,7 +104,7 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
                     "joint_ball_sigma_px", "joint_ball_alpha", "ball_radius_scale",
                     "matte_threshold", "silhouette_term", "silhouette_inward", "silhouette_sigma_px",
                     "silhouette_samples_per_bone", "coverage_sigma_px", "coverage_stride_px",
-                    "coverage_max_px", "coverage_huber_px", "little_free",
+                    "coverage_max_px", "coverage_huber_px", "digit_axis_sigma_px", "little_free",
                     "little_coupling_sigma_rad", "prior_sigma_wrist_m",
                     "prior_sigma_rotation_rad", "prior_sigma_joint_rad", "lambda_initial",
                     "max_iterations", "cost_epsilon", "step_epsilon", "relative_epsilon"});

@@ -209,6 +209,24 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
       add_projected(Term::kJointBall, p, Vec2::Zero(), b.target_px, w_ball);
     }
 
+    // The digits' axes: the projected axis point across its bone onto the edges' midpoint.
+    if (tg.axis_count > 0) {
+      const double w_axis = 1.0 / rp.digit_axis_sigma_px;
+      for (int k = 0; k < tg.axis_count; ++k) {
+        const DigitAxisPoint& ap = tg.axes[k];
+        const Vec3 p = bone_point(*pr.model, s, silhouette_bone(ap.bone), ap.t, J3p);
+        if constexpr (kJacobian) {
+          const Vec2 uv = camera->project(p, &Jp);
+          const Block<1> r = Block<1>::Constant(w_axis * ap.across_px.dot(uv - ap.target_px));
+          const BlockJacobian<1> J = w_axis * (ap.across_px.transpose() * Jp * J3);
+          sink.template add<1>(Term::kJointBall, r, &J);
+        } else {
+          const Block<1> r = Block<1>::Constant(w_axis * ap.across_px.dot(camera->project(p) - ap.target_px));
+          sink.template add<1>(Term::kJointBall, r, nullptr);
+        }
+      }
+    }
+
     // Silhouette points outside the real silhouette, toward their frozen nearest pixel.
     const double w_sil = 1.0 / rp.silhouette_sigma_px;
     for (int k = 0; k < tg.silhouette_count; ++k) {

@@ -1,7 +1,10 @@
 #include "spidar/registration/residuals.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -59,6 +62,66 @@ void freeze_silhouette(const ResidualProblem& pr, const detail::PoseState& s,
         sp.radius_m = radius_m;
         tg->silhouette[tg->silhouette_count++] = sp;
       }
+    }
+  }
+}
+
+/// The matte at the pixel nearest `uv` (CV_32FC1, or CV_8UC1 read as /255); 0 outside the image.
+double sample_nearest(const cv::Mat& alpha, const Vec2& uv) {
+  const long x = std::lround(uv.x()), y = std::lround(uv.y());
+  if (x < 0 || y < 0 || x >= alpha.cols || y >= alpha.rows) return 0.0;
+  return alpha.type() == CV_8UC1 ? alpha.at<std::uint8_t>(static_cast<int>(y), static_cast<int>(x)) / 255.0
+                                 : static_cast<double>(alpha.at<float>(static_cast<int>(y), static_cast<int>(x)));
+}
+
+/// How far from `from` along `dir` (unit) the matte leaves the silhouette [px]: walked a pixel at
+/// a time (nearest pixel), the crossing then placed between the last step on it and the first off
+/// it where the bilinear matte crosses the threshold. nullopt if it does not within `max_px`.
+std::optional<double> edge_along(const cv::Mat& alpha, const Vec2& from, const Vec2& dir, double max_px,
+                                 double threshold) {
+  for (double s = 1.0; s <= max_px; s += 1.0) {
+    if (sample_nearest(alpha, from + s * dir) >= threshold) continue;
+    const double a0 = vision::sample_bilinear(alpha, from + (s - 1.0) * dir);
+    const double a1 = vision::sample_bilinear(alpha, from + s * dir);
+    const double f = a0 > a1 ? (a0 - threshold) / (a0 - a1) : 0.5;
+    return s - 1.0 + std::clamp(f, 0.0, 1.0);
+  }
+  return std::nullopt;
+}
+
+/// The digits' axes (RegistrationParams::digit_axis_sigma_px): across each phalanx at t = 1/3 and
+/// 2/3, the silhouette's edges either side of the projected axis and their midpoint.
+void freeze_digit_axes(const ResidualProblem& pr, const detail::PoseState& s, const vision::Camera& camera,
+                       const cv::Mat& alpha, FrozenTargets* tg) {
+  const hand::HandModel& model = *pr.model;
+  const double focal = 0.5 * (camera.intrinsics().fx + camera.intrinsics().fy);
+  const double threshold = pr.params->matte_threshold;
+  for (int bone = 0; bone < kSilhouetteBoneCount; ++bone) {
+    const BoneRef b = silhouette_bone(bone);
+    if (b.segment == 0) continue;  // the metacarpals lie in the palm
+    const Vec3 a = detail::bone_end(model, s, b, 0, nullptr);
+    const Vec3 c = detail::bone_end(model, s, b, 1, nullptr);
+    if (camera.depth(a) < detail::kMinImageDepth || camera.depth(c) < detail::kMinImageDepth) continue;
+    const Vec2 ua = camera.project(a), uc = camera.project(c);
+    const double radius_m = model.shape.digits[b.finger].radius[b.segment];
+    const double r_px = radius_m * focal / camera.depth(0.5 * (a + c));
+    const Vec2 d = uc - ua;
+    // A bone seen nearly end-on has no direction across it to measure.
+    if (!(d.norm() > 2.0 * r_px) || !(r_px > 0.5)) continue;
+    const Vec2 across = Vec2(-d.y(), d.x()).normalized();
+    for (double t : {1.0 / 3.0, 2.0 / 3.0}) {
+      const Vec2 p = ua + t * d;
+      if (!camera.in_image(p) || !vision::on_silhouette(alpha, p, threshold)) continue;
+      const double max_px = 2.0 * r_px + 3.0;
+      const auto plus = edge_along(alpha, p, across, max_px, threshold);
+      const auto minus = edge_along(alpha, p, -across, max_px, threshold);
+      if (!plus || !minus) continue;
+      const double width = *plus + *minus;
+      if (width < 0.5 * 2.0 * r_px || width > 1.8 * 2.0 * r_px) continue;
+      // An axis more than the radius off may be another finger's: only a near one is this bone's.
+      if (std::abs(0.5 * (*plus - *minus)) > r_px) continue;
+      if (tg->axis_count >= kMaxDigitAxisPoints) return;
+      tg->axes[tg->axis_count++] = DigitAxisPoint{bone, t, across, p + 0.5 * (*plus - *minus) * across};
     }
   }
 }
@@ -208,6 +271,7 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   for (JointBall& b : tg->balls) b = JointBall{};
   tg->silhouette_count = 0;
   tg->coverage_count = 0;
+  tg->axis_count = 0;
   const ImageEvidence* image = pr.image;
   if (!image || !image->camera) return;
   const vision::Camera& camera = *image->camera;
@@ -245,6 +309,8 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   }
   if (!image->alpha.empty() && (image->alpha.type() == CV_32FC1 || image->alpha.type() == CV_8UC1)) {
     joint_ball_targets(*pr.model, s.points, camera, image->alpha, *pr.params, &tg->balls);
+    if (pr.params->silhouette_term && pr.params->digit_axis_sigma_px > 0)
+      freeze_digit_axes(pr, s, camera, image->alpha, tg);
   }
   if (pr.params->silhouette_term && pr.params->silhouette_inward && image->distance &&
       !image->distance->empty) {

@@ -29,11 +29,12 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
                     "max_fingertip_cost", "shared_hands", "keyframe_prior_scale",
                     "keyframe_prior", "joint_balls", "palm_breadth_sigma_px", "palm_breadth_at",
-                    "palm_breadth_min_facing"});
+                    "palm_breadth_min_facing", "digit_axes"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
   if (auto b = node.find("joint_balls")) p.joint_balls = b->as_bool();
+  if (auto b = node.find("digit_axes")) p.digit_axes = b->as_bool();
   if (auto b = node.find("keyframe_prior")) {
     const std::string v = b->as_string();
     if (v == "taken") p.keyframe_prior = KeyframePrior::kTaken;
@@ -200,6 +201,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     job.fit_params.silhouette_term = true;
     job.fit_params.silhouette_inward = true;
   }
+  if (!p.digit_axes) job.fit_params.digit_axis_sigma_px = 0.0;
   // The keyframes' pose prior (toward each keyframe's last pose), widened by keyframe_prior_scale.
   job.fit_params.prior_sigma_wrist_m *= p.keyframe_prior_scale;
   job.fit_params.prior_sigma_rotation_rad *= p.keyframe_prior_scale;

@@ -42,6 +42,7 @@ void make_case(int side, std::uint32_t seed, Case* c) {
   c->params.silhouette_term = true;
   c->params.silhouette_inward = true;
   c->params.silhouette_samples_per_bone = 4;
+  c->params.digit_axis_sigma_px = 5.0;
   // No other hand: this one owns its silhouette, decided at the truth.
   ProjectedHand outline;
   project_hand(c->model, c->truth, c->camera, 0.03, &outline);
@@ -52,6 +53,7 @@ void make_case(int side, std::uint32_t seed, Case* c) {
 
 TEST(ResidualJacobian, MatchesCentralDifferences) {
   int palm_points = 0;  // coverage points held by the palm box, over all cases
+  int axis_points = 0;  // digit axis sections (digit_axis_sigma_px), over all cases
   for (int side = 0; side < 2; ++side) {
     for (std::uint32_t seed : {1u, 2u, 3u, 4u}) {
       Case c;
@@ -98,6 +100,7 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
       EXPECT_GT(costs.prior, 0.0);
       EXPECT_GT(tg.silhouette_count, 5);
       EXPECT_GT(tg.coverage_count, 5) << "side " << side << " seed " << seed;
+      axis_points += tg.axis_count;
       for (int k = 0; k < tg.coverage_count; ++k) palm_points += tg.coverage[k].bone < 0 ? 1 : 0;
 
       VecX r;
@@ -130,6 +133,7 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
     }
   }
   EXPECT_GT(palm_points, 0);
+  EXPECT_GT(axis_points, 5);  // the digit axes' rows were checked too
 }
 
 // What the strings and the bracelet's midpoint measure of hand `truth`, exactly: its four

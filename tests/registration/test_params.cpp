@@ -39,6 +39,11 @@ TEST(RegistrationParams, ValidateNamesTheField) {
   p = {};
   p.coverage_huber_px = std::numeric_limits<double>::infinity();
   EXPECT_NE(validate(p).error().message.find("coverage_huber_px"), std::string::npos);
+  p = {};
+  p.digit_axis_sigma_px = -2;
+  EXPECT_NE(validate(p).error().message.find("digit_axis_sigma_px"), std::string::npos);
+  p.digit_axis_sigma_px = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(validate(p).error().message.find("digit_axis_sigma_px"), std::string::npos);
 }
 
 TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
@@ -60,6 +65,7 @@ TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
   EXPECT_EQ(p.coverage_stride_px, d.coverage_stride_px);
   EXPECT_EQ(p.coverage_max_px, d.coverage_max_px);
   EXPECT_EQ(p.coverage_huber_px, d.coverage_huber_px);
+  EXPECT_EQ(p.digit_axis_sigma_px, d.digit_axis_sigma_px);
   EXPECT_EQ(p.little_free, d.little_free);
   EXPECT_EQ(p.little_coupling_sigma_rad, d.little_coupling_sigma_rad);
   EXPECT_EQ(p.prior_sigma_wrist_m, d.prior_sigma_wrist_m);

@@ -382,6 +382,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.palm_breadth_sigma_px, d.palm_breadth_sigma_px);
   EXPECT_EQ(p.palm_chord.at, d.palm_chord.at);
   EXPECT_EQ(p.palm_chord.min_facing, d.palm_chord.min_facing);
+  EXPECT_EQ(p.digit_axes, d.digit_axes);
   expect_parse_error("personalisation:\n  min_pose_change: -1\n", "bad.yaml", "min_pose_change");
   for (const std::string key :
        {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost", "keyframe_prior_scale"})
@@ -406,6 +407,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   expect_parse_error("personalisation:\n  keyframe_prior: first\n", "where.yaml", "taken or last");
   expect_parse_error("personalisation:\n  shared_hands: sometimes\n", "maybe.yaml", "shared_hands");
   expect_parse_error("personalisation:\n  joint_balls: 3\n", "balls.yaml", "joint_balls");
+  expect_parse_error("personalisation:\n  digit_axes: often\n", "axes.yaml", "digit_axes");
   expect_parse_error("personalisation:\n  palm_breadth_at: 1.5\n", "at.yaml", "palm_breadth_at");
   expect_parse_error("personalisation:\n  palm_breadth_min_facing: -0.1\n", "f.yaml", "palm_breadth_min_facing");
   expect_parse_error("personalisation:\n  palm_breadth_sigma_px: -2\n", "s.yaml", "palm_breadth_sigma_px");

@@ -107,6 +107,25 @@ struct RegistrationParams {
   /// Uncovered pixels farther than this from the model count with a Huber weight (huber / d):
   /// far pixels are as likely a shape the model lacks as a pose error [px].
   double coverage_huber_px = 10.0;
+  /// The digits' axes in the image (with silhouette_term: part of the hand-aware image terms, not
+  /// the paper's): across each phalanx, at two points along it, the matte is
+  /// walked out both ways from the model's projected axis to the silhouette's edges, and the axis
+  /// pulled onto the edges' midpoint (one row each, across the bone) with this σ [px]; 0 = off.
+  /// The midpoint of a finger's two edges is its axis whatever its thickness: unlike the
+  /// joint-balls (whose neighbours sit at the model's radius) and the coverage (which pulls a
+  /// capsule's edge onto tissue it lacks), a finger thicker or thinner than the model's capsule
+  /// does not bias it. A cross-section whose width is not within [0.5, 1.8] times the model's
+  /// diameter (fingers side by side, a finger crossing another, a bone seen end-on) is left out,
+  /// and so is a midpoint more than the model's radius from its axis (another finger's, most
+  /// likely). Not used from a cold start (the pipeline's first frame and restarts).
+  ///
+  /// Measured (2026-11-27, docs/measurements.md "The digits' axes"): in the registration study
+  /// with the true sizes, σ 5 lowered the joint error for four users of five (mean 5.22 → 4.87
+  /// px) at the same or better IoU; in the demo (18 runs per setting, five users and the blocks
+  /// scene) it left the IoU where it was (mean 0.826 either way), the joints 7.54 → 7.07 px, but
+  /// the blocks scene and the short, wide user lost IoU and contested pixels, and the outcome
+  /// swung with the size estimate: not the default.
+  double digit_axis_sigma_px = 0.0;
   /// The little finger's own parameters (hand/parameters.hpp, 17..19): free (the default), the
   /// little finger moves on its own, observed by the image terms alone (no string measures it), held near the
   /// ring finger's angles by a coupling prior of σ little_coupling_sigma_rad per angle. Off: the

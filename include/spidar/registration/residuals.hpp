@@ -22,6 +22,10 @@
 ///              the real silhouette by more than 0.5 px when frozen)                      [px / px]
 ///   coverage   (uv(edge point)(θ) − owned pixel) / σ_cov (2 rows per silhouette pixel this hand
 ///              owns and leaves uncovered by more than 0.5 px when frozen; coverage.hpp)  [px / px]
+///   digit axis n·(uv(axis point)(θ) − midpoint) / σ_axis, n across the projected bone (1 row per
+///              phalanx section whose two silhouette edges were found when frozen, with the
+///              silhouette term and digit_axis_sigma_px > 0; counted with the joint-balls' cost:
+///              both are the digits' joints and axes read from the matte)            [px / px]
 ///   prior      (θ_i − θ_prior,i) / σ_group (1 row per parameter with a finite prior: the
 ///              paper's 17, and the little finger's own 3 where q.little_independent)
 ///   coupling   (θ_little,k − θ_ring,k) / σ_little (3 rows, only where q.little_independent;
@@ -29,7 +33,7 @@
 /// Frozen with the targets: the joint-ball targets P̃, each silhouette point's nearest silhouette
 /// pixel and its offset from the projected axis point (± the projected radius across the bone),
 /// whether the wrist term is active (bracelet point in front of the camera), the bracelet's
-/// visible-surface shift and the band's two ends.
+/// visible-surface shift and the band's two ends, and each digit axis section's midpoint.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -57,6 +61,18 @@ struct BoneRef {
   int segment;
 };
 BoneRef silhouette_bone(int bone);
+
+/// A digit's axis in the image (RegistrationParams::digit_axis_sigma_px): the point at t along
+/// silhouette bone `bone` is pulled across the bone, along `across_px`, onto `target_px`, the
+/// midpoint of the silhouette's edges there (frozen at the linearisation).
+struct DigitAxisPoint {
+  int bone = 0;
+  double t = 0;
+  Vec2 across_px = Vec2::Zero();  ///< unit, across the projected bone
+  Vec2 target_px = Vec2::Zero();  ///< [px]
+};
+/// Phalanges sampled (thumb 2, fingers 3 each) × points along each.
+inline constexpr int kMaxDigitAxisPoints = 14 * 2;
 
 /// One silhouette sample that lies outside the real silhouette (frozen at the linearisation).
 struct SilhouettePoint {
@@ -98,6 +114,8 @@ struct FrozenTargets {
   /// point (bones) or zero (palm).
   std::array<SilhouettePoint, kMaxCoveragePoints> coverage{};
   int coverage_count = 0;
+  std::array<DigitAxisPoint, kMaxDigitAxisPoints> axes{};
+  int axis_count = 0;  ///< entries of `axes` in use
 };
 
 /// What the residuals are about besides the parameters. Pointers are borrowed; `prior` may be

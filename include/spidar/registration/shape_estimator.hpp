@@ -162,6 +162,12 @@ struct ShapeEstimatorParams {
   /// narrower hand reaches the same fingertips by spreading its fingers.)
   double palm_breadth_sigma_px = 0.0;
   PalmChordParams palm_chord;
+  /// The keyframes' refits also take the digits' axes (RegistrationParams::digit_axis_sigma_px)
+  /// when the frames' fits do. Measured with the axes on (demo, 18 runs): with them in the refits
+  /// the left hand's width ended 12 % narrow for the default user and 20–23 % for the large one
+  /// (the axes' rows hold each keyframe's digits where the fit put them, and the width gives
+  /// way); without them 1–2 % and 14–18 % (the axes off: 1–6 %, 10–13 %).
+  bool digit_axes = false;
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's

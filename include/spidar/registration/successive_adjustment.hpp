@@ -25,7 +25,9 @@
 ///  - the silhouette term (coverage.hpp) pulls the nearest part of the model toward each silhouette
 ///    pixel this hand owns and leaves uncovered (> 0.5 px; ImageEvidence::coverage, the owners
 ///    decided per frame among both hands and forearms); with silhouette_inward also model points
-///    lying outside the real silhouette onto their nearest silhouette pixel (a distance transform).
+///    lying outside the real silhouette onto their nearest silhouette pixel (a distance transform),
+///    and with digit_axis_sigma_px each phalanx's projected axis onto the midpoint of the
+///    silhouette's two edges across it.
 /// Nothing here allocates per frame.
 #include <array>
 #include <opencv2/core/mat.hpp>

@@ -1,0 +1,128 @@
+// The digits' axes (RegistrationParams::digit_axis_sigma_px): across each phalanx the silhouette's
+// two edges, and the axis pulled onto their midpoint. Checked on mattes drawn from a hand of the
+// same skeleton with thicker or thinner digits than the model's: the midpoint is the real axis
+// whatever the thickness.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "registration_test_util.hpp"
+#include "spidar/registration/residuals.hpp"
+#include "spidar/registration/shape_estimator.hpp"
+
+namespace spidar::registration {
+namespace {
+
+struct Frozen {
+  FrozenTargets tg;
+  int near = 0;      ///< axis targets within 0.75 px of the true axis
+  double worst = 0;  ///< the farthest target from the true axis [px]
+};
+
+/// Freezes the targets of the model (default right hand) at pose `q` on a matte drawn from the
+/// hand `real` at `truth`, and measures each axis target's distance from the true projected axis.
+Frozen freeze_on(const hand::HandModel& real, const hand::HandParams& truth, const hand::HandParams& q,
+                 double axis_sigma_px) {
+  const hand::HandModel model = hand::default_hand_model(hand::Side::kRight);
+  const vision::Camera camera = vision::default_rig_camera();
+  cv::Mat mask;
+  test::draw_capsule_mask(real, truth, camera, &mask);
+  test::MaskEvidence ev;
+  test::evidence_from_mask(mask, &ev);
+  const ImageEvidence image = ev.evidence(&camera, false);
+  RegistrationParams params;
+  params.silhouette_term = true;
+  params.digit_axis_sigma_px = axis_sigma_px;
+  const HandObservation obs;  // no strings, no bracelet: the image terms alone
+  const ResidualProblem pr{&model, &obs, &image, nullptr, &params};
+  Frozen out;
+  freeze_targets(pr, q, &out.tg);
+  const hand::HandPoints truth_pts = hand::forward_kinematics(real, truth);
+  for (int k = 0; k < out.tg.axis_count; ++k) {
+    const DigitAxisPoint& ap = out.tg.axes[k];
+    const BoneRef b = silhouette_bone(ap.bone);
+    // The true bone's ends: the skeleton is the model's, so the same joints.
+    const int j0 = hand::joint_index(b.finger, b.segment - (b.finger == hand::kThumb ? 0 : 1));
+    const Vec2 a = camera.project(truth_pts.p_W_joint[j0]);
+    const Vec2 c = camera.project(truth_pts.p_W_joint[j0 + 1]);
+    const Vec2 n = Vec2(-(c - a).y(), (c - a).x()).normalized();
+    const double off = std::abs(n.dot(ap.target_px - a));  // from the true axis line
+    out.near += off < 0.75 ? 1 : 0;
+    out.worst = std::max(out.worst, off);
+  }
+  return out;
+}
+
+/// A right hand facing the camera with its fingers spread and a little bent: its phalanges are seen
+/// apart from each other and from the palm.
+hand::HandParams spread_hand() {
+  hand::HandParams q = test::reaching_hands(0)[1];
+  for (int f : {hand::kIndexMcpFlexion, hand::kMiddleMcpFlexion, hand::kRingMcpFlexion}) q[f] = 0.15;
+  for (int f : {hand::kIndexDip, hand::kMiddleDip, hand::kRingDip}) q[f] = 0.2;
+  q[hand::kIndexMcpAbduction] = 0.25;
+  q[hand::kRingMcpAbduction] = 0.25;
+  return q;
+}
+
+TEST(DigitAxes, FindTheRealAxisOfThickerAndThinnerDigits) {
+  const hand::HandModel model = hand::default_hand_model(hand::Side::kRight);
+  const hand::HandParams truth = spread_hand();
+  for (double thickness : {0.8, 1.0, 1.3}) {
+    const hand::HandModel real =
+        resized(model, model.shape.dimensions.length, model.shape.dimensions.width, thickness).value();
+    const Frozen f = freeze_on(real, truth, truth, 5.0);
+    std::printf("thickness %.1f: %d axis targets, %d within 0.75 px of the true axis, worst %.2f px\n", thickness,
+                f.tg.axis_count, f.near, f.worst);
+    EXPECT_GE(f.tg.axis_count, 8) << thickness;  // thicker digits touch: fewer sections stand alone
+    // The phalanges' cross-sections away from the palm and each other: nearly all on the axis
+    // (a digit drawn over another's end, or the palm's box, moves an edge).
+    EXPECT_GE(f.near, f.tg.axis_count - 2) << thickness;
+  }
+}
+
+TEST(DigitAxes, PullADisplacedModelBackAndLeaveFarOnesAlone) {
+  const hand::HandModel model = hand::default_hand_model(hand::Side::kRight);
+  const hand::HandParams truth = spread_hand();
+  const hand::HandModel thick =
+      resized(model, model.shape.dimensions.length, model.shape.dimensions.width, 1.3).value();
+  // The model's digits a little off the real ones: the targets still lie on the real axes.
+  hand::HandParams q = truth;
+  q[hand::kIndexMcpAbduction] += 0.04;
+  q[hand::kMiddleMcpFlexion] += 0.05;
+  q[hand::kRingMcpAbduction] -= 0.04;
+  const Frozen near = freeze_on(thick, truth, q, 5.0);
+  std::printf("displaced: %d targets, %d on the true axis, worst %.2f px\n", near.tg.axis_count, near.near, near.worst);
+  EXPECT_GE(near.tg.axis_count, 8);
+  EXPECT_GE(near.near, near.tg.axis_count - 2);
+  // Their rows pull toward the truth: the cost of the axis rows is lower at the truth.
+  // (Costs of the joint-ball term, which the axes' rows count with, with the balls off.)
+  const vision::Camera camera = vision::default_rig_camera();
+  RegistrationParams params;
+  params.silhouette_term = true;
+  params.joint_ball_alpha = 0.0;  // balls without a pull: only the axes' rows remain in the term
+  params.digit_axis_sigma_px = 5.0;
+  cv::Mat mask;
+  test::draw_capsule_mask(thick, truth, camera, &mask);
+  test::MaskEvidence ev;
+  test::evidence_from_mask(mask, &ev);
+  const ImageEvidence image = ev.evidence(&camera, false);
+  const HandObservation obs;
+  const ResidualProblem pr{&model, &obs, &image, nullptr, &params};
+  FrozenTargets tg;
+  freeze_targets(pr, q, &tg);
+  const double at_q = term_costs(pr, tg, q).joint_ball, at_truth = term_costs(pr, tg, truth).joint_ball;
+  EXPECT_GT(at_q, 1.0);
+  EXPECT_LT(at_truth, 0.2 * at_q);
+  // A model a whole palm's breadth off finds no digit within its radius: no target at all
+  // (a neighbouring finger is not this one).
+  hand::HandParams far = truth;
+  far.set_wrist(truth.p_W_wrist() + Vec3(0.04, 0.0, 0.0), truth.r_W_hand());
+  const Frozen off = freeze_on(thick, truth, far, 5.0);
+  EXPECT_LE(off.tg.axis_count, 2);
+  // Off (σ 0) or without the silhouette term (the paper's method), nothing is frozen.
+  EXPECT_EQ(freeze_on(thick, truth, q, 0.0).tg.axis_count, 0);
+}
+
+}  // namespace
+}  // namespace spidar::registration
