@@ -120,7 +120,7 @@ struct RegistrationParams {
   /// likely). Not used from a cold start (the pipeline's first frame and restarts).
   ///
   /// Measured (2026-11-27, docs/measurements.md "The digits' axes"): in the registration study
-  /// with the true sizes, σ 5 lowered the joint error for four users of five (mean 5.22 → 4.87
+  /// with the true sizes, σ 5 lowered the joint error for four users of five (mean 5.22 → 4.93
   /// px) at the same or better IoU; in the demo (18 runs per setting, five users and the blocks
   /// scene) it left the IoU where it was (mean 0.826 either way), the joints 7.54 → 7.07 px, but
   /// the blocks scene and the short, wide user lost IoU and contested pixels, and the outcome
