@@ -303,7 +303,7 @@ Vec3 RubiksTask::pressing(double t, int f) const {
 }
 
 void RubiksTask::touch_points(double t_run, std::span<Vec3> p_W) const {
-  scheduled_goals(read_plan(), t_run, published_.read().value_or(frames_), p_W, false);
+  scheduled_goals(read_plan(), t_run, read_frames(), p_W, false);
 }
 
 void RubiksTask::goals_at(double t, const GraspFrames& fr, std::span<Vec3> goal, bool squeeze,
@@ -355,7 +355,7 @@ hand::HandParams RubiksTask::script_nominal_local(double t, hand::Side side) con
 
 hand::HandParams RubiksTask::nominal(double t_run, hand::Side side) const {
   const Plan plan = read_plan();
-  const GraspFrames fr = published_.read().value_or(frames_);
+  const GraspFrames fr = read_frames();
   const ScriptSegment& seg = plan.schedule.at(t_run);
   hand::HandParams q = nominal_at(plan.schedule.script_time(t_run), side, fr);
   const double w = blend_weight(seg, t_run);

@@ -2,6 +2,7 @@
 // they start, and the phase names (rubiks_task.hpp, script_schedule.hpp).
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "spidar/sim/rubiks_task.hpp"
 
@@ -43,8 +44,20 @@ bool RubiksTask::within_reach(const CubePoseSample& c) const {
 }
 
 RubiksTask::Plan RubiksTask::read_plan() const {
-  if (auto p = published_plan_.read()) return *p;
-  return Plan{};  // only while a publish keeps racing: the open-loop script
+  // Published since construction, so a read fails only while publishes keep racing it (the
+  // servo thread's, under a slow build such as TSan's): read again rather than fall back to
+  // another plan for this call.
+  for (;;) {
+    if (auto p = published_plan_.read()) return *p;
+    std::this_thread::yield();
+  }
+}
+
+RubiksTask::GraspFrames RubiksTask::read_frames() const {
+  for (;;) {  // as read_plan: published since construction
+    if (auto f = published_.read()) return *f;
+    std::this_thread::yield();
+  }
 }
 
 double RubiksTask::script_time(double t_run) const { return read_plan().schedule.script_time(t_run); }

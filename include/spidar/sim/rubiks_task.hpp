@@ -193,6 +193,9 @@ class RubiksTask final : public device::FingertipSource {
   /// Starts a segment at run time t from script time s0, blending from the present script time.
   void jump(double t_s, double s0, double blend_s, SegmentKind kind, int attempt, int turn);
   Plan read_plan() const;
+  /// The newest grasp frames (published_), read again until no publish races the read: the
+  /// servo thread's own copy (frames_) is not for other threads.
+  GraspFrames read_frames() const;
   /// True while the cube is where a hand can take it: near its start place (not thrown off the
   /// table). Hands follow only such a cube.
   bool within_reach(const CubePoseSample& cube) const;
