@@ -66,21 +66,13 @@ void freeze_silhouette(const ResidualProblem& pr, const detail::PoseState& s,
   }
 }
 
-/// The matte at the pixel nearest `uv` (CV_32FC1, or CV_8UC1 read as /255); 0 outside the image.
-double sample_nearest(const cv::Mat& alpha, const Vec2& uv) {
-  const long x = std::lround(uv.x()), y = std::lround(uv.y());
-  if (x < 0 || y < 0 || x >= alpha.cols || y >= alpha.rows) return 0.0;
-  return alpha.type() == CV_8UC1 ? alpha.at<std::uint8_t>(static_cast<int>(y), static_cast<int>(x)) / 255.0
-                                 : static_cast<double>(alpha.at<float>(static_cast<int>(y), static_cast<int>(x)));
-}
-
 /// How far from `from` along `dir` (unit) the matte leaves the silhouette [px]: walked a pixel at
 /// a time (nearest pixel), the crossing then placed between the last step on it and the first off
 /// it where the bilinear matte crosses the threshold. nullopt if it does not within `max_px`.
 std::optional<double> edge_along(const cv::Mat& alpha, const Vec2& from, const Vec2& dir, double max_px,
                                  double threshold) {
   for (double s = 1.0; s <= max_px; s += 1.0) {
-    if (sample_nearest(alpha, from + s * dir) >= threshold) continue;
+    if (vision::sample_nearest(alpha, from + s * dir) >= threshold) continue;
     const double a0 = vision::sample_bilinear(alpha, from + (s - 1.0) * dir);
     const double a1 = vision::sample_bilinear(alpha, from + s * dir);
     const double f = a0 > a1 ? (a0 - threshold) / (a0 - a1) : 0.5;

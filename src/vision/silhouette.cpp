@@ -130,4 +130,13 @@ double sample_bilinear(const cv::Mat& alpha, const Vec2& uv) {
          ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
 }
 
+double sample_nearest(const cv::Mat& alpha, const Vec2& uv) {
+  const bool bytes = alpha.type() == CV_8UC1;
+  if (alpha.empty() || (alpha.type() != CV_32FC1 && !bytes) || !uv.allFinite()) return 0.0;
+  const double fx = std::round(uv.x()), fy = std::round(uv.y());
+  if (fx < 0.0 || fy < 0.0 || fx >= alpha.cols || fy >= alpha.rows) return 0.0;
+  const int x = static_cast<int>(fx), y = static_cast<int>(fy);
+  return bytes ? alpha.at<std::uint8_t>(y, x) / 255.0 : static_cast<double>(alpha.at<float>(y, x));
+}
+
 }  // namespace spidar::vision

@@ -158,5 +158,37 @@ TEST(SampleBilinear, ABinarySilhouetteOfBytesSamplesAsItsFloatCopy) {
   EXPECT_EQ(sample_bilinear(cv::Mat(24, 32, CV_16UC1, cv::Scalar(65535)), Vec2(5, 5)), 0.0);
 }
 
+
+// The nearest pixel's value, against the pixel whose centre is nearest by brute force; 0 outside
+// the image, for a non-finite point and for a type that is no matte.
+TEST(SampleNearest, ReadsThePixelWhoseCentreIsNearest) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u01(0.f, 1.f);
+  cv::Mat alpha(12, 16, CV_32FC1);
+  for (int y = 0; y < alpha.rows; ++y)
+    for (int x = 0; x < alpha.cols; ++x) alpha.at<float>(y, x) = u01(rng);
+  cv::Mat bytes;
+  alpha.convertTo(bytes, CV_8UC1, 255.0);
+  std::uniform_real_distribution<double> ux(-0.49, 15.49), uy(-0.49, 11.49);
+  for (int i = 0; i < 300; ++i) {
+    const Vec2 p(ux(rng), uy(rng));
+    int bx = 0, by = 0;
+    double best = 1e9;
+    for (int y = 0; y < alpha.rows; ++y)
+      for (int x = 0; x < alpha.cols; ++x)
+        if (const double d = (p - Vec2(x, y)).squaredNorm(); d < best) best = d, bx = x, by = y;
+    EXPECT_EQ(sample_nearest(alpha, p), static_cast<double>(alpha.at<float>(by, bx))) << p.transpose();
+    EXPECT_EQ(sample_nearest(bytes, p), bytes.at<std::uint8_t>(by, bx) / 255.0) << p.transpose();
+  }
+  EXPECT_EQ(sample_nearest(alpha, Vec2(-0.6, 3)), 0.0);
+  EXPECT_EQ(sample_nearest(alpha, Vec2(3, 11.6)), 0.0);
+  EXPECT_EQ(sample_nearest(alpha, Vec2(15.6, 3)), 0.0);
+  EXPECT_EQ(sample_nearest(alpha, Vec2(std::nan(""), 3)), 0.0);
+  EXPECT_EQ(sample_nearest(alpha, Vec2(3, std::numeric_limits<double>::infinity())), 0.0);
+  EXPECT_EQ(sample_nearest(alpha, Vec2(1e300, -1e300)), 0.0);
+  EXPECT_EQ(sample_nearest(cv::Mat(12, 16, CV_16UC1, cv::Scalar(65535)), Vec2(5, 5)), 0.0);
+  EXPECT_EQ(sample_nearest(cv::Mat(), Vec2(0, 0)), 0.0);
+}
+
 }  // namespace
 }  // namespace spidar::vision

@@ -63,6 +63,10 @@ Status silhouette_distance(const cv::Mat& silhouette, SilhouetteDistance* out,
 /// border. 0 for any other type.
 double sample_bilinear(const cv::Mat& alpha, const Vec2& uv);
 
+/// The matte at the pixel nearest a sub-pixel point [px] (the same types and scaling as
+/// sample_bilinear); 0 outside the image, for a non-finite point, or for any other type.
+double sample_nearest(const cv::Mat& alpha, const Vec2& uv);
+
 /// True if the matte at uv (bilinear) is at least `threshold`.
 inline bool on_silhouette(const cv::Mat& alpha, const Vec2& uv, double threshold = 0.5) {
   return sample_bilinear(alpha, uv) >= threshold;
