@@ -1,9 +1,12 @@
 #include "cli_support.hpp"
 
+#include "spidar/core/file_read.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <system_error>
 
 namespace spidar::app {
 
@@ -32,6 +35,22 @@ void require_range(double x, double lo, double hi, std::string_view option, std:
   std::ostringstream os;
   os << option << ": expected " << lo << " to " << hi << (unit.empty() ? "" : " ") << unit << ", got " << x;
   throw UsageError(os.str());
+}
+
+void require_path(const std::string& path, std::string_view option, std::string_view what) {
+  if (!path.empty()) return;
+  throw UsageError(std::string(option) + ": expected " + std::string(what) + ", got an empty path");
+}
+
+void make_output_dir(const std::string& dir, std::string_view option) {
+  require_path(dir, option, "a directory");
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!ec && !fs::is_directory(dir, ec)) ec = std::make_error_code(std::errc::not_a_directory);
+  if (ec)
+    throw UsageError(std::string(option) + ": cannot make the output directory '" +
+                     core::printable_for_message(dir) + "': " + ec.message());
 }
 
 CLI::Validator seed_check() {

@@ -39,6 +39,14 @@ using session::to_json;
 /// UsageError unless lo <= x <= hi (NaN is refused too): "--seconds: expected 0 to 600 s, got nan".
 void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit = "");
 
+/// UsageError naming `option` when a path it takes is empty (`what`: what it names, e.g. "a
+/// hands YAML file").
+void require_path(const std::string& path, std::string_view option, std::string_view what);
+
+/// Makes the output directory `dir` (and its parents) up front, before any input is loaded:
+/// UsageError naming `option` and the reason when it cannot (a file in the way, no permission).
+void make_output_dir(const std::string& dir, std::string_view option);
+
 /// The largest seed a --seed option takes.
 inline constexpr std::uint64_t kMaxSeed = 4294967295u;
 /// Check for --seed options: a decimal whole number 0 to kMaxSeed. CLI11 would otherwise map

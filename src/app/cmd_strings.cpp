@@ -7,7 +7,14 @@
 
 #include "cli_support.hpp"
 #include "commands.hpp"
+#include "spidar/core/config.hpp"
 #include "spidar/device/servo_loop.hpp"
+#include "spidar/hand/hand_config.hpp"
+#include "spidar/registration/registration_params.hpp"
+#include "spidar/registration/shape_estimator.hpp"
+#include "spidar/session/live_config.hpp"
+#include "spidar/vision/camera_config.hpp"
+#include "spidar/vision/vision_config.hpp"
 #include "spidar/device/workspace.hpp"
 #include "spidar/strings/position.hpp"
 #include "spidar/strings/tension.hpp"
@@ -69,14 +76,46 @@ void add_finger_options(CLI::App& cmd, FingerArgs& a) {
 }  // namespace
 
 Action add_check_config(CLI::App& app) {
-  auto* cmd = app.add_subcommand("check-config", "Validate a device config and summarise it");
+  auto* cmd = app.add_subcommand("check-config",
+                                 "Validate any spidar-mr config (device, camera, vision, registration, hands, "
+                                 "live session: told apart by its top-level keys) and summarise it");
   auto file = std::make_shared<std::string>();
-  cmd->add_option("file", *file, "device config (YAML)")->required();
+  cmd->add_option("file", *file, "config (YAML)")->required();
   return [file] {
+    // The kind of config, by its top-level keys (configs/*.yaml); a device config otherwise.
+    const auto root = core::ConfigNode::LoadFile(*file);
+    const auto keys = root.is_map() ? root.keys() : std::vector<std::string>{};
+    auto has = [&](const char* k) { return std::find(keys.begin(), keys.end(), k) != keys.end(); };
+    std::ostringstream os;
+    os << *file << ": ok: ";
+    if (has("device") && has("camera")) {
+      const auto live = session::load_live_config(*file, false);
+      os << "live session config (" << live.backend << " device, " << live.camera_source << " camera, compositor "
+         << live.compositor << ")";
+    } else if (has("camera")) {
+      const auto cam = vision::load_camera_file(*file).camera;
+      os << "camera " << cam.width() << "x" << cam.height() << ", fx " << num(cam.intrinsics().fx) << " px";
+    } else if (has("chroma_key") || has("bracelet")) {
+      (void)vision::load_vision_config(*file);
+      os << "vision settings (chroma key, bracelet)";
+    } else if (has("registration") || has("personalisation")) {
+      if (has("registration")) (void)registration::parse_registration_params(root["registration"]);
+      bool personalise = false;
+      if (has("personalisation")) (void)registration::parse_shape_estimator_params(root["personalisation"], &personalise);
+      os << "registration settings" << (has("personalisation") ? std::string(", personalisation ") + (personalise ? "on" : "off") : "");
+    } else if (has("hands")) {
+      const auto hands = hand::load_hand_profiles(*file);
+      os << hands.profiles.size() << " hand profile(s):";
+      for (const auto& p : hands.profiles)
+        os << " " << p.name << " (" << num(1e3 * p.dimensions.length) << " x " << num(1e3 * p.dimensions.width) << " mm)";
+    }
+    if (os.str().size() > file->size() + 6) {
+      std::cout << os.str() << "\n";
+      return 0;
+    }
     const auto cfg = strings::load_device_config(*file);
     const auto lim = cfg.effective_limits();
-    std::ostringstream os;
-    os << *file << ": ok: " << cfg.name << ", " << cfg.fingers.size() << " fingers, "
+    os << cfg.name << ", " << cfg.fingers.size() << " fingers, "
        << cfg.string_count() << " strings, tension " << cfg.tension.t_min << "-"
        << cfg.tension.t_max << " N (drive delivers " << lim.t_min << "-" << lim.t_max << " N)";
     std::cout << os.str() << "\n";

@@ -14,6 +14,7 @@
 #include "cli_support.hpp"
 #include "spidar/core/atomic_write.hpp"
 #include "spidar/core/units.hpp"
+#include "spidar/device/workspace.hpp"
 #include "demo.hpp"
 #include "spidar/session/run_report.hpp"
 #include "progress.hpp"
@@ -56,14 +57,31 @@ int run_mr_demo(const DemoOptions& o) {
   // Ctrl-C / SIGTERM end the run early but cleanly: the video is finished and the report written.
   SignalScope signals;
   // --- inputs (all checked before anything starts) ---
+  require_path(o.user_hand, "--user-hand", "a hands YAML file");
+  require_path(o.scene, "--scene", "an MJCF scene file");
+  require_path(o.camera, "--camera", "a camera YAML file");
+  require_path(o.config, "--config", "a device config YAML file");
+  make_output_dir(o.out, "--out");
   const auto cfg = strings::load_device_config(resolve_data_path(o.config));
   if (cfg.fingers.size() != 8) throw UsageError("--config: the rubiks demo needs 8 fingers");
   const std::string scene_path = resolve_data_path(o.scene);
   const std::string hand_path = resolve_data_path(o.user_hand);
-  const auto truth_models = session::hand_models(hand_path, o.user_profile, true);
+  std::string user_profile;  // the profile used: o.user_profile, else the file's first
+  const auto truth_models = session::hand_models(hand_path, o.user_profile, true, &user_profile);
   const auto models = session::hand_models(resolve_data_path("configs/hands.yaml"), o.model_profile, false);
-  const vision::Camera camera = session::scaled_camera(
-      vision::load_camera_file(resolve_data_path(o.camera)).camera, o.width, o.height);
+  const vision::Camera calibrated = vision::load_camera_file(resolve_data_path(o.camera)).camera;
+  {
+    // Scaling a calibration to another aspect ratio would make its pixels non-square.
+    const double a = static_cast<double>(o.width) / o.height;
+    const double a0 = static_cast<double>(calibrated.width()) / calibrated.height();
+    if (std::abs(a / a0 - 1.0) > 0.01)
+      throw UsageError("--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                       " is not the shape of the camera's calibration, " + std::to_string(calibrated.width()) +
+                       "x" + std::to_string(calibrated.height()) + " (--camera " + o.camera +
+                       "): give a size of the same aspect ratio, e.g. " +
+                       std::to_string(static_cast<int>(std::lround(o.height * a0))) + "x" + std::to_string(o.height));
+  }
+  const vision::Camera camera = session::scaled_camera(calibrated, o.width, o.height);
   auto mode = render::parse_composite_mode(o.compositor);
   if (!mode) throw UsageError("--compositor: " + mode.error().message);
   // The scripted user plays until its task is done (retries included), by --seconds at most.
@@ -75,6 +93,21 @@ int run_mr_demo(const DemoOptions& o) {
   fs::create_directories(fs::path(o.out) / "keyframes");
   const sim::RubiksTask& task = *scene.task;
   const double seconds = task.params().deadline;
+  // The object must be where the device's strings can follow the fingers to it: inside the frame
+  // its fulcrums span (a fingertip solved outside it latches the workspace fault at once).
+  {
+    const Vec3& p = task.params().p_W_cube;
+    const auto ws = device::device_workspace(cfg, 0.0);
+    if (const auto ex = device::workspace_excess(ws, {p.x(), p.y(), p.z()}); ex.distance_m > 0) {
+      const char* axis = ex.axis == 0 ? "x" : ex.axis == 1 ? "y" : "z";
+      std::ostringstream m;
+      m << std::fixed << std::setprecision(3) << "--scene: the object to reach for, at (" << p.x() << ", " << p.y()
+        << ", " << p.z() << ") m, lies " << ex.distance_m << " m beyond the device's frame along " << axis
+        << " (its fulcrums span [" << ws.lo_W[ex.axis] << ", " << ws.hi_W[ex.axis] << "] m, --config "
+        << o.config << ")";
+      throw UsageError(m.str());
+    }
+  }
 
   session::SessionParams sp;
   sp.servo.rate_hz = o.rate_hz;
@@ -153,7 +186,9 @@ int run_mr_demo(const DemoOptions& o) {
 
   std::cout << "spidar-mr demo: mixed-reality Rubik's cube on a simulated " << cfg.name << "\n"
             << "  scene " << scene_path << (cube ? "" : " (no cube: reaching for the nearest object)")
-            << "\n  user hands '" << o.user_profile << "' from " << hand_path << " ("
+            << "\n  user hands '" << user_profile << "'"
+            << (user_profile != o.user_profile ? " (no '" + o.user_profile + "' profile: the file's first)" : std::string())
+            << " from " << hand_path << " ("
             << truth_models[0].shape.dimensions.length * 1e3 << " mm; model "
             << models[0].shape.dimensions.length * 1e3 << " mm), camera " << o.width << "x"
             << o.height << " at " << o.fps << " fps, compositor " << o.compositor
@@ -205,6 +240,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.height = o.height;
   summary.scene = scene_path;
   summary.user_hand = hand_path;
+  summary.user_profile = user_profile;
   summary.user_length_m = truth_models[0].shape.dimensions.length;
   summary.user_width_m = truth_models[0].shape.dimensions.width;
   summary.ended_by = ended_by;

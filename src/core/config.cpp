@@ -3,7 +3,9 @@
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <new>
 #include <sstream>
 
@@ -275,10 +277,26 @@ double require_in_range(const ConfigNode& node, double value, double lo, double 
                         std::string_view unit) {
   if (!(value >= lo && value <= hi)) {
     std::ostringstream os;
-    os << "expected a value in [" << lo << ", " << hi << "] " << unit << ", got " << value;
+    os << "expected a value in [" << lo << ", " << hi << "]" << (unit.empty() ? "" : " ") << unit << ", got "
+       << value;
     node.fail(os.str());
   }
   return value;
+}
+
+std::string number_for_message(double v, int significant) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", std::clamp(significant, 1, 17), v);
+  return buf;
+}
+
+void fail_at_named_key(const ConfigNode& node, std::string_view message, std::string_view prefix) {
+  std::string_view rest = message;
+  if (rest.substr(0, prefix.size()) == prefix) rest.remove_prefix(prefix.size());
+  const std::size_t colon = rest.find(": ");
+  if (colon != std::string_view::npos && node.is_map())
+    if (const auto child = node.find(rest.substr(0, colon))) child->fail(rest.substr(colon + 2));
+  node.fail(message);
 }
 
 }  // namespace spidar::core

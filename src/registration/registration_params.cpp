@@ -17,45 +17,54 @@ struct Field {
   double hi;
   bool lo_open;  // (lo, hi] instead of [lo, hi]
   const char* unit;
+  bool zero_off = false;  // 0 (the term off) is allowed as well
 };
 
+// A σ divides a residual: below these a weight's square overflows the normal equations or
+// swamps every other term (fingertip_sigma_m 1e-300 gave IoU 0.16 and 56 mm), so they are the
+// smallest σ that still means a measurement.
+constexpr double kMinSigmaM = 1e-5;     // 10 µm
+constexpr double kMinSigmaPx = 0.01;    // a hundredth of a pixel
+constexpr double kMinSigmaRad = 1e-4;   // 0.006°
+constexpr double kMinSigmaRatio = 1e-3; // a relative σ
+
 constexpr Field kFields[] = {
-    {"fingertip_sigma_m", &RegistrationParams::fingertip_sigma_m, nullptr, 0.0, 0.1, true, "m"},
-    {"wrist_sigma_px", &RegistrationParams::wrist_sigma_px, nullptr, 0.0, 1000.0, true, "px"},
+    {"fingertip_sigma_m", &RegistrationParams::fingertip_sigma_m, nullptr, kMinSigmaM, 0.1, false, "m"},
+    {"wrist_sigma_px", &RegistrationParams::wrist_sigma_px, nullptr, kMinSigmaPx, 1000.0, false, "px"},
     {"bracelet_offset_m", &RegistrationParams::bracelet_offset_m, nullptr, -0.05, 0.05, false, "m"},
     {"bracelet_surface_shift", &RegistrationParams::bracelet_surface_shift, nullptr, 0.0, 1.0, false, ""},
     {"bracelet_radius_per_width", &RegistrationParams::bracelet_radius_per_width, nullptr, 0.0, 1.0, false, ""},
     {"bracelet_standoff_m", &RegistrationParams::bracelet_standoff_m, nullptr, 0.0, 0.02, false, "m"},
     {"bracelet_depth_ratio", &RegistrationParams::bracelet_depth_ratio, nullptr, 0.2, 1.0, false, ""},
-    {"bracelet_length_sigma", &RegistrationParams::bracelet_length_sigma, nullptr, 0.0, 1.0, false, ""},
+    {"bracelet_length_sigma", &RegistrationParams::bracelet_length_sigma, nullptr, kMinSigmaRatio, 1.0, false, "", true},
     {"bracelet_length_min_fill", &RegistrationParams::bracelet_length_min_fill, nullptr, 0.0, 1.0, false, ""},
     {"bracelet_length_tolerance", &RegistrationParams::bracelet_length_tolerance, nullptr, 0.0, 1.0, false, ""},
     {"bracelet_length_gate", &RegistrationParams::bracelet_length_gate, nullptr, 0.0, 10.0, true, ""},
     {"bracelet_width_m", &RegistrationParams::bracelet_width_m, nullptr, 0.0, 0.1, false, "m"},
-    {"bracelet_thickness_sigma", &RegistrationParams::bracelet_thickness_sigma, nullptr, 0.0, 1.0, false, ""},
+    {"bracelet_thickness_sigma", &RegistrationParams::bracelet_thickness_sigma, nullptr, kMinSigmaRatio, 1.0, false, "", true},
     {"bracelet_thickness_tolerance", &RegistrationParams::bracelet_thickness_tolerance, nullptr, 0.0, 1.0, false, ""},
-    {"joint_ball_sigma_px", &RegistrationParams::joint_ball_sigma_px, nullptr, 0.0, 1000.0, true,
+    {"joint_ball_sigma_px", &RegistrationParams::joint_ball_sigma_px, nullptr, kMinSigmaPx, 1000.0, false,
      "px"},
     {"joint_ball_alpha", &RegistrationParams::joint_ball_alpha, nullptr, 0.0, 1.0, false, ""},
     {"ball_radius_scale", &RegistrationParams::ball_radius_scale, nullptr, 0.0, 5.0, true, ""},
     {"matte_threshold", &RegistrationParams::matte_threshold, nullptr, 0.0, 1.0, true, ""},
-    {"silhouette_sigma_px", &RegistrationParams::silhouette_sigma_px, nullptr, 0.0, 1000.0, true,
+    {"silhouette_sigma_px", &RegistrationParams::silhouette_sigma_px, nullptr, kMinSigmaPx, 1000.0, false,
      "px"},
     {"silhouette_samples_per_bone", nullptr, &RegistrationParams::silhouette_samples_per_bone, 1.0,
      kMaxSilhouetteSamplesPerBone, false, ""},
-    {"coverage_sigma_px", &RegistrationParams::coverage_sigma_px, nullptr, 0.0, 1000.0, true, "px"},
+    {"coverage_sigma_px", &RegistrationParams::coverage_sigma_px, nullptr, kMinSigmaPx, 1000.0, false, "px"},
     {"coverage_stride_px", nullptr, &RegistrationParams::coverage_stride_px, 1.0, 64.0, false, "px"},
     {"coverage_max_px", &RegistrationParams::coverage_max_px, nullptr, 0.0, 1000.0, true, "px"},
     {"coverage_huber_px", &RegistrationParams::coverage_huber_px, nullptr, 0.0, 1000.0, true, "px"},
-    {"digit_axis_sigma_px", &RegistrationParams::digit_axis_sigma_px, nullptr, 0.0, 1000.0, false, "px"},
-    {"little_coupling_sigma_rad", &RegistrationParams::little_coupling_sigma_rad, nullptr, 0.0, 100.0, true,
+    {"digit_axis_sigma_px", &RegistrationParams::digit_axis_sigma_px, nullptr, kMinSigmaPx, 1000.0, false, "px", true},
+    {"little_coupling_sigma_rad", &RegistrationParams::little_coupling_sigma_rad, nullptr, kMinSigmaRad, 100.0, false,
      "rad"},
-    {"prior_sigma_wrist_m", &RegistrationParams::prior_sigma_wrist_m, nullptr, 0.0, 100.0, true,
+    {"prior_sigma_wrist_m", &RegistrationParams::prior_sigma_wrist_m, nullptr, kMinSigmaM, 100.0, false,
      "m"},
-    {"prior_sigma_rotation_rad", &RegistrationParams::prior_sigma_rotation_rad, nullptr, 0.0,
-     100.0, true, "rad"},
-    {"prior_sigma_joint_rad", &RegistrationParams::prior_sigma_joint_rad, nullptr, 0.0, 100.0,
-     true, "rad"},
+    {"prior_sigma_rotation_rad", &RegistrationParams::prior_sigma_rotation_rad, nullptr, kMinSigmaRad,
+     100.0, false, "rad"},
+    {"prior_sigma_joint_rad", &RegistrationParams::prior_sigma_joint_rad, nullptr, kMinSigmaRad, 100.0,
+     false, "rad"},
     {"lambda_initial", &RegistrationParams::lambda_initial, nullptr, 0.0, 1e6, false, ""},
     {"max_iterations", nullptr, &RegistrationParams::max_iterations, 1.0, 1000.0, false, ""},
     {"cost_epsilon", &RegistrationParams::cost_epsilon, nullptr, 0.0, 1e6, false, ""},
@@ -69,13 +78,15 @@ double value_of(const RegistrationParams& p, const Field& f) {
 
 bool in_range(const Field& f, double v) {
   if (!std::isfinite(v)) return false;
+  if (f.zero_off && v == 0.0) return true;
   return (f.lo_open ? v > f.lo : v >= f.lo) && v <= f.hi;
 }
 
 // "expected a value in (0, 0.1] m, got -1"
 std::string expectation(const Field& f, double v) {
   std::ostringstream os;
-  os << "expected " << (f.integer ? "an integer" : "a value") << " in " << (f.lo_open ? '(' : '[')
+  os << "expected " << (f.zero_off ? "0 (off) or " : "") << (f.integer ? "an integer" : "a value") << " in "
+     << (f.lo_open ? '(' : '[')
      << f.lo << ", " << f.hi << ']';
   if (*f.unit) os << ' ' << f.unit;
   os << ", got " << v;

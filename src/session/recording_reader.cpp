@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "csv_cursor.hpp"
+#include "spidar/core/config.hpp"
 #include "spidar/core/file_read.hpp"
 
 namespace spidar::session {
@@ -27,11 +28,7 @@ std::string location(const std::string& file, int line, int column) {
   return s;
 }
 
-std::string short_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+std::string short_number(double v) { return core::number_for_message(v, 9); }
 
 /// The sample columns of the current row (faults ... f7z).
 device::FingertipSample read_sample(const CsvCursor& c, int finger_count) {
@@ -128,6 +125,21 @@ bool inside(const fs::path& dir, const std::string& image) {
   return b == base.end() && f != full.end();
 }
 
+/// The 1-based line and column of byte `at` (0-based) of `text` (clamped to its end).
+std::pair<int, int> line_and_column(std::string_view text, std::size_t at) {
+  at = std::min(at, text.size());
+  int line = 1, column = 1;
+  for (std::size_t i = 0; i < at; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return {line, column};
+}
+
 }  // namespace
 
 RecordingError::RecordingError(std::string file, int line, int column, const std::string& message)
@@ -141,18 +153,22 @@ SessionJson parse_session_json(std::string_view text, const std::string& name) {
   try {
     j = json::parse(text);
   } catch (const json::parse_error& e) {
-    // e.byte is the 1-based offset of the error: turn it into line and column.
-    const std::size_t at = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
-    int line = 1, column = 1;
-    for (std::size_t i = 0; i < at; ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        column = 1;
-      } else {
-        ++column;
-      }
-    }
+    // e.byte is the 1-based offset of the error.
+    const auto [line, column] = line_and_column(text, e.byte == 0 ? 0 : e.byte - 1);
     throw RecordingError(name, line, column, "not valid JSON (expected a recording's session.json)");
+  } catch (const json::out_of_range& e) {
+    // A number beyond a double's range ("number overflow parsing '1e999'"): the parser gives no
+    // offset, so the number is found in the text.
+    const std::string what = e.what();
+    const std::size_t q0 = what.find('\''), q1 = q0 == std::string::npos ? q0 : what.find('\'', q0 + 1);
+    const std::string token = q1 == std::string::npos ? std::string() : what.substr(q0 + 1, q1 - q0 - 1);
+    const std::size_t at = token.empty() ? std::string_view::npos : text.find(token);
+    const auto [line, column] = at == std::string_view::npos ? std::pair{0, 0} : line_and_column(text, at);
+    throw RecordingError(name, line, column,
+                         "a number out of range" + (token.empty() ? std::string() : " ('" + token + "')") +
+                             " (expected a recording's session.json with finite numbers)");
+  } catch (const json::exception& e) {
+    throw RecordingError(name, 0, 0, std::string("not a readable session.json: ") + e.what());
   }
   if (!j.is_object()) throw RecordingError(name, 0, 0, "expected a JSON object (a recording's session.json)");
   const JsonKeys k(j, name);

@@ -21,7 +21,7 @@ vision::Camera scaled_camera(const vision::Camera& c, int w, int h) {
 }
 
 std::array<hand::HandModel, 2> hand_models(const std::string& path, const std::string& profile,
-                                           bool first_if_missing) {
+                                           bool first_if_missing, std::string* chosen) {
   const hand::HandProfiles profiles = hand::load_hand_profiles(path);  // throws ConfigError
   const hand::HandProfile* p = profiles.find(profile);
   if (p == nullptr) {
@@ -29,6 +29,7 @@ std::array<hand::HandModel, 2> hand_models(const std::string& path, const std::s
       throw SpidarError(path + ": no hand profile '" + profile + "'");
     p = &profiles.profiles.front();
   }
+  if (chosen) *chosen = p->name;
   return {p->model(hand::Side::kLeft), p->model(hand::Side::kRight)};
 }
 

@@ -42,14 +42,24 @@ std::vector<double> column(const MrTrace& t, F f) {
   return v;
 }
 
+/// The frames of `t` whose variant k (0 main, 1 comparison) had a real or fitted hand in view.
+MrTrace in_view(const MrTrace& t, int k) {
+  MrTrace out;
+  for (const auto& m : t.frames)
+    if (m.truth[k].scored_in_image()) out.frames.push_back(m);
+  return out;
+}
+
 /// Registration figures of one variant (0 main, 1 comparison).
 nlohmann::json registration_json(const MrTrace& all, int k) {
   MrTrace t;
   for (const auto& m : all.frames) {
     if (k == 0 || m.compared) t.frames.push_back(m);
   }
-  const auto iou = column(t, [k](const MrFrame& m) { return m.truth[k].iou; });
-  const auto jp = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].joint_px[0] + m.truth[k].joint_px[1]); });
+  // The image's figures over the frames where a real or fitted hand was in view (scored_in_image).
+  const MrTrace seen = in_view(t, k);
+  const auto iou = column(seen, [k](const MrFrame& m) { return m.truth[k].iou; });
+  const auto jp = column(seen, [k](const MrFrame& m) { return 0.5 * (m.truth[k].joint_px[0] + m.truth[k].joint_px[1]); });
   const auto tip = column(t, [k](const MrFrame& m) { return 0.5 * (m.truth[k].fingertip_mm[0] + m.truth[k].fingertip_mm[1]); });
   const auto occ = column(t, [k](const MrFrame& m) { return m.truth[k].occlusion_pct; });
   std::vector<double> depth;  // both hands' wrists, |fit − truth| along the optical axis
@@ -63,7 +73,8 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
           {"fingertip_mm_mean", mean(tip)},
           {"fingertip_mm_p95", quantile(tip, 0.95)},
           {"occlusion_error_pct", mean(occ)},
-          {"frames", t.frames.size()}};
+          {"frames", t.frames.size()},
+          {"frames_scored_in_image", seen.frames.size()}};
 }
 
 /// The main registration's figures and the contested pixels over the frames of each part of the
@@ -87,8 +98,9 @@ nlohmann::ordered_json by_phase_json(const MrTrace& t, const std::vector<std::st
       wrong += m.truth[0].contested_wrong;
       wrong_paper += m.truth[0].contested_wrong_paper;
     }
-    const auto iou = column(part, [](const MrFrame& m) { return m.truth[0].iou; });
-    const auto jp = column(part, [](const MrFrame& m) { return 0.5 * (m.truth[0].joint_px[0] + m.truth[0].joint_px[1]); });
+    const MrTrace seen = in_view(part, 0);
+    const auto iou = column(seen, [](const MrFrame& m) { return m.truth[0].iou; });
+    const auto jp = column(seen, [](const MrFrame& m) { return 0.5 * (m.truth[0].joint_px[0] + m.truth[0].joint_px[1]); });
     const auto tip = column(part, [](const MrFrame& m) { return 0.5 * (m.truth[0].fingertip_mm[0] + m.truth[0].fingertip_mm[1]); });
     const auto pct = [contested](long w) { return contested > 0 ? 100.0 * static_cast<double>(w) / static_cast<double>(contested) : 0.0; };
     out[name] = {{"frames", part.frames.size()},
@@ -290,7 +302,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   const double contested_mean = frames > 0 ? static_cast<double>(contested) / frames : 0.0;
   std::vector<double> ceiling;
   for (const MrFrame& m : t.frames)
-    if (m.ceiling_measured) ceiling.push_back(m.ceiling_iou);
+    if (m.ceiling_measured && m.truth[0].real_hand_pixels > 0) ceiling.push_back(m.ceiling_iou);
   const auto joint_floor = column(t, [](const MrFrame& m) { return 0.5 * (m.truth[0].joint_px_floor[0] + m.truth[0].joint_px_floor[1]); });
   const auto cap_res = column(t, [](const MrFrame& m) { return std::max(m.truth_cap_residual_mm[0], m.truth_cap_residual_mm[1]); });
   // Frames delivered per second of the run: processed frames over the span of their exposures
@@ -342,6 +354,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"image", {{"width", s.width}, {"height", s.height}}},
       {"scene", s.scene},
       {"user_hand", s.user_hand},
+      {"user_hand_profile", s.user_profile},
       {"shaped_fingers", s.shaped_fingers},
       {"bending_wrists", s.bending_wrists},
       {"haptic", [&] {
@@ -441,6 +454,13 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << (s.camera_skipped > 0 ? ", " + std::to_string(s.camera_skipped) + " not filmed in time by the simulated camera" : std::string())
      << "):\n"
      << std::setprecision(3)
+     << (reg["frames_scored_in_image"].get<std::size_t>() < static_cast<std::size_t>(frames)
+             ? "  warning        the hands were out of the camera's view in " +
+                   std::to_string(static_cast<std::size_t>(frames) - reg["frames_scored_in_image"].get<std::size_t>()) +
+                   " frames: IoU and joints are over the other " +
+                   std::to_string(reg["frames_scored_in_image"].get<std::size_t>()) +
+                   " (frames_scored_in_image); check the camera's pose and the scene\n"
+             : std::string())
      << "  registration   IoU mean " << reg["iou_mean"].get<double>() << " (p5 "
      << reg["iou_p5"].get<double>() << "), fingertip " << std::setprecision(2)
      << reg["fingertip_mm_mean"].get<double>() << " mm, joints " << reg["joint_px_mean"].get<double>()

@@ -13,8 +13,10 @@ Result<std::unique_ptr<Scene>> Scene::load(const std::string& path,
   s->world = std::move(world_r).value();
   if (auto cube_r = physics::RubiksCube::Attach(*s->world)) s->cube = std::move(cube_r).value();
   Pose X_cube0;
-  s->task = make_scripted_task(*s->world, s->cube, s->params.proxy.radius, user, &X_cube0,
-                               user_options);
+  auto task = make_scripted_task(*s->world, s->cube, s->params.proxy.radius, user, &X_cube0,
+                                 user_options);
+  if (!task) return task.error();
+  s->task = std::move(task).value();
   s->monitor = std::make_unique<CubeMonitor>(&s->cube, X_cube0);
   if (s->cube) s->task->track(&s->monitor->pose());  // the user watches the cube
   return s;

@@ -1,24 +1,61 @@
 #include "spidar/session/scripted_task.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
 
 namespace spidar::session {
 
-void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
-  double best = 1e9;
+double pinch_half_extent(const Shape& s) {
+  const Mat3 R = s.X_WS.R.toRotationMatrix();
+  const Vec3 along_y = R.row(1).transpose();  // world y in the shape's frame
+  switch (s.type) {
+    case Shape::Type::kBox:
+    case Shape::Type::kMesh:
+      return along_y.cwiseAbs().dot(s.size.cwiseAbs());
+    case Shape::Type::kSphere:
+      return std::abs(s.size.x());
+    case Shape::Type::kCapsule:
+      return std::abs(along_y.z()) * std::abs(s.size.y()) + std::abs(s.size.x());
+    case Shape::Type::kCylinder:
+      return std::abs(along_y.z()) * std::abs(s.size.y()) +
+             std::sqrt(std::max(0.0, 1.0 - along_y.z() * along_y.z())) * std::abs(s.size.x());
+    case Shape::Type::kPlane:
+      return 0.0;
+  }
+  return 0.0;
+}
+
+Status reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
+  double best = std::numeric_limits<double>::infinity();
+  const Shape* target = nullptr;
   for (const Shape& s : scene.shapes) {
-    if (s.body <= 0 || s.hand >= 0) continue;
+    if (s.body <= 0 || s.hand >= 0 || s.type == Shape::Type::kPlane) continue;
     const double d = s.X_WS.p.norm();
     if (d < best) {
       best = d;
-      tp->p_W_cube = s.X_WS.p;
-      tp->half = std::clamp(s.size.maxCoeff(), 0.01, 0.05);
-      tp->pitch = tp->half * 2.0 / 3.0;
+      target = &s;
     }
   }
+  auto mm = [](double m) { return std::to_string(static_cast<long>(std::lround(1e3 * m))); };
+  if (target == nullptr)
+    return Error{"no object for the scripted user to reach for: the scene has no body of its own "
+                 "besides the world's (add a <body> with a geom, e.g. a free box near the frame centre)"};
+  const Vec3& p = target->X_WS.p;
+  const std::string where = "the object nearest the frame centre, at (" + mm(p.x()) + ", " + mm(p.y()) + ", " +
+                            mm(p.z()) + ") mm,";
+  const double half = pinch_half_extent(*target);
+  if (!(2 * half >= kMinPinchAcrossM && 2 * half <= kMaxPinchAcrossM))
+    return Error{where + " is " + mm(2 * half) + " mm across the scripted user's pinch (thumb to fingers, along y); " +
+                 "it holds objects " + mm(kMinPinchAcrossM) + " to " + mm(kMaxPinchAcrossM) + " mm across"};
+  tp->p_W_cube = p;
+  tp->half = half;
+  tp->pitch = tp->half * 2.0 / 3.0;
+  return Ok{};
 }
 
-std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
+Result<std::shared_ptr<sim::RubiksTask>> make_scripted_task(const physics::World& world,
                                                     const std::optional<physics::RubiksCube>& cube,
                                                     double proxy_radius,
                                                     const std::array<hand::HandModel, 2>& user,
@@ -35,12 +72,12 @@ std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
   } else {
     SceneSnapshot s0;
     world.snapshot(s0, false);
-    reach_target(s0, &tp);
+    if (auto st = reach_target(s0, &tp); !st) return st.error();
     X_cube0->p = tp.p_W_cube;
   }
   auto task = std::make_shared<sim::RubiksTask>(tp);
   task->fit_to_hands(user);
-  return task;
+  return std::shared_ptr<sim::RubiksTask>(std::move(task));
 }
 
 }  // namespace spidar::session

@@ -47,6 +47,8 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     }
   }
   m.iou = registration::mask_iou(ws->model_mask, frame.hand_only);
+  m.real_hand_pixels = cv::countNonZero(frame.hand_only);
+  m.fitted_hand_pixels = cv::countNonZero(ws->model_mask);
 
   if (auto st = render::truth_composite_mask(frame.mask, frame.depth, result.virt.depth,
                                              &ws->truth_alpha);

@@ -2,11 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <string>
 
 namespace spidar::vision {
+namespace {
+/// The largest image the camera side reads (16384 × 16384, as a recording's frames) [px], and its
+/// span: a bracelet's area, length or a distance in it beyond these describes no image.
+constexpr int kMaxImagePixels = 16384 * 16384;
+constexpr int kMaxImageSpanPx = 16384 * 2;
+}  // namespace
 
 Status validate(const BraceletParams& p) {
   auto bad = [](const std::string& m) { return Status(Error{"bracelet: " + m}); };
@@ -14,14 +22,18 @@ Status validate(const BraceletParams& p) {
   if (p.hue_high_min < 120 || p.hue_high_min > 180) return bad("hue_high_min: expected 120..180");
   if (p.saturation_min < 1 || p.saturation_min > 255) return bad("saturation_min: expected 1..255");
   if (p.value_min < 0 || p.value_min > 255) return bad("value_min: expected 0..255");
-  if (p.min_area_px < 4) return bad("min_area_px: expected at least 4");
+  if (p.min_area_px < 4 || p.min_area_px > kMaxImagePixels)
+    return bad("min_area_px: expected 4.." + std::to_string(kMaxImagePixels) + " px, got " + std::to_string(p.min_area_px));
   if (!(p.merge_gap_px >= 0 && p.merge_gap_px <= 100)) return bad("merge_gap_px: expected 0..100");
-  if (!(p.expected_length_px >= 0)) return bad("expected_length_px: expected >= 0");
+  if (!(p.expected_length_px >= 0 && p.expected_length_px <= kMaxImageSpanPx))
+    return bad("expected_length_px: expected 0.." + std::to_string(kMaxImageSpanPx) + " px");
   if (!(p.expected_aspect >= 1.0 && p.expected_aspect <= 20.0))
     return bad("expected_aspect: expected 1..20");
-  if (!(p.max_prediction_distance_px > 0)) return bad("max_prediction_distance_px: expected > 0");
-  if (!(p.ambiguity_margin >= 0)) return bad("ambiguity_margin: expected >= 0");
-  if (!(p.centre_margin_px >= 0)) return bad("centre_margin_px: expected >= 0");
+  if (!(p.max_prediction_distance_px > 0 && p.max_prediction_distance_px <= kMaxImageSpanPx))
+    return bad("max_prediction_distance_px: expected a value in (0, " + std::to_string(kMaxImageSpanPx) + "] px");
+  if (!(p.ambiguity_margin >= 0 && p.ambiguity_margin <= 1e6)) return bad("ambiguity_margin: expected 0..1e6");
+  if (!(p.centre_margin_px >= 0 && p.centre_margin_px <= kMaxImageSpanPx))
+    return bad("centre_margin_px: expected 0.." + std::to_string(kMaxImageSpanPx) + " px");
   return Ok{};
 }
 
@@ -31,7 +43,11 @@ BraceletParams parse_bracelet_params(const core::ConfigNode& node) {
                     "max_prediction_distance_px", "ambiguity_margin", "centre_margin_px",
                     "left_hand_on_image_left"});
   BraceletParams p;
-  auto i = [&](const char* k, int fallback) { return static_cast<int>(node.get_int(k, fallback)); };
+  // Saturated into int: a value beyond it is out of every range below (not wrapped into one).
+  auto i = [&](const char* k, int fallback) {
+    return static_cast<int>(std::clamp<std::int64_t>(node.get_int(k, fallback), std::numeric_limits<int>::min(),
+                                                     std::numeric_limits<int>::max()));
+  };
   p.hue_low_max = i("hue_low_max", p.hue_low_max);
   p.hue_high_min = i("hue_high_min", p.hue_high_min);
   p.saturation_min = i("saturation_min", p.saturation_min);
@@ -45,7 +61,7 @@ BraceletParams parse_bracelet_params(const core::ConfigNode& node) {
   p.ambiguity_margin = node.get_double("ambiguity_margin", p.ambiguity_margin);
   p.centre_margin_px = node.get_double("centre_margin_px", p.centre_margin_px);
   if (auto v = node.find("left_hand_on_image_left")) p.left_hand_on_image_left = v->as_bool();
-  if (auto s = validate(p); !s.ok()) node.fail(s.error().message);
+  if (auto s = validate(p); !s.ok()) core::fail_at_named_key(node, s.error().message, "bracelet: ");
   return p;
 }
 

@@ -10,22 +10,22 @@ namespace spidar::vision {
 
 Status validate(const ChromaKeyParams& p) {
   if (!(p.s_foreground >= -1.0 && p.s_foreground < p.s_background && p.s_background <= 1.0)) {
-    return Error{"chroma key: expected -1 <= s_foreground < s_background <= 1, got " +
-                 std::to_string(p.s_foreground) + " and " + std::to_string(p.s_background)};
+    return Error{"chroma key: s_foreground: expected -1 <= s_foreground < s_background <= 1, got " +
+                 core::number_for_message(p.s_foreground) + " and " + core::number_for_message(p.s_background)};
   }
   if (!(p.dark_floor >= 1.0 && p.dark_floor <= 255.0)) {
-    return Error{"chroma key: dark_floor: expected 1..255, got " + std::to_string(p.dark_floor)};
+    return Error{"chroma key: dark_floor: expected 1..255, got " + core::number_for_message(p.dark_floor)};
   }
   if (!(p.silhouette_threshold > 0.0 && p.silhouette_threshold < 1.0)) {
     return Error{"chroma key: silhouette_threshold: expected a value in (0, 1), got " +
-                 std::to_string(p.silhouette_threshold)};
+                 core::number_for_message(p.silhouette_threshold)};
   }
   if (p.cleanup_radius_px < 0 || p.cleanup_radius_px > 10) {
     return Error{"chroma key: cleanup_radius_px: expected 0..10, got " +
                  std::to_string(p.cleanup_radius_px)};
   }
   if (!(p.spill_limit >= 0.5 && p.spill_limit <= 2.0)) {
-    return Error{"chroma key: spill_limit: expected 0.5..2, got " + std::to_string(p.spill_limit)};
+    return Error{"chroma key: spill_limit: expected 0.5..2, got " + core::number_for_message(p.spill_limit)};
   }
   return Ok{};
 }
@@ -38,10 +38,10 @@ ChromaKeyParams parse_chroma_key_params(const core::ConfigNode& node) {
   p.s_background = node.get_double("s_background", p.s_background);
   p.dark_floor = node.get_double("dark_floor", p.dark_floor);
   p.silhouette_threshold = node.get_double("silhouette_threshold", p.silhouette_threshold);
-  p.cleanup_radius_px = static_cast<int>(node.get_int("cleanup_radius_px", p.cleanup_radius_px));
+  p.cleanup_radius_px = static_cast<int>(std::clamp<std::int64_t>(node.get_int("cleanup_radius_px", p.cleanup_radius_px), -1, 11));
   if (auto d = node.find("despill")) p.despill = d->as_bool();
   p.spill_limit = node.get_double("spill_limit", p.spill_limit);
-  if (auto s = validate(p); !s.ok()) node.fail(s.error().message);
+  if (auto s = validate(p); !s.ok()) core::fail_at_named_key(node, s.error().message, "chroma key: ");
   return p;
 }
 

@@ -34,6 +34,25 @@ TEST(Cli, CheckConfigSummarisesOrFailsWithCode2) {
   auto missing = run("check-config /nonexistent.yaml");
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("/nonexistent.yaml: cannot open file"), std::string::npos);
+  // Every other config of ours, told apart by its top-level keys.
+  for (const auto& [file, says] : {std::pair{"configs/camera.yaml", "ok: camera 640x480"},
+                                   std::pair{"configs/vision.yaml", "ok: vision settings"},
+                                   std::pair{"configs/registration.yaml", "ok: registration settings, personalisation on"},
+                                   std::pair{"configs/hands.yaml", "hand profile(s): model"},
+                                   std::pair{"configs/lab-example.yaml", "ok: live session config"}}) {
+    auto r = run(std::string("check-config ") + file);
+    EXPECT_EQ(r.code, 0) << file << ": " << r.err;
+    EXPECT_NE(r.out.find(says), std::string::npos) << file << ": " << r.out;
+  }
+  // A bad value in one of them names its own line and key.
+  const std::string bad = spidar::test::temp_dir("spidar_check_config") + "/vision.yaml";
+  FILE* f = fopen(bad.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fputs("chroma_key:\n  s_foreground: 0.1\n  dark_floor: 300\n", f);
+  fclose(f);
+  auto r = run("check-config " + bad);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(bad + ":3: chroma_key.dark_floor: expected 1..255, got 300"), std::string::npos) << r.err;
 }
 
 TEST(Cli, PositionPrintsJsonThatRoundTrips) {
@@ -362,6 +381,40 @@ TEST(Cli, MixedRealityDemoRejectsBadSceneAndHandFiles) {
   r = run("demo --seconds 1 --no-video --user-hand /nonexistent/hands.yaml --out " + dir);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("/nonexistent/hands.yaml"), std::string::npos) << r.err;
+  // Scenes the scripted user cannot play: an object too large for its pinch, one outside the
+  // device's frame, none at all.
+  auto scene_with = [&](const std::string& name, const std::string& body) {
+    const std::string path = dir + "_" + name + ".xml";
+    FILE* g = fopen(path.c_str(), "w");
+    if (g == nullptr) return path;
+    fputs(("<mujoco><worldbody><geom type=\"plane\" size=\"0.5 0.5 0.01\"/>" + body + "</worldbody></mujoco>\n").c_str(), g);
+    fclose(g);
+    return path;
+  };
+  r = run("demo --seconds 1 --no-video --scene " +
+          scene_with("huge", "<body pos=\"0 0 0.1\"><freejoint/><geom type=\"box\" size=\"0.09 0.09 0.09\"/></body>") +
+          " --out " + dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("is 180 mm across the scripted user's pinch"), std::string::npos) << r.err;
+  r = run("demo --seconds 1 --no-video --scene " +
+          scene_with("far", "<body pos=\"0.6 0.4 0.03\"><freejoint/><geom type=\"box\" size=\"0.03 0.03 0.03\"/></body>") +
+          " --out " + dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("beyond the device's frame along x"), std::string::npos) << r.err;
+  r = run("demo --seconds 1 --no-video --scene " + scene_with("empty", "") + " --out " + dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("no object for the scripted user to reach for"), std::string::npos) << r.err;
+  // Another shape than the camera's calibration; an output folder that cannot be one.
+  r = run("demo --seconds 1 --no-video --width 3840 --height 48 --out " + dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--width/--height: 3840x48 is not the shape of the camera's calibration"), std::string::npos)
+      << r.err;
+  r = run("demo --seconds 1 --no-video --out \"\"");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--out: expected a directory, got an empty path"), std::string::npos) << r.err;
+  r = run("demo --seconds 1 --no-video --out " + bad_hand);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--out: cannot make the output directory"), std::string::npos) << r.err;
 }
 
 }  // namespace

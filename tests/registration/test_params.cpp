@@ -148,7 +148,20 @@ TEST(RegistrationParams, ParseErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("little_free"), std::string::npos) << e;
   e = parse_error("registration:\n  little_coupling_sigma_rad: 0\n");
   EXPECT_NE(e.find("registration.little_coupling_sigma_rad"), std::string::npos) << e;
-  EXPECT_NE(e.find("(0, 100] rad"), std::string::npos) << e;
+  EXPECT_NE(e.find("[0.0001, 100] rad"), std::string::npos) << e;
+  // A σ so small that its weight's square overflows is no measurement (1e-300 m gave IoU 0.16).
+  e = parse_error("registration:\n  fingertip_sigma_m: 1e-300\n");
+  EXPECT_NE(e.find("reg.yaml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("registration.fingertip_sigma_m: expected a value in [1e-05, 0.1] m, got 1e-300"),
+            std::string::npos) << e;
+  e = parse_error("registration:\n  joint_ball_sigma_px: 1e-9\n");
+  EXPECT_NE(e.find("[0.01, 1000] px"), std::string::npos) << e;
+  e = parse_error("registration:\n  prior_sigma_joint_rad: 1e-20\n");
+  EXPECT_NE(e.find("registration.prior_sigma_joint_rad"), std::string::npos) << e;
+  // A σ whose 0 turns its term off: 0 passes, a tiny one does not.
+  EXPECT_EQ(parse_error("registration:\n  bracelet_thickness_sigma: 0\n  digit_axis_sigma_px: 0\n"), "");
+  e = parse_error("registration:\n  digit_axis_sigma_px: 1e-200\n");
+  EXPECT_NE(e.find("expected 0 (off) or a value in [0.01, 1000] px"), std::string::npos) << e;
   // Not a map.
   e = parse_error("registration: 3\n");
   EXPECT_NE(e.find("registration"), std::string::npos) << e;

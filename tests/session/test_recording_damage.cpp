@@ -2,6 +2,8 @@
 // made by hand on a recording written by RecordingWriter.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "recording_test_support.hpp"
 #include "spidar/session/recording_reader.hpp"
 
@@ -182,6 +184,21 @@ TEST_F(Damage, BadSessionJsonIsNamed) {
   text.replace(text.find("\"finger_count\": 2"), 17, "\"finger_count\": 3");
   spit(dir_ / "session.json", text);
   EXPECT_HAS(refusal(), "finger_count: expected 3 (session.json finger_count), got 2");
+}
+
+// A number beyond a double's range is a damaged file (exit 2, its line and column), not an
+// internal error.
+TEST_F(Damage, ANumberBeyondADoublesRangeIsNamedWithItsPlace) {
+  std::string text = slurp(dir_ / "session.json");
+  const std::size_t at = text.find("\"fps\": ");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t value = at + 7, end = text.find_first_of(",\n}", value);
+  text.replace(value, end - value, "1e999");
+  spit(dir_ / "session.json", text);
+  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(value), '\n'));
+  const int column = static_cast<int>(value - text.rfind('\n', value - 1));
+  EXPECT_HAS(refusal(), (dir_ / "session.json").string() + ":" + std::to_string(line) + ":" +
+                            std::to_string(column) + ": a number out of range ('1e999')");
 }
 
 TEST_F(Damage, AFitRowMarkedNotFiniteMustHaveNoNumbers) {

@@ -2,9 +2,12 @@
 // (the GUI's scene panel), the turn counter, the camera scaling.
 #include <gtest/gtest.h>
 
+#include <numbers>
+
 #include "spidar/session/interactive_hands.hpp"
 #include "spidar/session/cube_monitor.hpp"
 #include "spidar/session/rig_inputs.hpp"
+#include "spidar/session/scripted_task.hpp"
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/physics/world.hpp"
@@ -138,6 +141,79 @@ TEST(InteractiveHands, ControlsMoveAndCloseTheHandsAndTheirCapsAreTheDeviceGoals
   const auto q = hands.pose(hands.controls());
   EXPECT_NEAR((q[0].p_W_wrist() - open[0].p_W_wrist()).norm(), 0.0, 1e-12);
   EXPECT_GT((q[0].r_W_hand() - open[0].r_W_hand()).norm(), 0.1);
+}
+
+}  // namespace
+}  // namespace spidar::session
+
+namespace spidar::session {
+namespace {
+
+Shape object(Shape::Type type, const Vec3& size, const Quat& q = Quat::Identity(), const Vec3& p = Vec3(0.02, 0, 0)) {
+  Shape s;
+  s.type = type;
+  s.size = size;
+  s.X_WS = Pose{q, p};
+  s.body = 1;
+  return s;
+}
+
+// The object the scripted user pinches (thumb to fingers along world y): its extent across the
+// pinch, whatever its kind and turn, against the brute-force extent of its surface points.
+TEST(ReachTarget, MeasuresTheObjectAcrossThePinchAndRefusesWhatItCannotHold) {
+  const Quat turned(Eigen::AngleAxisd(0.6, Vec3(0.3, -0.5, 0.8).normalized()));
+  // Brute force: the half extent along y of points sampled on the shape.
+  auto sampled = [](const Shape& s) {
+    const Mat3 R = s.X_WS.R.toRotationMatrix();
+    double hi = 0;
+    auto see = [&](const Vec3& p) { hi = std::max(hi, (R * p).y()); };
+    constexpr int n = 60;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) {
+        const double a = -1 + 2.0 * i / n, b = -1 + 2.0 * j / n;
+        const double phi = 2 * std::numbers::pi * i / n, theta = std::numbers::pi * j / n;
+        const Vec3 dir(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+        if (s.type == Shape::Type::kBox)
+          for (int k = 0; k <= n; ++k) see(Vec3(a, b, -1 + 2.0 * k / n).cwiseProduct(s.size));
+        else if (s.type == Shape::Type::kSphere) see(s.size.x() * dir);
+        else if (s.type == Shape::Type::kCapsule)
+          for (int k = 0; k <= n; ++k) see(Vec3(0, 0, s.size.y() * (-1 + 2.0 * k / n)) + s.size.x() * dir);
+        else
+          see(Vec3(s.size.x() * std::cos(phi), s.size.x() * std::sin(phi), s.size.y() * b));
+      }
+    return hi;
+  };
+  for (const Shape& s : {object(Shape::Type::kBox, Vec3(0.01, 0.03, 0.02), turned),
+                         object(Shape::Type::kSphere, Vec3(0.025, 0, 0), turned),
+                         object(Shape::Type::kCapsule, Vec3(0.01, 0.03, 0), turned),
+                         object(Shape::Type::kCylinder, Vec3(0.015, 0.02, 0), turned)})
+    EXPECT_NEAR(pinch_half_extent(s), sampled(s), 2e-4) << static_cast<int>(s.type);
+
+  SceneSnapshot scene;
+  sim::RubiksTaskParams tp;
+  // Nothing to reach for: the world's own geoms only.
+  Shape table = object(Shape::Type::kBox, Vec3(0.3, 0.3, 0.01));
+  table.body = 0;
+  scene.shapes = {table};
+  auto st = reach_target(scene, &tp);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.error().message.find("no object for the scripted user to reach for"), std::string::npos);
+  // The nearest of two objects, with its extent as the half size.
+  scene.shapes.push_back(object(Shape::Type::kBox, Vec3(0.02, 0.03, 0.02), Quat::Identity(), Vec3(0.2, 0, 0)));
+  scene.shapes.push_back(object(Shape::Type::kSphere, Vec3(0.025, 0, 0), Quat::Identity(), Vec3(0.05, 0.01, 0)));
+  ASSERT_TRUE(reach_target(scene, &tp));
+  EXPECT_EQ(tp.p_W_cube, Vec3(0.05, 0.01, 0));
+  EXPECT_DOUBLE_EQ(tp.half, 0.025);
+  // Too large for one hand's pinch (180 mm across): refused, not held from inside.
+  scene.shapes = {table, object(Shape::Type::kBox, Vec3(0.09, 0.09, 0.09))};
+  st = reach_target(scene, &tp);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.error().message.find("is 180 mm across the scripted user's pinch"), std::string::npos)
+      << st.error().message;
+  EXPECT_NE(st.error().message.find("20 to 100 mm"), std::string::npos) << st.error().message;
+  // A box long in x but narrow across the pinch is held.
+  scene.shapes = {table, object(Shape::Type::kBox, Vec3(0.09, 0.03, 0.03))};
+  EXPECT_TRUE(reach_target(scene, &tp));
 }
 
 }  // namespace

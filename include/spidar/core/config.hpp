@@ -126,4 +126,13 @@ class ConfigNode {
 double require_in_range(const ConfigNode& node, double value, double lo, double hi,
                         std::string_view unit);
 
+/// A number as an error message shows it: `significant` digits, no trailing zeros (300, 0.15,
+/// 1e-05, 3e+09), so that a message quotes what was written rather than 300.000000.
+std::string number_for_message(double v, int significant = 6);
+
+/// Fails with a validate() message of the form `prefix` + "key: expectation" at that key's own
+/// node when the map `node` has it (file:line of the key, `map.key: expectation`), else at `node`
+/// with the whole message.
+[[noreturn]] void fail_at_named_key(const ConfigNode& node, std::string_view message, std::string_view prefix);
+
 }  // namespace spidar::core

@@ -18,9 +18,9 @@ vision::Camera scaled_camera(const vision::Camera& c, int w, int h);
 
 /// Both hands (left, right) of profile `profile` in a hands YAML. With `first_if_missing`, a
 /// missing profile falls back to the file's first one; otherwise SpidarError naming the file
-/// (bad input: the CLI exits with code 2).
+/// (bad input: the CLI exits with code 2). `chosen` (optional): the name of the profile used.
 std::array<hand::HandModel, 2> hand_models(const std::string& path, const std::string& profile,
-                                           bool first_if_missing);
+                                           bool first_if_missing, std::string* chosen = nullptr);
 
 /// The frame pipeline's parameters: chroma key and bracelet from `vision_yaml`, registration from
 /// `registration_yaml` (key `registration`) with the silhouette term on or off, the compositor

@@ -36,6 +36,7 @@ struct MrSummary {
   bool solved = false, has_cube = false;
   std::map<char, double> face_deg;  ///< each face layer's final angle [deg]
   std::string facelets, video_path, video_format, compositor, scene, user_hand;
+  std::string user_profile;  ///< the hands YAML profile the simulated user has (user_hand's)
   double user_length_m = 0, user_width_m = 0;  ///< the simulated user's true hand sizes
   bool main_silhouette = false;
   bool personalised = false;  ///< the registration estimated the hands' sizes online

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "spidar/core/pose.hpp"
+#include "spidar/core/result.hpp"
 #include "spidar/core/scene_snapshot.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
@@ -14,9 +15,21 @@
 
 namespace spidar::session {
 
+/// The scripted user's pinch (thumb on one side, fingers on the other, along world y) holds
+/// objects this many metres across at least and at most (twice RubiksTaskParams::half).
+inline constexpr double kMinPinchAcrossM = 0.02;
+inline constexpr double kMaxPinchAcrossM = 0.10;
+
+/// An object's half extent along world y, across the scripted user's pinch [m]: a box's or
+/// mesh's (size as half sizes) turned by its pose, a sphere's radius, a capsule's or cylinder's
+/// axis turned by its pose plus its radius. 0 for a plane.
+double pinch_half_extent(const Shape& shape);
+
 /// Where the scripted user reaches in a scene without a cube: the non-static object nearest the
-/// frame centre (its centre and half size), else the centre itself.
-void reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp);
+/// frame centre (its centre, and pinch_half_extent as the half size). Fails, naming the object's
+/// place and size, when the scene has no such object, or when it is too small or too large for the
+/// pinch (kMinPinchAcrossM, kMaxPinchAcrossM).
+Status reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp);
 
 /// How the scripted user plays its task.
 struct ScriptedUserOptions {
@@ -27,7 +40,8 @@ struct ScriptedUserOptions {
 /// The scripted user's task in a scene: the cube's start pose (`X_cube0`) when it has one, else the
 /// object nearest the frame centre; the script fitted to the user's own hands (`user`), so their
 /// fingers can be where the device's caps are. (One place for the demo and the live session.)
-std::shared_ptr<sim::RubiksTask> make_scripted_task(const physics::World& world,
+/// Fails as reach_target does.
+Result<std::shared_ptr<sim::RubiksTask>> make_scripted_task(const physics::World& world,
                                                     const std::optional<physics::RubiksCube>& cube,
                                                     double proxy_radius,
                                                     const std::array<hand::HandModel, 2>& user,

@@ -15,6 +15,13 @@ namespace spidar::sim {
 
 struct FrameTruthMetrics {
   double iou = 0;                     ///< fitted hands' pixels vs the real hands' (no bracelet/arm)
+  /// The real hands' pixels (palms and digits) in the image, and the fitted hands'. A frame with
+  /// neither (the hands out of the camera's view) says nothing about the fit: its IoU (1 by
+  /// convention for two empty masks) and joint error are left out of a run's figures
+  /// (scored_in_image()).
+  long real_hand_pixels = 0;
+  long fitted_hand_pixels = 0;
+  bool scored_in_image() const { return real_hand_pixels > 0 || fitted_hand_pixels > 0; }
   std::array<double, 2> fingertip_mm{};  ///< mean fingertip cap error per hand [mm]
   std::array<double, 2> joint_px{};      ///< mean projected joint error per hand [px]
   /// The fitted wrist's depth (along the camera's optical axis) minus the true one per hand [mm]:

@@ -1,0 +1,68 @@
+// The run report's figures (session/run_report.hpp) from a hand-made trace: frames in which
+// neither a real nor a fitted hand was in the camera's view say nothing about the fit, and are left
+// out of the image's figures, said so, and counted.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <unistd.h>
+
+#include "spidar/session/run_report.hpp"
+
+namespace spidar::session {
+namespace {
+
+namespace fs = std::filesystem;
+
+MrFrame frame(double t, double iou, double joints_px, long real_px, long fitted_px, bool compared,
+              double ceiling) {
+  MrFrame m;
+  m.t_s = t;
+  for (auto& k : m.truth) {
+    k.iou = iou;
+    k.joint_px = {joints_px, joints_px};
+    k.fingertip_mm = {0.5, 0.5};
+    k.real_hand_pixels = real_px;
+    k.fitted_hand_pixels = fitted_px;
+  }
+  m.compared = compared;
+  m.ceiling_measured = compared;
+  m.ceiling_iou = ceiling;
+  return m;
+}
+
+TEST(RunReport, FramesWithoutAHandInViewAreLeftOutOfTheImagesFigures) {
+  MrTrace t;
+  t.frames.push_back(frame(0.0, 0.8, 4.0, 900, 800, true, 0.9));
+  t.frames.push_back(frame(0.1, 0.6, 6.0, 700, 900, false, 0));
+  // The hands out of view: two empty masks (IoU 1 by convention), no joint in the image.
+  t.frames.push_back(frame(0.2, 1.0, 0.0, 0, 0, true, 1.0));
+  // A fit drawn where no real hand is: a real failure, scored (IoU 0); the ceiling, whose model is
+  // at the true pose, has nothing to cover and is left out.
+  t.frames.push_back(frame(0.3, 0.0, 30.0, 0, 500, true, 1.0));
+  MrSummary s;
+  s.seconds = s.wall_s = 0.4;
+  const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ostringstream out;
+  write_mr_report(dir.string(), t, s, out);
+  std::ifstream in(dir / "report.json");
+  ASSERT_TRUE(in.good()) << out.str();
+  const auto j = nlohmann::json::parse(in);
+  const auto& reg = j["registration"];
+  EXPECT_EQ(reg["frames"].get<int>(), 4);
+  EXPECT_EQ(reg["frames_scored_in_image"].get<int>(), 3);
+  EXPECT_NEAR(reg["iou_mean"].get<double>(), (0.8 + 0.6 + 0.0) / 3, 1e-12);
+  EXPECT_NEAR(reg["joint_px_mean"].get<double>(), (4.0 + 6.0 + 30.0) / 3, 1e-12);
+  EXPECT_NEAR(reg["fingertip_mm_mean"].get<double>(), 0.5, 1e-12);  // the strings see every frame
+  EXPECT_NEAR(j["ground_truth"]["model_ceiling_iou"].get<double>(), 0.9, 1e-12);
+  EXPECT_EQ(j["ground_truth"]["model_ceiling_frames"].get<int>(), 1);
+  EXPECT_NE(out.str().find("out of the camera's view in 1 frames"), std::string::npos) << out.str();
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace spidar::session
