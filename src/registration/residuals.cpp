@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -81,13 +82,13 @@ std::optional<double> edge_along(const cv::Mat& alpha, const Vec2& from, const V
   return std::nullopt;
 }
 
-/// The digits' axes (RegistrationParams::digit_axis_sigma_px): across each phalanx at t = 1/3 and
-/// 2/3, the silhouette's edges either side of the projected axis and their midpoint.
-void freeze_digit_axes(const ResidualProblem& pr, const detail::PoseState& s, const vision::Camera& camera,
-                       const cv::Mat& alpha, FrozenTargets* tg) {
-  const hand::HandModel& model = *pr.model;
+/// The digits' sections (digit_sections): across each phalanx at t = 1/3 and 2/3, the
+/// silhouette's edges either side of the projected axis, their midpoint and the width between.
+int sections_of(const hand::HandModel& model, const detail::PoseState& s, const vision::Camera& camera,
+                const cv::Mat& alpha, double threshold, std::span<DigitAxisPoint> out) {
   const double focal = 0.5 * (camera.intrinsics().fx + camera.intrinsics().fy);
-  const double threshold = pr.params->matte_threshold;
+  const Vec3 camera_centre = camera.X_WC().p;
+  int count = 0;
   for (int bone = 0; bone < kSilhouetteBoneCount; ++bone) {
     const BoneRef b = silhouette_bone(bone);
     if (b.segment == 0) continue;  // the metacarpals lie in the palm
@@ -101,7 +102,7 @@ void freeze_digit_axes(const ResidualProblem& pr, const detail::PoseState& s, co
     // A bone seen nearly end-on has no direction across it to measure.
     if (!(d.norm() > 2.0 * r_px) || !(r_px > 0.5)) continue;
     const Vec2 across = Vec2(-d.y(), d.x()).normalized();
-    for (double t : {1.0 / 3.0, 2.0 / 3.0}) {
+    for (const double t : {1.0 / 3.0, 2.0 / 3.0}) {
       const Vec2 p = ua + t * d;
       if (!camera.in_image(p) || !vision::on_silhouette(alpha, p, threshold)) continue;
       const double max_px = 2.0 * r_px + 3.0;
@@ -112,10 +113,29 @@ void freeze_digit_axes(const ResidualProblem& pr, const detail::PoseState& s, co
       if (width < 0.5 * 2.0 * r_px || width > 1.8 * 2.0 * r_px) continue;
       // An axis more than the radius off may be another finger's: only a near one is this bone's.
       if (std::abs(0.5 * (*plus - *minus)) > r_px) continue;
-      if (tg->axis_count >= kMaxDigitAxisPoints) return;
-      tg->axes[tg->axis_count++] = DigitAxisPoint{bone, t, across, p + 0.5 * (*plus - *minus) * across};
+      if (count >= static_cast<int>(out.size())) return count;
+      // The capsule's own outline there, in perspective: its two silhouette generators lie at
+      // ±radius across the bone and across the ray to it (a bone off the optical axis, or leaning
+      // toward the camera, looks wider than 2 r f / depth).
+      const Vec3 c3 = a + t * (c - a);
+      const Vec3 side = (c - a).cross(c3 - camera_centre);
+      double model_width = 2.0 * r_px;
+      if (side.norm() > 1e-12) {
+        const Vec3 u = radius_m * side.normalized();
+        const Vec2 e1 = camera.project(c3 + u), e2 = camera.project(c3 - u);
+        if (e1.allFinite() && e2.allFinite()) model_width = std::abs((e1 - e2).dot(across));
+      }
+      out[static_cast<std::size_t>(count++)] =
+          DigitAxisPoint{bone, t, across, p + 0.5 * (*plus - *minus) * across, width, model_width};
     }
   }
+  return count;
+}
+
+/// The digits' axes (RegistrationParams::digit_axis_sigma_px): the sections' midpoints.
+void freeze_digit_axes(const ResidualProblem& pr, const detail::PoseState& s, const vision::Camera& camera,
+                       const cv::Mat& alpha, FrozenTargets* tg) {
+  tg->axis_count = sections_of(*pr.model, s, camera, alpha, pr.params->matte_threshold, tg->axes);
 }
 
 /// Owned silhouette pixels (ImageEvidence::coverage) that the pose leaves uncovered, each with the
@@ -337,6 +357,17 @@ void stacked_residuals(const ResidualProblem& pr, const FrozenTargets& tg,
     for (Eigen::Index i = 0; i < rows; ++i) J->row(i) = sink.J[static_cast<std::size_t>(i)];
   }
   if (terms) *terms = std::move(sink.terms);
+}
+
+std::vector<DigitAxisPoint> digit_sections(const hand::HandModel& model, const hand::HandParams& q,
+                                           const vision::Camera& camera, const cv::Mat& alpha,
+                                           double threshold) {
+  std::array<DigitAxisPoint, kMaxDigitAxisPoints> buffer;
+  if (alpha.empty() || (alpha.type() != CV_32FC1 && alpha.type() != CV_8UC1) || !q.q.allFinite()) return {};
+  detail::PoseState s;
+  detail::pose_state(model, q, false, &s);
+  const int n = sections_of(model, s, camera, alpha, threshold, buffer);
+  return {buffer.begin(), buffer.begin() + n};
 }
 
 }  // namespace spidar::registration

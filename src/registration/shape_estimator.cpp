@@ -19,6 +19,11 @@ namespace {
 /// The keyframes' distance transforms cover their silhouette's bounding box grown by this [px]
 /// (as the frame pipeline's, FramePipelineParams::silhouette_margin_px).
 constexpr int kSilhouetteMarginPx = 40;
+/// A digit's section is evidence on its thickness when the model's diameter is within this factor
+/// of it either way (wider: two fingers side by side; narrower: a finger partly hidden).
+constexpr double kSectionMaxRatio = 1.35;
+/// The digits' sections pooled (ShapeEstimatorParams::digit_section_sigma): the oldest go first.
+constexpr std::size_t kMaxSectionSizes = 400;
 }  // namespace
 
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled) {
@@ -29,7 +34,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
                     "max_fingertip_cost", "shared_hands", "keyframe_prior_scale",
                     "keyframe_prior", "joint_balls", "palm_breadth_sigma_px", "palm_breadth_at",
-                    "palm_breadth_min_facing", "digit_axes"});
+                    "palm_breadth_min_facing", "digit_axes", "digit_section_sigma"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
@@ -51,13 +56,15 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
   struct Field {
     const char* key;
     double ShapeEstimatorParams::*v;
-    double lo, hi;            // (lo, hi], or [lo, hi] with zero_ok
-    bool zero_ok = false;     // lo itself allowed (0 = never)
+    double lo, hi;            // (lo, hi]
+    bool zero_ok = false;     // 0 allowed as well (0 = never, or off)
   };
+  // A σ divides a residual: the lower bounds are the smallest that still mean a measurement
+  // (below them a weight's square overflows the normal equations).
   static constexpr Field kFields[] = {
-      {"prior_sigma_length_m", &ShapeEstimatorParams::prior_sigma_length_m, 0.0, 0.1},
-      {"prior_sigma_width_m", &ShapeEstimatorParams::prior_sigma_width_m, 0.0, 0.1},
-      {"prior_sigma_thickness", &ShapeEstimatorParams::prior_sigma_thickness, 0.0, 1.0},
+      {"prior_sigma_length_m", &ShapeEstimatorParams::prior_sigma_length_m, 1e-5, 0.1},
+      {"prior_sigma_width_m", &ShapeEstimatorParams::prior_sigma_width_m, 1e-5, 0.1},
+      {"prior_sigma_thickness", &ShapeEstimatorParams::prior_sigma_thickness, 1e-4, 1.0},
       {"min_pose_change", &ShapeEstimatorParams::min_pose_change, 0.0, 10.0},
       {"freeze_sigma_length_m", &ShapeEstimatorParams::freeze_sigma_length_m, 0.0, 0.1},
       {"freeze_sigma_width_m", &ShapeEstimatorParams::freeze_sigma_width_m, 0.0, 0.1},
@@ -65,8 +72,9 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       {"max_relative_change", &ShapeEstimatorParams::max_relative_change, 0.0, 0.5},
       {"reach_min_miss_m", &ShapeEstimatorParams::reach_min_miss_m, 0.0, 0.05, true},
       {"max_fingertip_cost", &ShapeEstimatorParams::max_fingertip_cost, 0.0, 1e6},
-      {"keyframe_prior_scale", &ShapeEstimatorParams::keyframe_prior_scale, 0.0, 1e3},
-      {"palm_breadth_sigma_px", &ShapeEstimatorParams::palm_breadth_sigma_px, 0.0, 1e3, true},
+      {"keyframe_prior_scale", &ShapeEstimatorParams::keyframe_prior_scale, 1e-3, 1e3},
+      {"palm_breadth_sigma_px", &ShapeEstimatorParams::palm_breadth_sigma_px, 0.01, 1e3, true},
+      {"digit_section_sigma", &ShapeEstimatorParams::digit_section_sigma, 1e-3, 2.0, true},
   };
   struct IntField {
     const char* key;
@@ -89,13 +97,20 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                   "], got " + std::to_string(v));
     p.*f.v = static_cast<int>(v);
   }
+  if (p.min_keyframes > p.keyframes) {
+    const auto child = node.find("min_keyframes");
+    (child ? *child : node)
+        .fail("min_keyframes (" + std::to_string(p.min_keyframes) + ") must not exceed keyframes (" +
+              std::to_string(p.keyframes) + "): the estimate would never start");
+  }
   for (const Field& f : kFields) {
     const auto child = node.find(f.key);
     if (!child) continue;
     const double v = child->as_double();
-    if (!(std::isfinite(v) && (v > f.lo || (f.zero_ok && v == f.lo)) && v <= f.hi))
-      child->fail("expected a value in " + std::string(f.zero_ok ? "[" : "(") + std::to_string(f.lo) +
-                  ", " + std::to_string(f.hi) + "], got " + std::to_string(v));
+    if (!(std::isfinite(v) && ((v > f.lo && v <= f.hi) || (f.zero_ok && v == 0.0))))
+      child->fail("expected " + std::string(f.zero_ok ? (f.lo == 0.0 ? "a value in [" : "0 (off) or a value in (")
+                                                      : "a value in (") +
+                  core::number_for_message(f.lo) + ", " + core::number_for_message(f.hi) + "], got " + core::number_for_message(v));
     p.*f.v = v;
   }
   // The palm chord's settings (palm_breadth.hpp), in [0, 1].
@@ -105,7 +120,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
     if (!child) continue;
     const double x = child->as_double();
     if (!(std::isfinite(x) && x >= 0.0 && x <= 1.0))
-      child->fail("expected a value in [0, 1], got " + std::to_string(x));
+      child->fail("expected a value in [0, 1], got " + core::number_for_message(x));
     *v = x;
   }
   return p;
@@ -208,8 +223,9 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   job.fit_params.prior_sigma_joint_rad *= p.keyframe_prior_scale;
   const RegistrationParams& fit_params = job.fit_params;
   const SuccessiveAdjustment solver(fit_params);
-  // β = (length [m], width [m], thickness); the thickness only where silhouettes are kept.
-  const int nb = any_silhouette ? 3 : 2;
+  // β = (length [m], width [m], thickness); the thickness only where silhouettes or sections are kept.
+  // The digits' sections measure the capsules' radius (width × thickness): the thickness too.
+  const int nb = any_silhouette || (p.digit_section_sigma > 0 && !job.section_sizes.empty()) ? 3 : 2;
   const Eigen::Vector3d beta0 = starts[0];
   const Eigen::Vector3d sigma0(p.prior_sigma_length_m, p.prior_sigma_width_m, p.prior_sigma_thickness);
   const Eigen::Matrix3d H0 = sigma0.cwiseProduct(sigma0).cwiseInverse().asDiagonal();
@@ -329,6 +345,16 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
         cost += r_chord * r_chord;
       }
     }
+    // The digits' sections pooled since the start (section_sizes): each a measurement of the
+    // capsules' radius scale, log(β_width β_thickness / measured) / σ, whatever pose refits.
+    if (p.digit_section_sigma > 0)
+      for (const double m : job.section_sizes) {
+        const double r_sec = std::log(beta.y() * beta.z() / m) / p.digit_section_sigma;
+        const Eigen::Vector3d J_s = Eigen::Vector3d(0.0, 1.0 / beta.y(), 1.0 / beta.z()) / p.digit_section_sigma;
+        S += J_s * J_s.transpose();
+        g -= J_s * r_sec;
+        cost += r_sec * r_sec;
+      }
     if (it == 0) estimate.objective_start = cost;
     const bool better = cost < best.cost;
     if (!better) ++estimate.steps_rejected;
@@ -406,7 +432,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
                                const ImageEvidence& image, const RegistrationParams& fit_params) {
   if (hand < 0 || hand >= hands()) return false;
   if (estimate_.length_frozen && estimate_.width_frozen &&
-      (estimate_.thickness_frozen || p_.silhouette == ShapeSilhouette::kNone))
+      (estimate_.thickness_frozen || (p_.silhouette == ShapeSilhouette::kNone && p_.digit_section_sigma <= 0)))
     return false;
   if (!q.q.allFinite()) return false;
   int tips = 0;
@@ -434,7 +460,8 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
   // breadth the model only assumes in proportion to the palm's).
   kf.observation.wrist_length_px = 0.0;
   kf.observation.wrist_thickness_px = 0.0;
-  if ((p_.silhouette != ShapeSilhouette::kNone || p_.joint_balls) && !image.alpha.empty() &&
+  if ((p_.silhouette != ShapeSilhouette::kNone || p_.joint_balls || p_.digit_section_sigma > 0) &&
+      !image.alpha.empty() &&
       image.alpha.type() == CV_32FC1)
     cv::compare(image.alpha, fit_params.matte_threshold, kf.silhouette, cv::CMP_GE);
   if (p_.silhouette == ShapeSilhouette::kBoth && image.coverage != nullptr) kf.owned = *image.coverage;
@@ -445,6 +472,8 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     kf.chord = measure_palm_chord(models_.at(static_cast<std::size_t>(hand)), q, *image.camera, mask,
                                   image.coverage, fit_params.coverage_stride_px, p_.palm_chord);
   }
+  if (p_.digit_section_sigma > 0 && image.camera != nullptr && !image.alpha.empty())
+    add_sections(hand, q, *image.camera, image.alpha, fit_params.matte_threshold);
   if (held < std::max(p_.keyframes, 1))
     keyframes_.push_back(std::move(kf));
   else
@@ -463,6 +492,24 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
   return false;
 }
 
+void ShapeEstimator::add_sections(int hand, const hand::HandParams& q, const vision::Camera& camera,
+                                  const cv::Mat& alpha, double threshold) {
+  const hand::HandModel& model = models_.at(static_cast<std::size_t>(hand));
+  const hand::HandDimensions& d = model.shape.dimensions;
+  const Eigen::Vector3d& start = starts_.at(static_cast<std::size_t>(hand));
+  // The measured radius scale in β's units (hand 0's sizes): the model's width × thickness times
+  // the section's real / model diameter, over the hand's width ratio to hand 0's.
+  const double to_beta = starts_[0].y() / start.y();
+  for (const DigitAxisPoint& sec : digit_sections(model, q, camera, alpha, threshold)) {
+    const BoneRef bone = silhouette_bone(sec.bone);
+    if (bone.finger == hand::kThumb || bone.segment != 2) continue;  // the fingers' middle phalanges
+    const double ratio = sec.width_px / sec.model_width_px;
+    if (!(ratio > 1.0 / kSectionMaxRatio && ratio < kSectionMaxRatio)) continue;
+    if (section_sizes_.size() >= kMaxSectionSizes) section_sizes_.erase(section_sizes_.begin());
+    section_sizes_.push_back(d.width * d.thickness * ratio * to_beta);
+  }
+}
+
 bool ShapeEstimator::poll() {
   if (!pending_.valid()) return false;
   if (++polls_since_start_ < p_.apply_after_frames) return false;
@@ -478,6 +525,7 @@ ShapeEstimator::Solve ShapeEstimator::make_solve(const vision::Camera* camera,
   job.models = models_;
   job.starts = starts_;
   job.keyframes = keyframes_;
+  job.section_sizes = section_sizes_;
   job.estimate = estimate_;
   return job;
 }

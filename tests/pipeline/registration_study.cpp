@@ -65,6 +65,7 @@ struct Args {
   bool oracle = false;  ///< also fit each frame from the true pose, and compare the evidence
   double q_from = -1, q_to = 0.4;  ///< with --verbose, fit − truth parameters for frames in [q_from, q_to) [s]
   bool ceiling_scan = false;
+  bool section_widths = false;  ///< --section-widths: the digits' sections against the model's, at the truth
   double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
   std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below --dump-below
@@ -120,6 +121,7 @@ int main(int argc, char** argv) {
     else if (k == "--q-from") a.q_from = std::atof(next().c_str());
     else if (k == "--q-to") a.q_to = std::atof(next().c_str());
     else if (k == "--ceiling-scan") a.ceiling_scan = true;
+    else if (k == "--section-widths") a.section_widths = true;
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
     else if (k == "--bending-wrists") a.bending_wrists = true;
@@ -335,6 +337,9 @@ int main(int argc, char** argv) {
   // Joint error by digit and joint along it (fit, and the floor as above) [px sums], and counts.
   std::array<std::array<double, 4>, 5> joint_at_sum{}, joint_at_floor{}, joint_at_n{};
   std::vector<double> chord_ratio;  // the real palm's chord / the model's, at the truth
+  // --section-widths: the real digits' sections / the model's diameters at the truth: proximal,
+  // middle (the thumb's none), distal phalanges, all.
+  std::array<std::vector<double>, 4> section_ratio;
   // The fits' evidence cost per hand and frame (TermCosts, without the prior): total, fingertip,
   // wrist, joint-ball, silhouette.
   std::array<std::vector<double>, 5> evidence_terms;
@@ -418,6 +423,31 @@ int main(int argc, char** argv) {
         chord_ratio.push_back(ch->measured_px / registration::model_palm_chord_px(truth_models[h], truth[h], camera,
                                                                                 ch->at, ch->across_px));
     for (Variant& v : variants) v.iou.push_back(v.ceiling->iou(truth, frame.hand_only, frame.toward_elbow_W).value());
+    // The digits' sections at the truth (--section-widths): the real digit's silhouette across
+    // each phalanx against the model capsule's diameter, both at the true pose and sizes, on the
+    // hand's own pixels (so that the other hand does not widen a section).
+    if (a.section_widths) {
+      registration::RegistrationParams sp = p.registration;
+      sp.silhouette_term = true;
+      sp.digit_axis_sigma_px = 5.0;
+      for (int h = 0; h < 2; ++h) {
+        const cv::Mat own = frame.hand_index == h + 1;
+        registration::ImageEvidence ev;
+        ev.camera = &camera;
+        ev.alpha = own;
+        registration::HandObservation no_obs;
+        const registration::ResidualProblem pr{&truth_models[h], &no_obs, &ev, nullptr, &sp};
+        registration::FrozenTargets tg;
+        registration::freeze_targets(pr, truth[h], &tg);
+        for (int k = 0; k < tg.axis_count; ++k) {
+          const auto& ap = tg.axes[static_cast<std::size_t>(k)];
+          const auto bone = registration::silhouette_bone(ap.bone);
+          section_ratio[static_cast<std::size_t>(bone.segment == 3 || (bone.finger == 0 && bone.segment == 2) ? 2 : bone.segment - 1)]
+              .push_back(ap.width_px / ap.model_width_px);
+          section_ratio[3].push_back(ap.width_px / ap.model_width_px);
+        }
+      }
+    }
     if (part_renderer) {
       SceneSnapshot hands_scene;
       hands_scene.meshes = part_meshes;
@@ -779,6 +809,14 @@ int main(int argc, char** argv) {
     auto q = [&](double f) { return chord_ratio[static_cast<std::size_t>(f * static_cast<double>(chord_ratio.size() - 1))]; };
     std::printf("palm chord at the truth, real / model: median %.3f (p10 %.3f, p90 %.3f), %zu chords\n", q(0.5),
                 q(0.1), q(0.9), chord_ratio.size());
+  }
+  if (a.section_widths) {
+    const char* names[] = {"proximal", "middle", "distal", "all"};
+    std::printf("digits' sections at the truth, real / model diameter: median (p10, p90), count\n");
+    for (std::size_t k = 0; k < 4; ++k)
+      if (!section_ratio[k].empty())
+        std::printf("  %-9s %.3f (%.3f, %.3f) %zu\n", names[k], quantile(section_ratio[k], 0.5),
+                    quantile(section_ratio[k], 0.1), quantile(section_ratio[k], 0.9), section_ratio[k].size());
   }
   std::printf("wrist depth switches %d, restarts %d\n", depth_switches, restarts);
   if (oracle)

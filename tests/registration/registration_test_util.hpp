@@ -79,15 +79,35 @@ inline hand::HandParams perturb(const hand::HandParams& q, const hand::HandModel
 
 /// A silhouette drawn from a model's own capsules and palm box (no GL): CV_8UC1, 255 = hand.
 /// `box_palm` false: the palm as the slab palm_breadth.hpp's chords assume (the box's breadth
-/// with its edges rounded by its half thickness) instead of the box's corners.
+/// with its edges rounded by its half thickness) instead of the box's corners. `exact_digits`: the
+/// digits drawn at sub-pixel precision (a polygon and discs with fractional corners: a pixel is
+/// on where its centre is inside), so that a digit is as wide in the mask as its capsule; without
+/// it a thick 8-connected line is drawn, about a pixel wider.
 inline void draw_capsule_mask(const hand::HandModel& model, const hand::HandParams& q,
-                              const vision::Camera& camera, cv::Mat* mask, bool box_palm = true) {
+                              const vision::Camera& camera, cv::Mat* mask, bool box_palm = true,
+                              bool exact_digits = false) {
   if (mask->empty()) *mask = cv::Mat::zeros(camera.height(), camera.width(), CV_8UC1);
   const double f = camera.intrinsics().fx;
   const auto shapes = hand::hand_render_shapes(model, q);
   for (const auto& c : shapes.capsules) {
     const Vec2 a = camera.project(c.p_W_a), b = camera.project(c.p_W_b);
     const double r = c.radius * f / camera.depth(0.5 * (c.p_W_a + c.p_W_b));
+    if (exact_digits) {
+      constexpr int kShift = 8;
+      constexpr double kOne = 1 << kShift;
+      auto fixed = [&](const Vec2& p) {
+        return cv::Point(static_cast<int>(std::lround(p.x() * kOne)), static_cast<int>(std::lround(p.y() * kOne)));
+      };
+      const Vec2 d = b - a;
+      if (d.norm() > 1e-9) {
+        const Vec2 n = r * Vec2(-d.y(), d.x()).normalized();
+        const cv::Point quad[4] = {fixed(a + n), fixed(b + n), fixed(b - n), fixed(a - n)};
+        cv::fillConvexPoly(*mask, quad, 4, 255, cv::LINE_8, kShift);
+      }
+      for (const Vec2& e : {a, b})
+        cv::circle(*mask, fixed(e), static_cast<int>(std::lround(r * kOne)), 255, cv::FILLED, cv::LINE_8, kShift);
+      continue;
+    }
     const int thick = std::max(1, static_cast<int>(std::lround(2 * r)));
     cv::line(*mask, cv::Point2d(a.x(), a.y()), cv::Point2d(b.x(), b.y()), 255, thick, cv::LINE_8);
     for (const Vec2& e : {a, b})

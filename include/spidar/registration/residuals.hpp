@@ -70,9 +70,22 @@ struct DigitAxisPoint {
   double t = 0;
   Vec2 across_px = Vec2::Zero();  ///< unit, across the projected bone
   Vec2 target_px = Vec2::Zero();  ///< [px]
+  double width_px = 0;        ///< the silhouette's section across the bone [px]
+  double model_width_px = 0;  ///< the model capsule's outline across the bone there, in perspective [px]
 };
 /// Phalanges sampled (thumb 2, fingers 3 each) × points along each.
 inline constexpr int kMaxDigitAxisPoints = 14 * 2;
+
+/// The digits' sections of hand `model` at pose `q` in the matte `alpha` (CV_32FC1 in [0, 1], or
+/// CV_8UC1 read as /255; anything else, or a non-finite pose: none): across each phalanx, at 1/3
+/// and 2/3 of it, the matte walked out both ways from the projected axis to its edges (at
+/// `threshold`). A section is left out when its width is not within 0.5–1.8 times the model
+/// capsule's projected diameter, or its midpoint lies more than the radius from the axis. What the
+/// digit axes pull toward (the midpoints), and the size estimate's evidence on the digits'
+/// thickness (the widths against the model's outline; ShapeEstimatorParams::digit_section_sigma).
+std::vector<DigitAxisPoint> digit_sections(const hand::HandModel& model, const hand::HandParams& q,
+                                           const vision::Camera& camera, const cv::Mat& alpha,
+                                           double threshold);
 
 /// One silhouette sample that lies outside the real silhouette (frozen at the linearisation).
 struct SilhouettePoint {
