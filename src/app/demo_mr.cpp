@@ -70,6 +70,15 @@ int run_mr_demo(const DemoOptions& o) {
   const auto truth_models = session::hand_models(hand_path, o.user_profile, true, &user_profile);
   const auto models = session::hand_models(resolve_data_path("configs/hands.yaml"), o.model_profile, false);
   const vision::Camera calibrated = vision::load_camera_file(resolve_data_path(o.camera)).camera;
+  if (const auto& d = calibrated.intrinsics().distortion; !d.is_zero()) {
+    // The synthetic camera renders a pinhole image; the registration would project with the lens.
+    std::ostringstream m;
+    m << "--camera " << o.camera << ": the simulated camera films a pinhole image, without lens distortion, "
+      << "but this calibration has distortion (k1 " << d.k1 << ", k2 " << d.k2 << ", p1 " << d.p1 << ", p2 "
+      << d.p2 << ", k3 " << d.k3 << "): the registration would project the hands where the film does not "
+      << "show them; give the simulated rig a camera file with distortion: [0, 0, 0, 0, 0]";
+    throw UsageError(m.str());
+  }
   {
     // Scaling a calibration to another aspect ratio would make its pixels non-square.
     const double a = static_cast<double>(o.width) / o.height;

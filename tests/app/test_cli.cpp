@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <array>
 #include <cstdio>
@@ -409,6 +410,23 @@ TEST(Cli, MixedRealityDemoRejectsBadSceneAndHandFiles) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("--width/--height: 3840x48 is not the shape of the camera's calibration"), std::string::npos)
       << r.err;
+  // A calibration with lens distortion, which the simulated camera does not film.
+  {
+    std::ifstream in("configs/camera.yaml");
+    std::string cam((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string zero = "distortion: [0, 0, 0, 0, 0]";
+    ASSERT_NE(cam.find(zero), std::string::npos);
+    cam.replace(cam.find(zero), zero.size(), "distortion: [50, 0, 0, 0, 0]");
+    const std::string cam_path = dir + "_camera.yaml";
+    FILE* g = fopen(cam_path.c_str(), "w");
+    ASSERT_NE(g, nullptr);
+    fputs(cam.c_str(), g);
+    fclose(g);
+    r = run("demo --seconds 1 --no-video --camera " + cam_path + " --out " + dir);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("the simulated camera films a pinhole image, without lens distortion"), std::string::npos)
+        << r.err;
+  }
   r = run("demo --seconds 1 --no-video --out \"\"");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("--out: expected a directory, got an empty path"), std::string::npos) << r.err;
