@@ -108,16 +108,13 @@ Action add_check_config(CLI::App& app) {
       os << hands.profiles.size() << " hand profile(s):";
       for (const auto& p : hands.profiles)
         os << " " << p.name << " (" << num(1e3 * p.dimensions.length) << " x " << num(1e3 * p.dimensions.width) << " mm)";
+    } else {
+      const auto cfg = strings::load_device_config(*file);
+      const auto lim = cfg.effective_limits();
+      os << cfg.name << ", " << cfg.fingers.size() << " fingers, "
+         << cfg.string_count() << " strings, tension " << cfg.tension.t_min << "-"
+         << cfg.tension.t_max << " N (drive delivers " << lim.t_min << "-" << lim.t_max << " N)";
     }
-    if (os.str().size() > file->size() + 6) {
-      std::cout << os.str() << "\n";
-      return 0;
-    }
-    const auto cfg = strings::load_device_config(*file);
-    const auto lim = cfg.effective_limits();
-    os << cfg.name << ", " << cfg.fingers.size() << " fingers, "
-       << cfg.string_count() << " strings, tension " << cfg.tension.t_min << "-"
-       << cfg.tension.t_max << " N (drive delivers " << lim.t_min << "-" << lim.t_max << " N)";
     std::cout << os.str() << "\n";
     return 0;
   };
