@@ -10,6 +10,9 @@
 //                      [--t0 S] [--t1 S] [--fps F] [--verbose [--q-from S --q-to S]] [--ceiling-scan]
 //                      [--dump DIR [--dump-below IOU]] [--bending-wrists] [--set KEY=VALUE]...
 //
+// Besides the run's means it prints them second by second of the script (IoU against the ceiling,
+// joints), so that the approach, the sizes' convergence and the release are seen apart.
+//
 // --set: a registration setting (configs/registration.yaml's keys, e.g. coverage_max_px=15) or,
 // as shape.KEY, a personalisation one (shape.max_fingertip_cost=25), checked by the same parsers.
 //
@@ -327,6 +330,7 @@ int main(int argc, char** argv) {
   std::array<double, 6> joint_part_sum{}, joint_floor_sum{}, joint_part_n{};  // wrist, thumb … little
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
+  std::vector<double> frame_t;  // each scored frame's time on the script [s]
   std::array<std::vector<double>, 2> wrist_depth_mm;  // fit − truth along the camera's axis, per hand
   std::array<Vec3, 2> palm_rot{Vec3::Zero(), Vec3::Zero()};  // |rotation error| about x_H, y_H, z_H [° sums]
   std::array<double, 2> palm_n{};
@@ -680,6 +684,7 @@ int main(int argc, char** argv) {
     obs.push_back(1e3 * obs_res);
     caps.push_back(1e3 * cap_res);
     iou.push_back(m.iou);
+    frame_t.push_back(t);
     tip.push_back(0.5 * (m.fingertip_mm[0] + m.fingertip_mm[1]));
     for (int h = 0; h < 2; ++h) {
       const registration::TermCosts& tc = r.fits[static_cast<std::size_t>(h)].terms;
@@ -710,6 +715,19 @@ int main(int argc, char** argv) {
       "%.2f px  contested %.2f %% (paper %.2f %%)\n",
       iou.size(), mean(iou), quantile(iou, 0.05), mean(ceil_iou), quantile(ceil_iou, 0.05),
       mean(tip), quantile(tip, 0.95), mean(joint), mean(contested), mean(contested_paper));
+  // The same figures second by second of the script: where in the run the fit loses (the approach,
+  // the sizes' convergence, the release), each against its ceiling.
+  {
+    std::printf("by second of the script: IoU (ceiling) joints\n ");
+    const int seconds = frame_t.empty() ? 0 : static_cast<int>(frame_t.back()) + 1;
+    for (int b = 0; b < seconds; ++b) {
+      std::vector<double> bi, bc, bj;
+      for (std::size_t k = 0; k < frame_t.size(); ++k)
+        if (static_cast<int>(frame_t[k]) == b) bi.push_back(iou[k]), bc.push_back(ceil_iou[k]), bj.push_back(joint[k]);
+      if (!bi.empty()) std::printf(" %d: %.3f (%.3f) %.1f", b, mean(bi), mean(bc), mean(bj));
+    }
+    std::printf("\n");
+  }
   {
     const hand::HandDimensions &l = r.models[0].shape.dimensions, &rt = r.models[1].shape.dimensions,
                                &tr = truth_models[0].shape.dimensions;
@@ -847,10 +865,12 @@ int main(int argc, char** argv) {
                   "tracked fit is cheaper %+.1f %+.1f %+.1f %+.1f; elsewhere %+.1f %+.1f %+.1f %+.1f\n",
                   c[0], c[1], c[2], c[3], e[0], e[1], e[2], e[3]);
     }
-  std::printf("final shape: left L %.4f W %.4f, right L %.4f W %.4f (truth L %.4f W %.4f)\n",
+  std::printf("final shape: left L %.4f W %.4f T %.3f, right L %.4f W %.4f T %.3f (truth L %.4f W %.4f T %.3f)\n",
               r.models[0].shape.dimensions.length, r.models[0].shape.dimensions.width,
-              r.models[1].shape.dimensions.length, r.models[1].shape.dimensions.width,
-              truth_models[0].shape.dimensions.length, truth_models[0].shape.dimensions.width);
+              r.models[0].shape.dimensions.thickness, r.models[1].shape.dimensions.length,
+              r.models[1].shape.dimensions.width, r.models[1].shape.dimensions.thickness,
+              truth_models[0].shape.dimensions.length, truth_models[0].shape.dimensions.width,
+              truth_models[0].shape.dimensions.thickness);
   for (int h = 0; h < 2; ++h) {
     const registration::ShapeEstimate& e = r.shapes[h];
     std::printf("  %s: %d keyframes (%d with a palm chord), %d solves, sigma L %.4f W %.4f m%s%s\n",
