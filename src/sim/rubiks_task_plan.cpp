@@ -188,7 +188,7 @@ std::string RubiksTask::phase(double t_run) const {
   const bool again = seg.kind == SegmentKind::kRegrasp;
   const bool cube = p_.has_cube;
   auto turn = [&](int n) {
-    std::string name = cube ? "turn " + std::to_string(n) + " (top layer)" : "turn the object";
+    std::string name = cube ? "turn " + std::to_string(n) + " (top layer)" : "twist the object";
     if (cube && seg.kind == SegmentKind::kRetryTurn && s >= kFirstCheck) name += ", again";
     return name;
   };
@@ -212,9 +212,9 @@ std::string_view RubiksTask::phase_kind(double t_run) const {
   if (s < 1.0) return "approach";
   if (s < 2.0) return "grasp";
   if (s < kHeldFrom) return "lift";
-  if (s < 5.0) return "turn";
+  if (s < 5.0) return p_.has_cube ? "turn" : "twist";
   if (s < 7.2) return "regrasp";
-  if (s < 9.2) return "turn";
+  if (s < 9.2) return p_.has_cube ? "turn" : "twist";
   if (s < kWithdrawFrom) return "release";
   if (s < p_.duration) return "withdraw";
   return "done";

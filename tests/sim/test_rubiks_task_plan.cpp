@@ -387,11 +387,45 @@ TEST(ClosedLoopUser, PhasesAreNamedFromTheScene) {
   EXPECT_EQ(a.phase(4.0), "turn 1 (top layer)");
   EXPECT_EQ(a.phase(8.0), "turn 2 (top layer)");
   EXPECT_EQ(b.phase(0.5), "reach");
-  EXPECT_EQ(b.phase(4.0), "turn the object");
-  EXPECT_EQ(b.phase(8.0), "turn the object");
+  EXPECT_EQ(b.phase(4.0), "twist the object");
+  EXPECT_EQ(b.phase(8.0), "twist the object");
   EXPECT_EQ(b.phase(9.5), "let go, set it down");
+  EXPECT_EQ(b.phase_kind(4.0), "twist");
+  EXPECT_EQ(a.phase_kind(4.0), "turn");
   for (double t = 0; t < 13; t += 0.1) EXPECT_EQ(b.phase(t).find("layer"), std::string::npos) << t;
   EXPECT_EQ(b.progress().turns_planned, 0);
+}
+
+// A rigid object held by the left hand does not turn: without a cube the right hand only twists
+// it (a third of a cube's turn), and the holding hand's fingertips stay where they are.
+TEST(ClosedLoopUser, WithoutACubeTheRightHandOnlyTwistsTheHeldObject) {
+  RubiksTaskParams with_cube, without;
+  without.has_cube = false;
+  RubiksTask a(with_cube), b(without);
+  std::array<Vec3, 8> a0, a1, b0, b1;
+  // Script time 3.0 to 5.0 s: lifted (the lift ends at 3.0 s), the right hand turning a cube's
+  // layer from 0 to its full turn.
+  a.goals(3.0, a0);
+  a.goals(5.0, a1);
+  b.goals(3.0, b0);
+  b.goals(5.0, b1);
+  // Each right fingertip's angle about the vertical through the grasp (the cube's centre).
+  auto angle = [&](const Vec3& p0, const Vec3& p1) {
+    const Vec3 c = with_cube.p_W_cube;
+    const double a0z = std::atan2(p0.y() - c.y(), p0.x() - c.x()), a1z = std::atan2(p1.y() - c.y(), p1.x() - c.x());
+    return std::remainder(a1z - a0z, 2 * 3.14159265358979);
+  };
+  for (int f = 4; f < 8; ++f) {
+    if (std::hypot(a0[f].x() - with_cube.p_W_cube.x(), a0[f].y() - with_cube.p_W_cube.y()) < 0.01) continue;  // on the axis
+    const double turned = angle(a0[f], a1[f]), twisted = angle(b0[f], b1[f]);
+    EXPECT_NEAR(std::abs(turned), with_cube.turn, 0.05) << "finger " << f;
+    // Less than half the cube's turn (a quarter turn drags the fingertips against the object), but
+    // a twist all the same: the right hand still changes its pose.
+    EXPECT_LT(std::abs(twisted), 0.5 * std::abs(turned)) << "finger " << f;
+    EXPECT_GT(std::abs(twisted), 0.2 * std::abs(turned)) << "finger " << f;
+    EXPECT_GT(twisted * turned, 0.0) << "finger " << f;  // the same way round
+  }
+  for (int f = 0; f < 4; ++f) EXPECT_LT((b1[f] - b0[f]).norm(), 1e-6) << "left finger " << f;
 }
 
 TEST(ClosedLoopUser, PhaseKindsGroupTheScriptAndFollowItsJumps) {

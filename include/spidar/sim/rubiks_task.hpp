@@ -32,7 +32,14 @@
 /// and a relaxed grip), which sim::UserHands uses as the prior of the user's hand posture.
 /// Goals lie `squeeze` inside the faces, so the fingertips' impedance sets the grip force.
 /// In a scene without a cube, p_W_cube and half describe the object to reach for (any box-like
-/// object): the same motions then grasp, push and turn it.
+/// object): the same motions grasp, lift, let go, grasp again and set it down, but the right hand
+/// only twists it (kRigidTwistShare of the turn, and back). A rigid object held by the other hand
+/// does not turn: a full quarter turn dragged the right fingertips against it until their caps
+/// lay where the user's fingers could not follow. The simulated hands missed them by up to 3 mm
+/// (`ground_truth.cap_residual_mm_max`, a 4 cm box off the centre; 0.75 mm with the twist). Not
+/// turning at all kept the caps as well, but the right hand then held one pose for seconds, and
+/// the size estimate, short of other poses, took its width to the −15 % bound
+/// (docs/measurements.md, 2026-11-27, late night).
 ///
 /// The user watches the cube: with track() given, a hand approaching for a grasp takes the cube's
 /// current pose (from the physics thread) as the frame of that grasp, so a cube that tilted or slid
@@ -55,6 +62,10 @@
 
 namespace spidar::sim {
 
+/// The share of the turn (RubiksTaskParams::turn) by which the right hand twists an object that is
+/// not a cube, while the left hand holds it.
+inline constexpr double kRigidTwistShare = 1.0 / 3.0;
+
 struct RubiksTaskParams {
   Vec3 p_W_cube = Vec3::Zero();  ///< cube centre at the start [m]
   double half = 0.0285;          ///< half the cube's size [m]
@@ -73,7 +84,7 @@ struct RubiksTaskParams {
   /// goals go `firm_squeeze` deeper into the faces (over 0.2 s) for the rest of the run. 0 = never.
   double firm_squeeze = 0.004;   ///< [m]
   double sink = 0.002;           ///< [m]
-  bool has_cube = true;          ///< a Rubik's cube (false: another object; no turns are counted)
+  bool has_cube = true;          ///< a Rubik's cube (false: another object, held and twisted; no turns)
   /// The user's fingertips held with their own fingers' stiffness (sim/finger_hold.hpp) once
   /// fit_to_hands is called: the caps then yield to the displayed forces only where the fingers
   /// can follow them, so the user's hands reach the device's caps within their active ranges
