@@ -41,8 +41,12 @@ mjModel* load_from_memory(const std::string& scene_path, const std::string& text
 
 /// Physics steps in real time beside the servo loop: a step longer than this makes the coupling
 /// a spring sampled too slowly to be stable, one shorter cannot be computed in real time.
+/// Measured (demo, a 4 cm box held and twisted, seed 1): at 1 and 2 ms the simulated user's caps
+/// stay within 0.63 mm of its fingers and the fit scores IoU 0.86; at 3 ms the fingertip contacts
+/// no longer settle, the caps swing up to 9.1 mm away (5 ms: 8.7 mm) and IoU falls to 0.72–0.77.
+/// 2 ms is also MuJoCo's default time step.
 constexpr double kMinTimestep = 1e-5;  // [s]
-constexpr double kMaxTimestep = 0.01;  // [s]
+constexpr double kMaxTimestep = 0.002;  // [s]
 
 }  // namespace
 
@@ -85,7 +89,8 @@ Result<std::unique_ptr<World>> World::Load(const std::string& scene_path, const 
     std::ostringstream os;
     os << scene_path << ": <option timestep=\"" << dt << "\"> is out of range; expected "
        << kMinTimestep << " s <= timestep <= " << kMaxTimestep
-       << " s (the physics steps in real time beside the servo loop)";
+       << " s (the physics renders the fingertips' contacts at 1/timestep beside the 1 kHz servo "
+          "loop; with longer steps they do not settle)";
     return Error{os.str()};
   }
 

@@ -150,12 +150,12 @@ TEST(MjcfProxies, SceneFileMustBeASmallRegularFileWithASaneTimestep) {
   EXPECT_NE(load_error(dir).find(dir + ": is a directory"), std::string::npos) << load_error(dir);
   EXPECT_NE(load_error("/dev/zero").find("/dev/zero: is not a regular file"), std::string::npos)
       << load_error("/dev/zero");
-  for (const char* dt : {"1", "0.5", "1e-06"}) {
+  for (const char* dt : {"1", "0.5", "0.003", "1e-06"}) {
     const auto path = write(dir, std::string("dt_") + dt + ".xml",
                             std::string("<mujoco><option timestep=\"") + dt +
                                 "\"/><worldbody/></mujoco>");
     const std::string e = load_error(path);
-    EXPECT_NE(e.find(path + ": <option timestep=\"" + dt + "\"> is out of range; expected 1e-05 s <= timestep <= 0.01 s"),
+    EXPECT_NE(e.find(path + ": <option timestep=\"" + dt + "\"> is out of range; expected 1e-05 s <= timestep <= 0.002 s"),
               std::string::npos)
         << e;
   }
