@@ -130,6 +130,28 @@ TEST(HandConfig, LoadsTheShippedFile) {
   EXPECT_EQ(user->model(Side::kLeft).side, Side::kLeft);
 }
 
+// The README's other users (configs/users/): each loads, and lies at the corner of the issue's
+// ±10 % box around the model hand that its name says (length, width), with its coupling.
+TEST(HandConfig, TheShippedUsersAreTheirCornersOfTheTenPercentBox) {
+  const HandProfile model = *load_hand_profiles(SPIDAR_SOURCE_DIR "/configs/hands.yaml").find("model");
+  struct Expected {
+    const char* file;
+    double length, width;  // relative to the model
+    Coupling coupling;
+  };
+  for (const Expected& e : {Expected{"large", 0.1, 0.1, Coupling::kLinear}, Expected{"small", -0.1, -0.1, Coupling::kPaperQuadratic},
+                            Expected{"short-wide", -0.1, 0.1, Coupling::kLinear},
+                            Expected{"long-narrow", 0.1, -0.1, Coupling::kLinear}}) {
+    const auto profiles = load_hand_profiles(std::string(SPIDAR_SOURCE_DIR "/configs/users/") + e.file + ".yaml");
+    ASSERT_EQ(profiles.profiles.size(), 1u) << e.file;
+    const HandProfile& u = profiles.profiles[0];
+    EXPECT_EQ(u.name, e.file);
+    EXPECT_NEAR(u.dimensions.length / model.dimensions.length - 1.0, e.length, 1e-3) << e.file;
+    EXPECT_NEAR(u.dimensions.width / model.dimensions.width - 1.0, e.width, 1e-3) << e.file;
+    EXPECT_EQ(u.coupling, e.coupling) << e.file;
+  }
+}
+
 // Parses `text` as "hands.yaml" and returns the error message (empty if it parsed).
 std::string error_of(const std::string& text) {
   try {
