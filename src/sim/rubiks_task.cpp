@@ -17,6 +17,18 @@ struct Contacts {
   std::array<Vec3, 4> left, right;
 };
 
+/// The pitch that spaces the fingertips of one hand across each other (the right hand's index and
+/// ring either side of the middle, the left hand's fingers stacked down the back face), the
+/// farthest at `extent` pitches from the centre: the cube's layer pitch. A smaller object keeps the
+/// cube's spacing as far as its face allows (the proxy sphere's centre within half − r of its
+/// centre): the fingers do not shrink with the object, and fingertips squeezed closer than the
+/// user's fingers can adduct pulled the size estimate's width to its bound.
+double spread(const RubiksTaskParams& p, double extent) {
+  if (p.has_cube) return p.pitch;
+  const double cube = RubiksTaskParams{}.pitch;
+  return std::max(p.pitch, std::min(cube, (p.half - p.proxy_radius) / extent));
+}
+
 /// Grasp contacts in the cube frame (world axes at the start), thumb, index, middle, ring.
 Contacts contacts(const RubiksTaskParams& p) {
   const double face = p.half + p.proxy_radius - p.squeeze;
@@ -32,14 +44,15 @@ Contacts contacts(const RubiksTaskParams& p) {
   // middle layer that holds against the turning hand: the bottom layer then feels a third of the
   // holding torque and the top layer's twist clearly stands out (held by the bottom layer alone,
   // a top-layer turn and a bottom-layer turn would be the same twist).
-  c.left = {Vec3(-0.26 * a, -hold, -0.47 * a), Vec3(-0.2 * a, hold, -0.15 * a),
-            Vec3(-0.26 * a, hold, -0.45 * a), Vec3(-0.32 * a, hold, -0.8 * a)};
+  const double az = spread(p, 0.8), ax = spread(p, 0.37);
+  c.left = {Vec3(-0.26 * a, -hold, -0.47 * az), Vec3(-0.2 * a, hold, -0.15 * az),
+            Vec3(-0.26 * a, hold, -0.45 * az), Vec3(-0.32 * a, hold, -0.8 * az)};
   // Right hand on the top layer, from above: thumb in front, index and ring behind either side
   // of the middle, which presses on the top. High on the layer: a fingertip on the middle layer
   // would drag it along.
   const double zr = 1.2 * a;
-  c.right = {Vec3(0.0, -face, zr), Vec3(-0.37 * a, face, zr),
-             Vec3(0.0, 0.2 * a, p.half + p.proxy_radius - 0.6 * p.squeeze), Vec3(0.37 * a, face, zr)};
+  c.right = {Vec3(0.0, -face, zr), Vec3(-0.37 * ax, face, zr),
+             Vec3(0.0, 0.2 * a, p.half + p.proxy_radius - 0.6 * p.squeeze), Vec3(0.37 * ax, face, zr)};
   return c;
 }
 

@@ -428,6 +428,26 @@ TEST(ClosedLoopUser, WithoutACubeTheRightHandOnlyTwistsTheHeldObject) {
   for (int f = 0; f < 4; ++f) EXPECT_LT((b1[f] - b0[f]).norm(), 1e-6) << "left finger " << f;
 }
 
+// Fingers do not shrink with the object: on a box smaller than the cube the right hand's index and
+// ring stay as far apart as on the cube (they were squeezed to 10 mm, past what the user's fingers
+// adduct), and the left hand's fingers stay on the box's back face.
+TEST(ClosedLoopUser, FingertipsOnASmallerObjectKeepTheCubesSpacing) {
+  RubiksTaskParams cube, box;
+  box.has_cube = false;
+  box.half = 0.02;
+  box.pitch = box.half * 2.0 / 3.0;  // as session::make_scripted_task sets it
+  RubiksTask a(cube), b(box);
+  std::array<Vec3, 8> ga, gb;
+  a.goals(2.5, ga);  // grasped and lifting
+  b.goals(2.5, gb);
+  const double cube_spread = std::abs(ga[7].x() - ga[5].x());
+  EXPECT_NEAR(cube_spread, 0.74 * cube.pitch, 1e-3);  // the cube's layout, unchanged
+  EXPECT_NEAR(std::abs(gb[7].x() - gb[5].x()), cube_spread, 1e-3);
+  const double lift = script_lift(box, 2.5);
+  for (int f = 0; f < 4; ++f)
+    EXPECT_LE(std::abs(gb[f].z() - box.p_W_cube.z() - lift), box.half - box.proxy_radius + 1e-6) << "left finger " << f;
+}
+
 TEST(ClosedLoopUser, PhaseKindsGroupTheScriptAndFollowItsJumps) {
   RubiksTask task({});
   const std::pair<double, const char*> expected[] = {{0.5, "approach"}, {1.5, "grasp"},   {2.5, "lift"},

@@ -39,7 +39,9 @@
 /// (`ground_truth.cap_residual_mm_max`, a 4 cm box off the centre; 0.75 mm with the twist). Not
 /// turning at all kept the caps as well, but the right hand then held one pose for seconds, and
 /// the size estimate, short of other poses, took its width to the −15 % bound
-/// (docs/measurements.md, 2026-11-27, late night).
+/// (docs/measurements.md, 2026-11-27, late night). On an object smaller than the cube the
+/// fingertips of each hand keep the cube's spacing across each other, as far as the object's
+/// faces allow: fingers do not shrink with the object.
 ///
 /// The user watches the cube: with track() given, a hand approaching for a grasp takes the cube's
 /// current pose (from the physics thread) as the frame of that grasp, so a cube that tilted or slid
