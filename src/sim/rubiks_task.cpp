@@ -144,7 +144,8 @@ RubiksTask::HandState RubiksTask::state(double t, hand::Side side, int /*finger*
   // A cube's top layer turns; any other object is rigid and held by the left hand, and the right
   // hand only twists it, by kRigidTwistShare of the turn (rubiks_task.hpp).
   if (side == hand::Side::kRight) {
-    s.yaw = (p_.has_cube ? 1.0 : kRigidTwistShare) * p_.turn * (ramp(t, 3.0, 5.0) - ramp(t, 5.7, 6.5) + ramp(t, 7.2, 9.2) - ramp(t, 10.6, 11.3));
+    const double share = p_.has_cube ? 1.0 : kRigidTwistShare;
+    s.yaw = share * p_.turn * (ramp(t, 3.0, 5.0) - ramp(t, 5.7, 6.5) + ramp(t, 7.2, 9.2) - ramp(t, 10.6, 11.3));
   }
   return s;
 }

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "spidar/core/seqlock.hpp"
+#include "spidar/core/units.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 
 namespace spidar::sim {
@@ -413,7 +414,7 @@ TEST(ClosedLoopUser, WithoutACubeTheRightHandOnlyTwistsTheHeldObject) {
   auto angle = [&](const Vec3& p0, const Vec3& p1) {
     const Vec3 c = with_cube.p_W_cube;
     const double a0z = std::atan2(p0.y() - c.y(), p0.x() - c.x()), a1z = std::atan2(p1.y() - c.y(), p1.x() - c.x());
-    return std::remainder(a1z - a0z, 2 * 3.14159265358979);
+    return std::remainder(a1z - a0z, 2 * units::kPi);
   };
   for (int f = 4; f < 8; ++f) {
     if (std::hypot(a0[f].x() - with_cube.p_W_cube.x(), a0[f].y() - with_cube.p_W_cube.y()) < 0.01) continue;  // on the axis
