@@ -119,6 +119,10 @@ struct FramePipeline::Impl {
   core::SideTask side;
   /// This frame's predicted bracelets (find_bracelets): where the previous fits put them [px].
   std::array<Vec2, 2> predicted_wrist_px{Vec2::Zero(), Vec2::Zero()};
+  /// Where each forearm points, world (set_forearm_directions), and the same in each hand's frame
+  /// at the previous fit (HandObservation::forearm_H), set at the start of each frame.
+  std::array<std::optional<Vec3>, 2> toward_elbow_W;
+  std::array<Vec3, 2> forearm_H{Vec3(0.0, -1.0, 0.0), Vec3(0.0, -1.0, 0.0)};
 
   Status key_and_evidence(const cv::Mat& bgr, const vision::ChromaKeyResult* matte, FrameResult* out);
   Status find_bracelets(const cv::Mat& bgr, FrameResult* out);
@@ -212,6 +216,10 @@ Status FramePipeline::present(render::Context& context, const cv::Mat& bgr) {
 }
 const FramePipelineParams& FramePipeline::params() const { return impl_->params; }
 const std::array<hand::HandModel, 2>& FramePipeline::models() const { return impl_->models; }
+void FramePipeline::set_forearm_directions(const std::array<std::optional<Vec3>, 2>& toward_elbow_W) {
+  impl_->toward_elbow_W = toward_elbow_W;
+}
+
 void FramePipeline::use_model_sizes(const std::array<hand::HandModel, 2>& models) {
   Impl& s = *impl_;
   for (int h = 0; h < 2; ++h) {
@@ -254,7 +262,8 @@ Status FramePipeline::Impl::key_and_evidence(const cv::Mat& bgr, const vision::C
       for (int h = 0; h < 2; ++h) {
         const double forearm_radius =
             registration::bracelet_radius_m(p.registration, s.models[h].shape.dimensions.width);
-        registration::project_hand(s.models[h], s.previous[h], s.camera, forearm_radius, &s.outlines[h]);
+        registration::project_hand(s.models[h], s.previous[h], s.camera, forearm_radius, &s.outlines[h],
+                                   s.forearm_H[h]);
       }
       registration::coverage_evidence(out->key.silhouette, {&s.outlines[0], &s.outlines[1]},
                                       p.registration, &s.owned);
@@ -280,9 +289,9 @@ Status FramePipeline::Impl::find_bracelets(const cv::Mat& bgr, FrameResult* out)
   if (s.have_previous) {
     for (int h = 0; h < 2; ++h) {
       const Pose X_WH = hand::hand_pose(s.previous[h]);
-      const Vec3 p_WB = X_WH * Vec3(0.0, -p.registration.bracelet_offset_m, 0.0);
+      const Vec3 p_WB = X_WH * Vec3(p.registration.bracelet_offset_m * s.forearm_H[h]);
       predicted[h] = s.camera.project(registration::bracelet_visible_point(
-          X_WH, s.models[h].shape.dimensions.width, s.camera.X_WC().p, p.registration));
+          X_WH, s.models[h].shape.dimensions.width, s.camera.X_WC().p, p.registration, nullptr, s.forearm_H[h]));
       prediction.wrist_px[h] = predicted[h];
       // The band's expected length: its projected diameter there.
       const double depth = (s.camera.X_CW() * p_WB).z();
@@ -290,14 +299,14 @@ Status FramePipeline::Impl::find_bracelets(const cv::Mat& bgr, FrameResult* out)
         const double radius = registration::bracelet_radius_m(p.registration, s.models[h].shape.dimensions.width);
         prediction.length_px[h] = 2.0 * radius * s.camera.intrinsics().fx / depth;
       }
-      // The band's long axis in the image: across the forearm (hand y) and the line of sight.
+      // The band's long axis in the image: across the forearm and the line of sight.
       // Only where the camera sees the forearm from the side (its axis more than 58° off the line
       // of sight, sin > 0.85): nearer end-on the band is a ring whose visible arc's long axis
       // need not lie across the forearm, and a predicted axis made the detector refuse the
       // right band there (registration_study: the right bracelet lost for 14 frames at 6.1–6.6 s,
       // its wrist drifting 3 cm).
       const Vec3 sight = p_WB - s.camera.X_WC().p;
-      const Vec3 across = (X_WH.R * Vec3::UnitY()).cross(sight);
+      const Vec3 across = (X_WH.R * Vec3(-s.forearm_H[h])).cross(sight);
       if (across.norm() > 0.85 * sight.norm()) {
         const Vec2 a = s.camera.project(p_WB + 0.01 * across.normalized()) - predicted[h];
         if (a.norm() > 1e-6) prediction.axis_px[h] = a.normalized();
@@ -320,6 +329,14 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   const FramePipelineParams& p = s.params;
   if (auto st = check_frame(bgr, s.camera); !st) return st;
   const auto t_start = Clock::now();
+  // Each forearm's direction in its hand's frame at the previous fit: for the predicted bracelet,
+  // the forearm outline that decides the silhouette's owners, and the bracelet term.
+  for (int h = 0; h < 2; ++h) {
+    s.forearm_H[h] = Vec3(0.0, -1.0, 0.0);
+    const auto& d = s.toward_elbow_W[static_cast<std::size_t>(h)];
+    if (s.have_previous && d && d->allFinite() && d->norm() > 0.5)
+      s.forearm_H[h] = hand::hand_pose(s.previous[h]).R.toRotationMatrix().transpose() * d->normalized();
+  }
   FrameTimings& tm = out->timings;
 
   // The image's two independent stages side by side (FramePipelineParams::side_by_side): the
@@ -348,6 +365,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       if (e.poll()) s.take_sizes(e);
   for (int h = 0; h < 2; ++h) {
     registration::HandObservation obs;
+    obs.forearm_H = s.forearm_H[h];
     for (int f = 0; f < hand::kFingertipCount; ++f) {
       const int d = p.fingers[h][f];
       const Vec3 x = device::fingertip_position(tips, d);

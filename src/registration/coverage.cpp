@@ -67,7 +67,8 @@ double capsule_distance(const ImageCapsule& c, const Vec2& px, double* t_out) {
 }
 
 void project_hand(const hand::HandModel& model, const hand::HandParams& q,
-                  const vision::Camera& camera, double forearm_radius_m, ProjectedHand* out) {
+                  const vision::Camera& camera, double forearm_radius_m, ProjectedHand* out,
+                  const Vec3& forearm_H) {
   detail::PoseState s;
   detail::pose_state(model, q, false, &s);
   const double focal = 0.5 * (camera.intrinsics().fx + camera.intrinsics().fy);
@@ -90,7 +91,7 @@ void project_hand(const hand::HandModel& model, const hand::HandParams& q,
   }
   if (palm_visible) palm_hull(out);
   out->forearm = project_capsule(camera, s.p_W_wrist,
-                                 detail::rigid_point(s, Vec3(0.0, -kForearmLengthM, 0.0), nullptr),
+                                 detail::rigid_point(s, kForearmLengthM * forearm_H, nullptr),
                                  forearm_radius_m, focal);
 }
 

@@ -82,9 +82,11 @@ inline Vec3 bone_point(const hand::HandModel& model, const PoseState& s, BoneRef
   return (1.0 - t) * a + t * c;
 }
 
-/// The bracelet's centre: (0, −bracelet_offset_m, 0) in the hand frame.
-inline Vec3 bracelet_point(const PoseState& s, const RegistrationParams& p, PointJacobian* J) {
-  return rigid_point(s, Vec3(0.0, -p.bracelet_offset_m, 0.0), J);
+/// The bracelet's centre: bracelet_offset_m along the forearm (`forearm_H`, unit, right-hand H
+/// coordinates) from the wrist; frozen in the hand frame for one frame's fit.
+inline Vec3 bracelet_point(const PoseState& s, const RegistrationParams& p, const Vec3& forearm_H,
+                           PointJacobian* J) {
+  return rigid_point(s, p.bracelet_offset_m * forearm_H, J);
 }
 
 /// A silhouette point's offset from its projected axis point [px], scaled with the bone's radius
@@ -160,7 +162,7 @@ void visit_residuals(const ResidualProblem& pr, const FrozenTargets& tg, const h
     // The projected wrist from the bracelet.
     if (tg.wrist_active && wrist_observed(obs)) {
       const double w = std::sqrt(std::min(obs.wrist_confidence, 1.0)) / rp.wrist_sigma_px;
-      const Vec3 p = bracelet_point(s, rp, J3p) + tg.bracelet_shift_W;
+      const Vec3 p = bracelet_point(s, rp, obs.forearm_H, J3p) + tg.bracelet_shift_W;
       add_projected(Term::kWrist, p, Vec2::Zero(), *obs.wrist_px, w);
     }
     // The band's extent in the image from two points frozen on it (right-hand H), relative to

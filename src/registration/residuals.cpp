@@ -206,9 +206,9 @@ struct StackSink {
 }  // namespace
 
 Vec3 bracelet_visible_point(const Pose& X_WH, double hand_width_m, const Vec3& p_W_camera,
-                            const RegistrationParams& params, Vec3* shift_W) {
-  const Vec3 centre = X_WH * Vec3(0.0, -params.bracelet_offset_m, 0.0);
-  const Vec3 axis = X_WH.R * Vec3::UnitY();
+                            const RegistrationParams& params, Vec3* shift_W, const Vec3& forearm_H) {
+  const Vec3 centre = X_WH * Vec3(params.bracelet_offset_m * forearm_H);
+  const Vec3 axis = X_WH.R * forearm_H;
   Vec3 toward = p_W_camera - centre;
   toward -= toward.dot(axis) * axis;
   Vec3 shift = Vec3::Zero();
@@ -292,7 +292,8 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   tg->bracelet_shift_W = Vec3::Zero();
   if (detail::wrist_observed(*pr.observation)) {
     const Vec3 p = bracelet_visible_point(hand::hand_pose(q), pr.model->shape.dimensions.width,
-                                          camera.X_WC().p, *pr.params, &tg->bracelet_shift_W);
+                                          camera.X_WC().p, *pr.params, &tg->bracelet_shift_W,
+                                          pr.observation->forearm_H);
     tg->wrist_active = camera.depth(p) >= detail::kMinImageDepth;
     const HandObservation& obs = *pr.observation;
     if (tg->wrist_active && pr.params->bracelet_length_sigma > 0 && std::isfinite(obs.wrist_length_px) &&

@@ -8,7 +8,11 @@
 //   registration_study [--user PROFILE|--user-file FILE] [--model L,W | --model-user]
 //                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
 //                      [--t0 S] [--t1 S] [--fps F] [--verbose [--q-from S --q-to S]] [--ceiling-scan]
-//                      [--dump DIR [--dump-below IOU]] [--bending-wrists] [--set KEY=VALUE]...
+//                      [--dump DIR [--dump-below IOU]] [--bending-wrists [--oracle-forearm]]
+//                      [--set KEY=VALUE]...
+//
+// --oracle-forearm: the registration is told where the simulated forearms point
+// (FramePipeline::set_forearm_directions), to measure what an estimate of that direction is worth.
 //
 // Besides the run's means it prints them second by second of the script (IoU against the ceiling,
 // joints), so that the approach, the sizes' convergence and the release are seen apart.
@@ -74,6 +78,7 @@ struct Args {
   std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below --dump-below
   double dump_below = 0.5;
   bool bending_wrists = false;  ///< --bending-wrists: the user's forearms point at fixed elbows (sim::user_elbows)
+  bool oracle_forearm = false;  ///< --oracle-forearm: the registration is told where the true forearms point
   double shape_w = 0, shape_dq = 0;
   bool shape_silhouette = false;  ///< --shape-silhouette: the size estimator also fits the keyframes' spill
 };
@@ -128,6 +133,7 @@ int main(int argc, char** argv) {
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
     else if (k == "--bending-wrists") a.bending_wrists = true;
+    else if (k == "--oracle-forearm") a.oracle_forearm = true;
     else if (k == "--dump-below") {
       const std::string v = next();
       char* end = nullptr;
@@ -362,6 +368,7 @@ int main(int argc, char** argv) {
     for (int f = 0; f < 8; ++f) s.p_W[f] = {g[f].x(), g[f].y(), g[f].z()};
     const auto& truth = hands.params();
     if (!film->film({&truth[0], &truth[1]}, &frame).ok()) return 1;
+    if (a.oracle_forearm) pipe->set_forearm_directions(frame.toward_elbow_W);
     if (auto st = pipe->process(frame.bgr, s, scene, &r); !st.ok()) {
       std::fprintf(stderr, "%s\n", st.error().message.c_str());
       return 1;

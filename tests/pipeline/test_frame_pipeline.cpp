@@ -61,6 +61,16 @@ class FramePipelineTest : public ::testing::Test {
     return s;
   }
 
+  // The shipped keyer and bracelet detector, with the silhouette term.
+  static FramePipelineParams keyed_params() {
+    const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+    FramePipelineParams p;
+    p.chroma_key = vc.chroma_key;
+    p.bracelet = vc.bracelet;
+    p.registration.silhouette_term = true;
+    return p;
+  }
+
   std::unique_ptr<render::Context> context_;
   std::array<hand::HandModel, 2> truth_models_, models_;
   vision::Camera camera_;
@@ -394,11 +404,7 @@ TEST_F(FramePipelineTest, UseModelSizesTakesAnotherFitsSizesAndKeepsItsJointBox)
 // cold start, and with the user's own sizes it stays near the truth; a cold pipeline on the same
 // frame starts from its nominal rotation. Non-finite poses are refused and change nothing.
 TEST_F(FramePipelineTest, WarmStartFitsTheNextFrameFromTheGivenPoses) {
-  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
-  FramePipelineParams p;
-  p.chroma_key = vc.chroma_key;
-  p.bracelet = vc.bracelet;
-  p.registration.silhouette_term = true;
+  const FramePipelineParams p = keyed_params();
   sim::RubiksTask task({});
   sim::UserHands user(truth_models_, task);
   const double t = 4.0;  // holding the cube, far from the script's start
@@ -430,6 +436,46 @@ TEST_F(FramePipelineTest, WarmStartFitsTheNextFrameFromTheGivenPoses) {
   EXPECT_GT(c.fits[0].iterations + c.fits[1].iterations, r.fits[0].iterations + r.fits[1].iterations)
       << "cold " << c.fits[0].iterations << "+" << c.fits[1].iterations << ", warm " << r.fits[0].iterations << "+"
       << r.fits[1].iterations;
+}
+
+// Forearm directions given to the pipeline (a rig that tracks the forearms, the study's oracle):
+// the in-line direction is the default bit for bit, a bent one moves the fits, and a broken one
+// is the in-line forearm.
+TEST_F(FramePipelineTest, GivenForearmDirectionsMoveTheBraceletAndInLineIsTheDefault) {
+  const FramePipelineParams p = keyed_params();
+  sim::RubiksTask task({});
+  sim::UserHands user(truth_models_, task);
+  const double t = 4.0;
+  const auto sample = pose_user(user, task, t);
+  const auto truth = user.params();
+  sim::SyntheticFrame frame;
+  ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+  auto fit_with = [&](const std::array<std::optional<Vec3>, 2>& directions) {
+    auto pipe = FramePipeline::create(*context_, camera_, truth_models_, p).value();
+    EXPECT_TRUE(pipe->warm_start(truth).ok());
+    pipe->set_forearm_directions(directions);
+    FrameResult r;
+    EXPECT_TRUE(pipe->process(frame.bgr, sample, scene_, &r, true).ok());
+    return r;
+  };
+  const FrameResult plain = fit_with({});
+  std::array<std::optional<Vec3>, 2> in_line, bent, broken;
+  for (int h = 0; h < 2; ++h) {
+    const Mat3 R = hand::hand_pose(truth[h]).R.toRotationMatrix();
+    in_line[h] = -R.col(1);
+    bent[h] = (-R.col(1) + 0.9 * R.col(2)).normalized();  // bent 42° toward the hand's back
+    broken[h] = Vec3(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
+  }
+  const FrameResult a = fit_with(in_line), b = fit_with(bent), c = fit_with(broken);
+  for (int h = 0; h < 2; ++h) {
+    ASSERT_TRUE(plain.bracelets[h].found) << "hand " << h;
+    EXPECT_LT((a.hands[h].q - plain.hands[h].q).norm(), 1e-9) << "hand " << h;
+    EXPECT_EQ((c.hands[h].q - plain.hands[h].q).norm(), 0.0) << "hand " << h;
+    EXPECT_TRUE(b.hands[h].q.allFinite());
+    // The bent forearm's band sits 12 mm · sin 42° ≈ 8 mm elsewhere: the wrist moves to put it
+    // on the detected band.
+    EXPECT_GT((b.hands[h].p_W_wrist() - plain.hands[h].p_W_wrist()).norm(), 1e-3) << "hand " << h;
+  }
 }
 
 TEST_F(FramePipelineTest, BadFramesAreErrorsNamingTheSize) {

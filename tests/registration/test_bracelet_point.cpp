@@ -48,5 +48,36 @@ TEST(BraceletVisiblePoint, LiesOnTheBandsCrossSectionTowardTheCamera) {
   EXPECT_NEAR((on_axis - Vec3(0, -0.012, 0)).norm(), 0.0, 1e-12);
 }
 
+// A bent wrist (HandObservation::forearm_H): the band sits along the forearm's own direction, and
+// the point on its cross-section there, not on the hand's axis.
+TEST(BraceletVisiblePoint, FollowsABentForearm) {
+  RegistrationParams p;
+  p.bracelet_offset_m = 0.012;
+  p.bracelet_surface_shift = 0.5;
+  const double width = 0.08;
+  const double r = bracelet_radius_m(p, width);
+  const Vec3 camera(0.02, -0.45, 0.5);
+  for (const Vec3& bend : {Vec3(0.5, -0.8, 0.3), Vec3(0.0, -0.6, -0.8), Vec3(-0.7, -0.7, 0.0)}) {
+    const Vec3 forearm_H = bend.normalized();
+    for (const Vec3& rot : {Vec3(0, 0, 0), Vec3(0.3, -0.2, 1.0)}) {
+      const Pose X_WH = Pose::FromRotationVector(rot, Vec3(0.05, -0.02, 0.1));
+      Vec3 shift;
+      const Vec3 q = bracelet_visible_point(X_WH, width, camera, p, &shift, forearm_H);
+      const Vec3 axis = X_WH.R * forearm_H;
+      const Vec3 centre = X_WH.p + 0.012 * axis;
+      EXPECT_NEAR((q - centre).dot(axis), 0.0, 1e-12);
+      EXPECT_NEAR((q - centre).norm(), 0.5 * r, 1e-12);
+      EXPECT_NEAR((q - centre - shift).norm(), 0.0, 1e-12);
+      EXPECT_LT((camera - q).norm(), (camera - centre).norm());
+      // Not where the in-line forearm puts it.
+      EXPECT_GT((q - bracelet_visible_point(X_WH, width, camera, p)).norm(), 1e-3);
+    }
+  }
+  // (0, −1, 0), the default, is the in-line forearm.
+  const Pose X_WH = Pose::FromRotationVector(Vec3(0.3, -0.2, 1.0), Vec3(0.05, -0.02, 0.1));
+  EXPECT_NEAR((bracelet_visible_point(X_WH, width, camera, p, nullptr, Vec3(0, -1, 0)) -
+               bracelet_visible_point(X_WH, width, camera, p)).norm(), 0.0, 1e-15);
+}
+
 }  // namespace
 }  // namespace spidar::registration

@@ -249,5 +249,27 @@ TEST(Coverage, DegenerateInputsOwnNothingAndFitsStayFinite) {
   EXPECT_TRUE(hand::within_limits(q, models[1].limits));
 }
 
+// The forearm's outline runs from the wrist along the forearm it is given (a bent wrist), so that
+// the silhouette pixels of a bent forearm go to it and not to the hand.
+TEST(Coverage, TheForearmOutlineFollowsTheForearmsDirection) {
+  const auto models = test::model_hands();
+  const auto poses = test::reaching_hands();
+  const vision::Camera camera = vision::default_rig_camera();
+  const hand::HandParams& q = poses[1];
+  const Vec3 wrist = q.p_W_wrist();
+  const Mat3 R = hand::hand_pose(q).R.toRotationMatrix();
+  for (const Vec3& bend : {Vec3(0.0, -1.0, 0.0), Vec3(0.6, -0.8, 0.0), Vec3(0.0, -0.7, 0.7)}) {
+    const Vec3 forearm_H = bend.normalized();
+    ProjectedHand outline;
+    project_hand(models[1], q, camera, 0.03, &outline, forearm_H);
+    ASSERT_TRUE(outline.forearm.valid);
+    EXPECT_NEAR((outline.forearm.a - camera.project(wrist)).norm(), 0.0, 1e-9);
+    // Its far end projects from a point along R·forearm_H (whatever its length).
+    const Vec2 dir = (outline.forearm.c - outline.forearm.a).normalized();
+    const Vec2 expected = (camera.project(wrist + 0.05 * R * forearm_H) - outline.forearm.a).normalized();
+    EXPECT_GT(dir.dot(expected), 0.999) << forearm_H.transpose();
+  }
+}
+
 }  // namespace
 }  // namespace spidar::registration

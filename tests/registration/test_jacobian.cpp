@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "registration_test_util.hpp"
@@ -84,6 +85,8 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
                                                                  c.camera, c.params, across);
         ASSERT_GT(c.obs.wrist_thickness_px, 1.0);
       }
+      // A bent wrist (HandObservation::forearm_H): the bracelet sits along the forearm.
+      if (seed == 3) c.obs.forearm_H = Vec3(0.4, -0.8, 0.45).normalized();
       ImageEvidence image = c.mask.evidence(&c.camera, true);
       image.coverage = &c.owned;
       const ResidualProblem pr{&c.model, &c.obs, &image, &c.prior, &c.params};
@@ -98,6 +101,14 @@ TEST(ResidualJacobian, MatchesCentralDifferences) {
       EXPECT_GT(costs.joint_ball, 0.0) << "side " << side << " seed " << seed;
       EXPECT_GT(costs.silhouette, 0.0);
       EXPECT_GT(costs.prior, 0.0);
+      if (seed == 3) {  // the bent forearm moved the wrist term's point
+        HandObservation in_line = c.obs;
+        in_line.forearm_H = Vec3(0.0, -1.0, 0.0);
+        const ResidualProblem pr_in_line{&c.model, &in_line, &image, &c.prior, &c.params};
+        FrozenTargets tg_in_line;
+        freeze_targets(pr_in_line, c.q, &tg_in_line);
+        EXPECT_GT(std::abs(term_costs(pr_in_line, tg_in_line, c.q).wrist - costs.wrist), 1e-3 * costs.wrist);
+      }
       EXPECT_GT(tg.silhouette_count, 5);
       EXPECT_GT(tg.coverage_count, 5) << "side " << side << " seed " << seed;
       axis_points += tg.axis_count;

@@ -12,6 +12,7 @@
 /// pipeline per frame thread, whose GL context must be current.
 #include <array>
 #include <memory>
+#include <optional>
 #include <span>
 #include <opencv2/core/mat.hpp>
 
@@ -193,6 +194,12 @@ class FramePipeline {
   /// says), for a pipeline that learns no sizes itself (personalise_shape off): the comparison fit
   /// takes the main fit's estimate, so the two methods differ in nothing else.
   void use_model_sizes(const std::array<hand::HandModel, 2>& models);
+  /// Where each forearm points (left, right): world, from the wrist toward the elbow, for the next
+  /// frames' bracelet term, predicted bracelet and forearm outline, kept until set again; nullopt
+  /// (the default) or a non-finite or zero vector: in line with the hand, as the paper assumes.
+  /// For a rig that tracks the forearms, and for the registration study's --oracle-forearm (the
+  /// simulated user's true forearms: how much an estimate of their direction would be worth).
+  void set_forearm_directions(const std::array<std::optional<Vec3>, 2>& toward_elbow_W);
 
  private:
   struct Impl;

@@ -46,9 +46,12 @@ struct ProjectedHand {
   ImageCapsule forearm;
 };
 
-/// Draws hand `model` at pose `q` seen by `camera`. `forearm_radius_m` for the forearm capsule.
+/// Draws hand `model` at pose `q` seen by `camera`. `forearm_radius_m` for the forearm capsule,
+/// which runs from the wrist along `forearm_H` (right-hand H coordinates, unit; in line with the
+/// hand by default, HandObservation::forearm_H).
 void project_hand(const hand::HandModel& model, const hand::HandParams& q,
-                  const vision::Camera& camera, double forearm_radius_m, ProjectedHand* out);
+                  const vision::Camera& camera, double forearm_radius_m, ProjectedHand* out,
+                  const Vec3& forearm_H = Vec3(0.0, -1.0, 0.0));
 
 /// The nearest part of an outline to pixel `px`.
 struct OutlineNearest {

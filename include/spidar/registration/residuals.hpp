@@ -7,7 +7,7 @@
 /// Residual blocks, each divided by its σ (registration_params.hpp), in this order:
 ///   fingertip  p_W_fingertip(θ) − p̃_W (3 rows per valid, finite fingertip)            [m / m]
 ///   wrist      √conf · (uv(p_W_bracelet(θ)) − wrist_px) / σ_wrist (2 rows)              [px / px]
-///              p_W_bracelet = p_W_wrist + R_WH·(0, −bracelet_offset_m, 0) + s_W, with s_W the
+///              p_W_bracelet = p_W_wrist + R_WH·(bracelet_offset_m · forearm_H) + s_W, with s_W the
 ///              frozen shift to the band's visible surface (bracelet_visible_point)
 ///   band       √conf · dz(‖uv(e₁(θ)) − uv(e₀(θ))‖ / wrist_length_px − 1) / σ_band, dz(x) =
 ///              sign(x)·max(|x| − tolerance, 0) (1 row, where the band's length is measured and
@@ -150,9 +150,12 @@ inline double bracelet_radius_m(const RegistrationParams& params, double hand_wi
 /// Where the bracelet's detected midpoint should lie for a hand at pose `X_WH` seen from
 /// `p_W_camera` (world, m): the band centre, bracelet_offset_m from the wrist toward the elbow,
 /// shifted toward the camera across the forearm by bracelet_surface_shift × the band's radius
-/// (registration_params.hpp). `shift_W` (optional) receives the shift alone.
+/// (registration_params.hpp). `shift_W` (optional) receives the shift alone. `forearm_H`: the
+/// forearm's direction toward the elbow in right-hand H coordinates (HandObservation::forearm_H;
+/// unit, (0, −1, 0) in line with the hand).
 Vec3 bracelet_visible_point(const Pose& X_WH, double hand_width_m, const Vec3& p_W_camera,
-                            const RegistrationParams& params, Vec3* shift_W = nullptr);
+                            const RegistrationParams& params, Vec3* shift_W = nullptr,
+                            const Vec3& forearm_H = Vec3(0.0, -1.0, 0.0));
 
 /// The band's two ends across the forearm as seen from `p_W_camera` (world, m), for a hand at
 /// pose `X_WH` (the x axis's sign does not matter): the forearm's section at the band is an

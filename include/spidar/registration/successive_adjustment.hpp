@@ -58,6 +58,10 @@ struct HandObservation {
   /// axis) [px] and that long axis in the image (unit), under the same conditions; 0 = not measured.
   double wrist_thickness_px = 0.0;
   Vec2 wrist_axis_px = Vec2::Zero();
+  /// The forearm's direction from the wrist toward the elbow, in right-hand H coordinates (unit):
+  /// the bracelet sits bracelet_offset_m along it. (0, −1, 0) is the forearm in line with the
+  /// hand (the paper's assumption); a bent wrist turns it (pipeline::forearm_direction).
+  Vec3 forearm_H = Vec3(0.0, -1.0, 0.0);
 };
 
 /// The image evidence shared by both hands. Without a camera only the 3D terms and the prior act.
