@@ -12,6 +12,7 @@
 
 #include "spidar/hand/hand_config.hpp"
 #include "spidar/hand/rotation_vector.hpp"
+#include "spidar/registration/forearm_from_band.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
@@ -31,6 +32,7 @@ struct Frame {
   vision::ChromaKeyResult key;
   vision::SilhouetteDistance distance;
   std::array<registration::HandObservation, 2> obs;
+  std::array<vision::BraceletObservation, 2> bands;
   std::vector<std::array<hand::HandParams, 2>> starts;
   bool ok = false;
 };
@@ -84,6 +86,7 @@ const Frame& frame() {
         fr->obs[h].p_W_fingertip[i] = p.p_W_fingertip[i] + Vec3(noise(rng), noise(rng), noise(rng));
         fr->obs[h].fingertip_valid[i] = true;
       }
+      fr->bands[h] = (*bracelets)[h];
       if ((*bracelets)[h].found) {
         fr->obs[h].wrist_px = (*bracelets)[h].wrist_px;
         fr->obs[h].wrist_confidence = (*bracelets)[h].confidence;
@@ -131,6 +134,27 @@ void RegistrationBothHands(benchmark::State& state) {
   state.counters["iterations_per_hand"] =
       fits ? static_cast<double>(iterations) / static_cast<double>(fits) : 0.0;
 }
+// The forearms' bend from both bands (registration/forearm_from_band.hpp: every candidate bend's
+// band predicted and compared), as the pipeline runs it before the fits with forearm_from_band.
+void ForearmFromBandBothHands(benchmark::State& state) {
+  const Frame& f = frame();
+  if (!f.ok) return state.SkipWithError("no headless GL or synthetic frame");
+  if (!f.bands[0].found || !f.bands[1].found) return state.SkipWithError("a bracelet was not found");
+  registration::RegistrationParams params;
+  params.forearm_from_band = true;
+  for (auto _ : state) {
+    for (int h = 0; h < 2; ++h) {
+      const vision::BraceletObservation& b = f.bands[h];
+      const registration::BandObservation band{b.end_a_px, b.end_b_px, b.length_px, b.thickness_px, b.fill};
+      const Vec3 last(0.0, -1.0, 0.0);
+      auto d = registration::forearm_from_band(hand::hand_pose(f.truth[h]), f.models[h].shape.dimensions.width,
+                                               f.camera, params, band, &last);
+      benchmark::DoNotOptimize(d);
+    }
+  }
+}
+BENCHMARK(ForearmFromBandBothHands)->Unit(benchmark::kMicrosecond);
+
 BENCHMARK(RegistrationBothHands)
     ->ArgNames({"silhouette", "little_free"})
     ->Args({0, 0})

@@ -11,6 +11,7 @@
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/coverage.hpp"
 #include "spidar/registration/fingertip_reach.hpp"
+#include "spidar/registration/forearm_from_band.hpp"
 #include "spidar/registration/wrist_depth.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/registration/shape_estimator.hpp"
@@ -123,6 +124,9 @@ struct FramePipeline::Impl {
   /// at the previous fit (HandObservation::forearm_H), set at the start of each frame.
   std::array<std::optional<Vec3>, 2> toward_elbow_W;
   std::array<Vec3, 2> forearm_H{Vec3(0.0, -1.0, 0.0), Vec3(0.0, -1.0, 0.0)};
+  /// The forearms' directions estimated from their bands (registration/forearm_from_band.hpp),
+  /// world, from the last frame that showed them.
+  std::array<std::optional<Vec3>, 2> estimated_toward_elbow_W;
 
   Status key_and_evidence(const cv::Mat& bgr, const vision::ChromaKeyResult* matte, FrameResult* out);
   Status find_bracelets(const cv::Mat& bgr, FrameResult* out);
@@ -200,6 +204,7 @@ void FramePipeline::reset() {
   // reach the live run's sizes.
   for (int h = 0; h < 2; ++h) s.models[h] = fit_model(s.start[h], s.params);
   s.make_estimators();
+  s.estimated_toward_elbow_W = {};
 }
 Status FramePipeline::warm_start(const std::array<hand::HandParams, 2>& fits) {
   for (int h = 0; h < 2; ++h)
@@ -333,7 +338,8 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   // the forearm outline that decides the silhouette's owners, and the bracelet term.
   for (int h = 0; h < 2; ++h) {
     s.forearm_H[h] = Vec3(0.0, -1.0, 0.0);
-    const auto& d = s.toward_elbow_W[static_cast<std::size_t>(h)];
+    const auto& given = s.toward_elbow_W[static_cast<std::size_t>(h)];
+    const auto& d = given ? given : s.estimated_toward_elbow_W[static_cast<std::size_t>(h)];
     if (s.have_previous && d && d->allFinite() && d->norm() > 0.5)
       s.forearm_H[h] = hand::hand_pose(s.previous[h]).R.toRotationMatrix().transpose() * d->normalized();
   }
@@ -366,6 +372,21 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   for (int h = 0; h < 2; ++h) {
     registration::HandObservation obs;
     obs.forearm_H = s.forearm_H[h];
+    // The forearm's bend from this frame's band, from the previous fit's pose (forearm_from_band.hpp);
+    // directions given by set_forearm_directions take precedence.
+    if (registration::forearms_from_bands(p.registration) && s.have_previous &&
+        !s.toward_elbow_W[static_cast<std::size_t>(h)] && out->bracelets[h].found) {
+      const vision::BraceletObservation& b = out->bracelets[h];
+      const registration::BandObservation band{b.end_a_px, b.end_b_px, b.length_px, b.thickness_px, b.fill};
+      const Pose X_WH = hand::hand_pose(s.previous[h]);
+      const auto& last = s.estimated_toward_elbow_W[static_cast<std::size_t>(h)];
+      const Vec3 last_H = last ? Vec3(X_WH.R.conjugate() * *last) : Vec3(0.0, -1.0, 0.0);
+      if (const auto est = registration::forearm_from_band(X_WH, s.models[h].shape.dimensions.width, s.camera,
+                                                           p.registration, band, &last_H)) {
+        obs.forearm_H = *est;
+        s.estimated_toward_elbow_W[static_cast<std::size_t>(h)] = X_WH.R * *est;
+      }
+    }
     for (int f = 0; f < hand::kFingertipCount; ++f) {
       const int d = p.fingers[h][f];
       const Vec3 x = device::fingertip_position(tips, d);
@@ -483,6 +504,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       ++out->reaches;
     out->hands[h] = q;
     out->fits[h] = report;
+    out->toward_elbow_W[h] = hand::hand_pose(s.have_previous ? s.previous[h] : q).R * obs.forearm_H;
     out->models[h] = s.models[h];
     // Personalisation: this frame's evidence on the hand's sizes; the next fit uses the estimate.
     // Only a fit that agrees with the strings is evidence on the sizes: a broken one (a lost

@@ -22,6 +22,7 @@ void copy_frame_result(const FrameResult& from, FrameResult* to) {
   to->restarts = from.restarts;
   to->reaches = from.reaches;
   to->bracelets = from.bracelets;
+  to->toward_elbow_W = from.toward_elbow_W;
   copy_image(from.key.alpha, to->key.alpha);
   copy_image(from.key.silhouette, to->key.silhouette);
   copy_image(from.key.foreground, to->key.foreground);

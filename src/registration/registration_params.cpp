@@ -59,6 +59,12 @@ constexpr Field kFields[] = {
     {"digit_axis_sigma_px", &RegistrationParams::digit_axis_sigma_px, nullptr, kMinSigmaPx, 1000.0, false, "px", true},
     {"little_coupling_sigma_rad", &RegistrationParams::little_coupling_sigma_rad, nullptr, kMinSigmaRad, 100.0, false,
      "rad"},
+    {"forearm_max_bend_rad", &RegistrationParams::forearm_max_bend_rad, nullptr, 0.0, 1.5707963267948966, true, "rad"},
+    {"forearm_thickness_sigma", &RegistrationParams::forearm_thickness_sigma, nullptr, kMinSigmaRatio, 100.0, false, ""},
+    {"forearm_axis_sigma_rad", &RegistrationParams::forearm_axis_sigma_rad, nullptr, kMinSigmaRad, 100.0, false, "rad"},
+    {"forearm_bend_sigma_rad", &RegistrationParams::forearm_bend_sigma_rad, nullptr, kMinSigmaRad, 100.0, false, "rad"},
+    {"forearm_previous_sigma_rad", &RegistrationParams::forearm_previous_sigma_rad, nullptr, kMinSigmaRad, 100.0, false,
+     "rad"},
     {"prior_sigma_wrist_m", &RegistrationParams::prior_sigma_wrist_m, nullptr, kMinSigmaM, 100.0, false,
      "m"},
     {"prior_sigma_rotation_rad", &RegistrationParams::prior_sigma_rotation_rad, nullptr, kMinSigmaRad,
@@ -116,7 +122,9 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
                     "matte_threshold", "silhouette_term", "silhouette_inward", "silhouette_sigma_px",
                     "silhouette_samples_per_bone", "coverage_sigma_px", "coverage_stride_px",
                     "coverage_max_px", "coverage_huber_px", "digit_axis_sigma_px", "little_free",
-                    "little_coupling_sigma_rad", "prior_sigma_wrist_m",
+                    "little_coupling_sigma_rad", "forearm_from_band", "forearm_max_bend_rad",
+                    "forearm_thickness_sigma", "forearm_axis_sigma_rad", "forearm_bend_sigma_rad",
+                    "forearm_previous_sigma_rad", "prior_sigma_wrist_m",
                     "prior_sigma_rotation_rad", "prior_sigma_joint_rad", "lambda_initial",
                     "max_iterations", "cost_epsilon", "step_epsilon", "relative_epsilon"});
   RegistrationParams p;
@@ -137,6 +145,7 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
   if (auto b = node.find("silhouette_term")) p.silhouette_term = b->as_bool();
   if (auto b = node.find("silhouette_inward")) p.silhouette_inward = b->as_bool();
   if (auto b = node.find("little_free")) p.little_free = b->as_bool();
+  if (auto b = node.find("forearm_from_band")) p.forearm_from_band = b->as_bool();
   // Every field was range-checked at its key; this only guards against the table and the
   // struct drifting apart.
   if (auto s = validate(p); !s.ok()) node.fail(s.error().message);

@@ -118,6 +118,10 @@ struct FrameResult {
   int depth_switches = 0;  ///< hands whose fit was kept from the wrist's other depth this frame
   int reaches = 0;   ///< hands whose fit was kept from a digit re-posed to its string this frame
   std::array<vision::BraceletObservation, 2> bracelets;
+  /// The forearms' directions the fits used (world, unit, from the wrist toward the elbow): given
+  /// (set_forearm_directions), estimated from the bands (RegistrationParams::forearm_from_band), or
+  /// in line with the hand.
+  std::array<Vec3, 2> toward_elbow_W{Vec3(0.0, -1.0, 0.0), Vec3(0.0, -1.0, 0.0)};
   vision::ChromaKeyResult key;
   render::RenderTargets virt;   ///< the virtual scene with the fitted hands (hidden): colour,
                                 ///< depth, hand_depth, hand_id (finger render::kForearmPart on

@@ -133,6 +133,22 @@ struct RegistrationParams {
   /// (little_moves_freely): the paper's method keeps the paper's little finger.
   bool little_free = true;
   double little_coupling_sigma_rad = 0.25;  ///< σ of (little − ring) per angle [rad]
+  /// The forearms' direction from their bands (registration/forearm_from_band.hpp): each frame,
+  /// the bend within forearm_max_bend_rad of the hand's axis whose band best explains the detected
+  /// band's thickness and long axis, for the bracelet term and the forearm's outline (the paper's
+  /// forearm is in line with the hand). Only with silhouette_term (forearms_from_bands): the
+  /// paper's method keeps the paper's forearm. Measured 2026-11-28 (docs/measurements.md, "The
+  /// forearm's direction"): with bending wrists, registration study, five users, IoU +0.02..0.08
+  /// over the in-line forearm, within 0.03 of the true forearm given. Off by default: a band seen
+  /// nearly end-on does not tell a tilt toward the camera from one away from it, and the estimate
+  /// can keep the wrong one (a test pose: 42° off against 33° in line); with the in-line
+  /// simulated forearm it is mixed (IoU −0.02..+0.04 by user).
+  bool forearm_from_band = false;
+  double forearm_max_bend_rad = 1.2;        ///< the wrist's bend, at most (a cone) [rad], (0, π/2]
+  double forearm_thickness_sigma = 0.3;     ///< σ of the band's thickness, predicted / detected − 1
+  double forearm_axis_sigma_rad = 0.05;     ///< σ of the band's long axis's angle [rad]
+  double forearm_bend_sigma_rad = 0.8;      ///< σ of the prior toward the in-line forearm [rad]
+  double forearm_previous_sigma_rad = 0.3;  ///< σ of the prior toward the last estimate [rad]
   // --- temporal prior (toward the previous frame's parameters) ---
   double prior_sigma_wrist_m = 0.02;     ///< [m]
   double prior_sigma_rotation_rad = 0.2; ///< [rad]
@@ -150,6 +166,10 @@ struct RegistrationParams {
 /// Whether a fit's little finger moves on its own: little_free with the silhouette term (the
 /// image is all that observes it). The paper's method (no silhouette term) always copies the ring.
 inline bool little_moves_freely(const RegistrationParams& p) { return p.little_free && p.silhouette_term; }
+
+/// Whether the forearms' direction is estimated from their bands: forearm_from_band with the
+/// silhouette term. The paper's method keeps its forearm in line with the hand.
+inline bool forearms_from_bands(const RegistrationParams& p) { return p.forearm_from_band && p.silhouette_term; }
 
 /// Upper bound of silhouette_samples_per_bone (fixed-size storage, no allocation per frame).
 inline constexpr int kMaxSilhouetteSamplesPerBone = 8;

@@ -1,0 +1,50 @@
+#pragma once
+/// Where a forearm points, from its bracelet's band in the image. The 17-DOF hand has no wrist
+/// joint; the registration puts the bracelet along the forearm it is given
+/// (HandObservation::forearm_H), in line with the hand unless told otherwise. A real wrist bends
+/// by tens of degrees, mostly toward or away from the camera when the hands work on a table below
+/// it, and the forearm's direction in the image alone cannot show that.
+///
+/// The band can: it is a ring around the forearm (registration_params.hpp's section, width
+/// bracelet_width_m), and how thick it looks across its long axis says how obliquely the camera
+/// sees the forearm (a thin strip from the side, a full ring end-on); its long axis lies across the
+/// forearm's image direction. Each candidate direction within the wrist's bend (a cone about the
+/// hand's axis) predicts both for the band around that forearm (hand::wrist_bend applied to the
+/// hand's pose); the estimate is the candidate whose prediction is nearest the detection, with a
+/// prior toward the in-line forearm and one toward the previous frame's estimate (the two signs of
+/// the tilt, toward or away from the camera, look alike).
+#include <optional>
+
+#include "spidar/core/types.hpp"
+#include "spidar/registration/registration_params.hpp"
+#include "spidar/vision/camera.hpp"
+
+namespace spidar::registration {
+
+/// The candidates: bends 0 .. RegistrationParams::forearm_max_bend_rad in this many steps, each
+/// (but 0) at this many directions around the hand's axis.
+inline constexpr int kForearmBendSteps = 8;
+inline constexpr int kForearmAzimuthSteps = 16;
+/// A band less solid than this (its red share of its oriented box) is no evidence: torn or mostly
+/// hidden. A crescent, the band's near side seen obliquely, fills about 0.35 of its box.
+inline constexpr double kForearmBandMinFill = 0.2;
+
+
+/// The detected band (vision::BraceletObservation's fields).
+struct BandObservation {
+  Vec2 end_a_px = Vec2::Zero(), end_b_px = Vec2::Zero();  ///< ends along its long axis [px]
+  double length_px = 0;     ///< extent along the long axis [px]
+  double thickness_px = 0;  ///< extent across it [px]
+  double fill = 0;          ///< share of its oriented box that is red, 0..1
+};
+
+/// The forearm's direction (right-hand H coordinates, unit, toward the elbow) for a hand at pose
+/// X_WH of width hand_width_m [m], seen by `camera`, from its detected band; `previous_H` the last
+/// estimate (H coordinates) or null. Uses the band's geometry (bracelet_*) and the forearm_*
+/// settings of `params`. nullopt where the band is no evidence (torn, degenerate, not finite) or
+/// no candidate's band is in front of the camera.
+std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                                      const RegistrationParams& params, const BandObservation& band,
+                                      const Vec3* previous_H);
+
+}  // namespace spidar::registration

@@ -1,0 +1,63 @@
+#include "spidar/registration/forearm_from_band.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "spidar/core/units.hpp"
+#include "spidar/hand/forearm.hpp"
+#include "spidar/registration/residuals.hpp"
+
+namespace spidar::registration {
+
+std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                                      const RegistrationParams& params, const BandObservation& band,
+                                      const Vec3* previous_H) {
+  const RegistrationParams& o = params;
+  const Vec2 axis_obs = band.end_b_px - band.end_a_px;
+  if (!(band.fill >= kForearmBandMinFill) || !(band.length_px > 1.0) || !(band.thickness_px > 0.5) ||
+      !(axis_obs.norm() > 1e-6) || !axis_obs.allFinite() || !X_WH.p.allFinite())
+    return std::nullopt;
+  if (!(o.forearm_max_bend_rad > 0)) return std::nullopt;
+  const Vec2 axis_unit = axis_obs.normalized();
+  const Vec2 across(-axis_unit.y(), axis_unit.x());
+  const Mat3 R = X_WH.R.toRotationMatrix();
+  const double elongation_obs = std::clamp(1.0 - band.thickness_px / band.length_px, 0.0, 1.0);
+  double best = std::numeric_limits<double>::infinity();
+  std::optional<Vec3> best_H;
+  for (int i = 0; i <= kForearmBendSteps; ++i) {
+    const double bend = o.forearm_max_bend_rad * i / kForearmBendSteps;
+    const int azimuths = i == 0 ? 1 : kForearmAzimuthSteps;
+    for (int k = 0; k < azimuths; ++k) {
+      const double phi = 2.0 * units::kPi * k / azimuths;
+      // About −y_H: bend toward x_H cos φ + z_H sin φ.
+      const Vec3 d_H(std::sin(bend) * std::cos(phi), -std::cos(bend), std::sin(bend) * std::sin(phi));
+      const Vec3 d_W = R * d_H;
+      const Pose X_WF{Quat(hand::wrist_bend(R, d_W) * R).normalized(), X_WH.p};
+      const double thickness = bracelet_band_thickness(X_WF, hand_width_m, camera, params, across);
+      if (!(thickness > 0)) continue;
+      const auto ends = bracelet_band_ends(X_WF, hand_width_m, camera.X_WC().p, params);
+      if (camera.depth(ends[0]) < 1e-3 || camera.depth(ends[1]) < 1e-3) continue;
+      const Vec2 axis_pred = camera.project(ends[1]) - camera.project(ends[0]);
+      if (!(axis_pred.norm() > 1e-6)) continue;
+      // The long axis's angle, either sign, counted as far as the band is elongated.
+      const double c = std::abs(axis_pred.normalized().dot(axis_unit));
+      const double angle = std::acos(std::clamp(c, 0.0, 1.0));
+      const double r_t = (thickness / band.thickness_px - 1.0) / o.forearm_thickness_sigma;
+      const double r_a = elongation_obs * angle / o.forearm_axis_sigma_rad;
+      const double r_b = bend / o.forearm_bend_sigma_rad;
+      double cost = r_t * r_t + r_a * r_a + r_b * r_b;
+      if (previous_H && previous_H->allFinite()) {
+        const double a = std::acos(std::clamp(previous_H->normalized().dot(d_H), -1.0, 1.0));
+        cost += (a / o.forearm_previous_sigma_rad) * (a / o.forearm_previous_sigma_rad);
+      }
+      if (cost < best) {
+        best = cost;
+        best_H = d_H;
+      }
+    }
+  }
+  return best_H;
+}
+
+}  // namespace spidar::registration
