@@ -23,41 +23,59 @@ std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, con
   const Vec2 across(-axis_unit.y(), axis_unit.x());
   const Mat3 R = X_WH.R.toRotationMatrix();
   const double elongation_obs = std::clamp(1.0 - band.thickness_px / band.length_px, 0.0, 1.0);
-  double best = std::numeric_limits<double>::infinity();
-  std::optional<Vec3> best_H;
-  for (int i = 0; i <= kForearmBendSteps; ++i) {
-    const double bend = o.forearm_max_bend_rad * i / kForearmBendSteps;
-    const int azimuths = i == 0 ? 1 : kForearmAzimuthSteps;
-    for (int k = 0; k < azimuths; ++k) {
-      const double phi = 2.0 * units::kPi * k / azimuths;
-      // About −y_H: bend toward x_H cos φ + z_H sin φ.
-      const Vec3 d_H(std::sin(bend) * std::cos(phi), -std::cos(bend), std::sin(bend) * std::sin(phi));
-      const Vec3 d_W = R * d_H;
-      const Pose X_WF{Quat(hand::wrist_bend(R, d_W) * R).normalized(), X_WH.p};
-      const double thickness = bracelet_band_thickness(X_WF, hand_width_m, camera, params, across);
-      if (!(thickness > 0)) continue;
-      const auto ends = bracelet_band_ends(X_WF, hand_width_m, camera.X_WC().p, params);
-      if (camera.depth(ends[0]) < 1e-3 || camera.depth(ends[1]) < 1e-3) continue;
-      const Vec2 axis_pred = camera.project(ends[1]) - camera.project(ends[0]);
-      if (!(axis_pred.norm() > 1e-6)) continue;
-      // The long axis's angle, either sign, counted as far as the band is elongated.
-      const double c = std::abs(axis_pred.normalized().dot(axis_unit));
-      const double angle = std::acos(std::clamp(c, 0.0, 1.0));
-      const double r_t = (thickness / band.thickness_px - 1.0) / o.forearm_thickness_sigma;
-      const double r_a = elongation_obs * angle / o.forearm_axis_sigma_rad;
-      const double r_b = bend / o.forearm_bend_sigma_rad;
-      double cost = r_t * r_t + r_a * r_a + r_b * r_b;
-      if (previous_H && previous_H->allFinite()) {
-        const double a = std::acos(std::clamp(previous_H->normalized().dot(d_H), -1.0, 1.0));
-        cost += (a / o.forearm_previous_sigma_rad) * (a / o.forearm_previous_sigma_rad);
-      }
-      if (cost < best) {
-        best = cost;
-        best_H = d_H;
-      }
+  // The cost of the forearm bent by `bend` toward x_H cos φ + z_H sin φ (about −y_H); +∞ where
+  // its band is not in front of the camera.
+  auto cost_of = [&](double bend, double phi) {
+    const Vec3 d_H(std::sin(bend) * std::cos(phi), -std::cos(bend), std::sin(bend) * std::sin(phi));
+    const Vec3 d_W = R * d_H;
+    const Pose X_WF{Quat(hand::wrist_bend(R, d_W) * R).normalized(), X_WH.p};
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    const double thickness = bracelet_band_thickness(X_WF, hand_width_m, camera, params, across);
+    if (!(thickness > 0)) return kInf;
+    const auto ends = bracelet_band_ends(X_WF, hand_width_m, camera.X_WC().p, params);
+    if (camera.depth(ends[0]) < 1e-3 || camera.depth(ends[1]) < 1e-3) return kInf;
+    const Vec2 axis_pred = camera.project(ends[1]) - camera.project(ends[0]);
+    if (!(axis_pred.norm() > 1e-6)) return kInf;
+    // The long axis's angle, either sign, counted as far as the band is elongated.
+    const double c = std::abs(axis_pred.normalized().dot(axis_unit));
+    const double angle = std::acos(std::clamp(c, 0.0, 1.0));
+    const double r_t = (thickness / band.thickness_px - 1.0) / o.forearm_thickness_sigma;
+    const double r_a = elongation_obs * angle / o.forearm_axis_sigma_rad;
+    const double r_b = bend / o.forearm_bend_sigma_rad;
+    double cost = r_t * r_t + r_a * r_a + r_b * r_b;
+    if (previous_H && previous_H->allFinite()) {
+      const double a = std::acos(std::clamp(previous_H->normalized().dot(d_H), -1.0, 1.0));
+      cost += (a / o.forearm_previous_sigma_rad) * (a / o.forearm_previous_sigma_rad);
     }
+    return cost;
+  };
+  double best = std::numeric_limits<double>::infinity(), best_bend = 0, best_phi = 0;
+  auto consider = [&](double bend, double phi) {
+    bend = std::clamp(bend, 0.0, o.forearm_max_bend_rad);
+    const double c = cost_of(bend, phi);
+    if (c < best) best = c, best_bend = bend, best_phi = phi;
+  };
+  // A coarse grid over the cone, and the last estimate itself (a track keeps its basin) ...
+  for (int i = 0; i <= kForearmBendSteps; ++i) {
+    const int azimuths = i == 0 ? 1 : kForearmAzimuthSteps;
+    for (int k = 0; k < azimuths; ++k)
+      consider(o.forearm_max_bend_rad * i / kForearmBendSteps, 2.0 * units::kPi * k / azimuths);
   }
-  return best_H;
+  if (previous_H && previous_H->allFinite() && previous_H->norm() > 1e-9) {
+    const Vec3 d = previous_H->normalized();
+    consider(std::acos(std::clamp(-d.y(), -1.0, 1.0)), std::atan2(d.z(), d.x()));
+  }
+  if (!std::isfinite(best)) return std::nullopt;
+  // ... then refined around the best, the steps halved each round.
+  double step_bend = 0.5 * o.forearm_max_bend_rad / kForearmBendSteps;
+  double step_phi = units::kPi / kForearmAzimuthSteps;
+  for (int round = 0; round < kForearmRefinements; ++round, step_bend *= 0.5, step_phi *= 0.5) {
+    const double b0 = best_bend, p0 = best_phi;
+    for (int db = -1; db <= 1; ++db)
+      for (int dp = -1; dp <= 1; ++dp)
+        if (db != 0 || dp != 0) consider(b0 + db * step_bend, p0 + dp * step_phi);
+  }
+  return Vec3(std::sin(best_bend) * std::cos(best_phi), -std::cos(best_bend), std::sin(best_bend) * std::sin(best_phi));
 }
 
 }  // namespace spidar::registration

@@ -12,7 +12,8 @@
 /// hand's axis) predicts both for the band around that forearm (hand::wrist_bend applied to the
 /// hand's pose); the estimate is the candidate whose prediction is nearest the detection, with a
 /// prior toward the in-line forearm and one toward the previous frame's estimate (the two signs of
-/// the tilt, toward or away from the camera, look alike).
+/// the tilt, toward or away from the camera, look alike). A search, not a descent: the cost has
+/// a minimum for each sign.
 #include <optional>
 
 #include "spidar/core/types.hpp"
@@ -21,10 +22,12 @@
 
 namespace spidar::registration {
 
-/// The candidates: bends 0 .. RegistrationParams::forearm_max_bend_rad in this many steps, each
-/// (but 0) at this many directions around the hand's axis.
-inline constexpr int kForearmBendSteps = 8;
-inline constexpr int kForearmAzimuthSteps = 16;
+/// The candidates: a coarse grid of bends 0 .. RegistrationParams::forearm_max_bend_rad in this
+/// many steps, each (but 0) at this many directions around the hand's axis, and the last estimate;
+/// then this many rounds of the 8 neighbours of the best, at half the grid's steps and halving.
+inline constexpr int kForearmBendSteps = 4;
+inline constexpr int kForearmAzimuthSteps = 8;
+inline constexpr int kForearmRefinements = 3;
 /// A band less solid than this (its red share of its oriented box) is no evidence: torn or mostly
 /// hidden. A crescent, the band's near side seen obliquely, fills about 0.35 of its box.
 inline constexpr double kForearmBandMinFill = 0.2;

@@ -138,11 +138,11 @@ struct RegistrationParams {
   /// band's thickness and long axis, for the bracelet term and the forearm's outline (the paper's
   /// forearm is in line with the hand). Only with silhouette_term (forearms_from_bands): the
   /// paper's method keeps the paper's forearm. Measured 2026-11-28 (docs/measurements.md, "The
-  /// forearm's direction"): with bending wrists, registration study, five users, IoU +0.02..0.08
+  /// forearm's direction"): with bending wrists, registration study, five users, IoU +0.02..0.09
   /// over the in-line forearm, within 0.03 of the true forearm given. Off by default: a band seen
   /// nearly end-on does not tell a tilt toward the camera from one away from it, and the estimate
   /// can keep the wrong one (a test pose: 42° off against 33° in line); with the in-line
-  /// simulated forearm it is mixed (IoU −0.02..+0.04 by user).
+  /// simulated forearm, IoU −0.01..+0.05 by user, and the demo not yet measured with it.
   bool forearm_from_band = false;
   double forearm_max_bend_rad = 1.2;        ///< the wrist's bend, at most (a cone) [rad], (0, π/2]
   double forearm_thickness_sigma = 0.3;     ///< σ of the band's thickness, predicted / detected − 1
