@@ -9,11 +9,19 @@
 #include "spidar/registration/residuals.hpp"
 
 namespace spidar::registration {
+namespace {
+
+/// The forearm bent by `bend` [rad] from −y_H toward x_H cos φ + z_H sin φ (right-hand H, unit).
+Vec3 bent_forearm_H(double bend, double phi) {
+  return {std::sin(bend) * std::cos(phi), -std::cos(bend), std::sin(bend) * std::sin(phi)};
+}
+
+}  // namespace
 
 std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
                                       const RegistrationParams& params, const BandObservation& band,
                                       const Vec3* previous_H) {
-  const RegistrationParams& o = params;
+  const RegistrationParams& o = params;  // the forearm_* settings
   const Vec2 axis_obs = band.end_b_px - band.end_a_px;
   if (!(band.fill >= kForearmBandMinFill) || !(band.length_px > 1.0) || !(band.thickness_px > 0.5) ||
       !(axis_obs.norm() > 1e-6) || !axis_obs.allFinite() || !X_WH.p.allFinite())
@@ -23,10 +31,9 @@ std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, con
   const Vec2 across(-axis_unit.y(), axis_unit.x());
   const Mat3 R = X_WH.R.toRotationMatrix();
   const double elongation_obs = std::clamp(1.0 - band.thickness_px / band.length_px, 0.0, 1.0);
-  // The cost of the forearm bent by `bend` toward x_H cos φ + z_H sin φ (about −y_H); +∞ where
-  // its band is not in front of the camera.
+  // The cost of the forearm bent_forearm_H(bend, φ); +∞ where its band is not in front of the camera.
   auto cost_of = [&](double bend, double phi) {
-    const Vec3 d_H(std::sin(bend) * std::cos(phi), -std::cos(bend), std::sin(bend) * std::sin(phi));
+    const Vec3 d_H = bent_forearm_H(bend, phi);
     const Vec3 d_W = R * d_H;
     const Pose X_WF{Quat(hand::wrist_bend(R, d_W) * R).normalized(), X_WH.p};
     constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -75,7 +82,7 @@ std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, con
       for (int dp = -1; dp <= 1; ++dp)
         if (db != 0 || dp != 0) consider(b0 + db * step_bend, p0 + dp * step_phi);
   }
-  return Vec3(std::sin(best_bend) * std::cos(best_phi), -std::cos(best_bend), std::sin(best_bend) * std::sin(best_phi));
+  return bent_forearm_H(best_bend, best_phi);
 }
 
 }  // namespace spidar::registration

@@ -32,7 +32,6 @@ inline constexpr int kForearmRefinements = 3;
 /// hidden. A crescent, the band's near side seen obliquely, fills about 0.35 of its box.
 inline constexpr double kForearmBandMinFill = 0.2;
 
-
 /// The detected band (vision::BraceletObservation's fields).
 struct BandObservation {
   Vec2 end_a_px = Vec2::Zero(), end_b_px = Vec2::Zero();  ///< ends along its long axis [px]

@@ -60,7 +60,8 @@ struct HandObservation {
   Vec2 wrist_axis_px = Vec2::Zero();
   /// The forearm's direction from the wrist toward the elbow, in right-hand H coordinates (unit):
   /// the bracelet sits bracelet_offset_m along it. (0, −1, 0) is the forearm in line with the
-  /// hand (the paper's assumption); a bent wrist turns it (pipeline::forearm_direction).
+  /// hand (the paper's assumption); a bent wrist turns it (given to the pipeline by
+  /// FramePipeline::set_forearm_directions, or estimated by registration/forearm_from_band.hpp).
   Vec3 forearm_H = Vec3(0.0, -1.0, 0.0);
 };
 
