@@ -61,10 +61,11 @@ Action add_demo(CLI::App& app) {
   cmd->add_flag("--shaped-fingers", o->shaped_fingers,
                 "the simulated user's fingertips yield only where their fingers can move (stiffness "
                 "ellipsoids from their hands): their hands then reach the device's caps");
-  cmd->add_flag("--bending-wrists", o->bending_wrists,
-                "the simulated user's forearms point at elbows that stay where they were at the "
-                "script's start, and their wrists bend (up to 60 deg) when the hands turn (default: "
-                "forearms in line with the hands, as the registration's model has them)");
+  cmd->add_flag("--bending-wrists,!--in-line-forearms", o->bending_wrists,
+                "--bending-wrists (the default): the simulated user's forearms point at elbows that "
+                "stay where they were at the script's start, and their wrists bend (up to 60 deg) "
+                "when the hands turn; --in-line-forearms: forearms in line with the hands, as the "
+                "paper's model has them");
   cmd->add_flag("!--paper-registration", o->silhouette,
                 "register the main fit with the paper's joint-balls alone (default: joint-balls and "
                 "the hand-aware silhouette term; the other method always runs as the comparison)");

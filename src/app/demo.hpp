@@ -27,7 +27,7 @@ struct DemoOptions {
   std::string compositor = "depth";
   bool silhouette = true;          ///< the silhouette term in the main registration
   bool fixed_hand_size = false;    ///< no online hand-size personalisation (on in the demo)
-  bool bending_wrists = false;     ///< the user's wrists bend: forearms point at fixed elbows
+  bool bending_wrists = true;      ///< the user's wrists bend: forearms point at fixed elbows
   bool shaped_fingers = false;     ///< the user's fingertips held with their fingers' stiffness
   bool video = true;
 };

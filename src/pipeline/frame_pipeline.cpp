@@ -377,7 +377,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     if (registration::forearms_from_bands(p.registration) && s.have_previous &&
         !s.toward_elbow_W[static_cast<std::size_t>(h)] && out->bracelets[h].found) {
       const vision::BraceletObservation& b = out->bracelets[h];
-      const registration::BandObservation band{b.end_a_px, b.end_b_px, b.length_px, b.thickness_px, b.fill};
+      const registration::BandObservation band{b.end_a_px, b.end_b_px, b.length_px, b.thickness_px, b.fill, b.bulge_px};
       const Pose X_WH = hand::hand_pose(s.previous[h]);
       const auto& last = s.estimated_toward_elbow_W[static_cast<std::size_t>(h)];
       const Vec3 last_H = last ? Vec3(X_WH.R.conjugate() * *last) : Vec3(0.0, -1.0, 0.0);

@@ -31,13 +31,16 @@ std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, con
   const Vec2 across(-axis_unit.y(), axis_unit.x());
   const Mat3 R = X_WH.R.toRotationMatrix();
   const double elongation_obs = std::clamp(1.0 - band.thickness_px / band.length_px, 0.0, 1.0);
+  const double bulge_obs = std::isfinite(band.bulge_px) ? band.bulge_px / band.thickness_px : 0.0;
   // The cost of the forearm bent_forearm_H(bend, φ); +∞ where its band is not in front of the camera.
   auto cost_of = [&](double bend, double phi) {
     const Vec3 d_H = bent_forearm_H(bend, phi);
     const Vec3 d_W = R * d_H;
     const Pose X_WF{Quat(hand::wrist_bend(R, d_W) * R).normalized(), X_WH.p};
     constexpr double kInf = std::numeric_limits<double>::infinity();
-    const double thickness = bracelet_band_thickness(X_WF, hand_width_m, camera, params, across);
+    const BandProfile profile = bracelet_band_profile(X_WF, hand_width_m, camera, params, across,
+                                                         kForearmBandSamplesPerRim);
+    const double thickness = profile.hi_px - profile.lo_px;
     if (!(thickness > 0)) return kInf;
     const auto ends = bracelet_band_ends(X_WF, hand_width_m, camera.X_WC().p, params);
     if (camera.depth(ends[0]) < 1e-3 || camera.depth(ends[1]) < 1e-3) return kInf;
@@ -49,7 +52,10 @@ std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, con
     const double r_t = (thickness / band.thickness_px - 1.0) / o.forearm_thickness_sigma;
     const double r_a = elongation_obs * angle / o.forearm_axis_sigma_rad;
     const double r_b = bend / o.forearm_bend_sigma_rad;
-    double cost = r_t * r_t + r_a * r_a + r_b * r_b;
+    // The crescent's side: its area's centroid against the middle of its extent, per thickness.
+    const double bulge_pred = (profile.centroid_px - 0.5 * (profile.lo_px + profile.hi_px)) / thickness;
+    const double r_g = (bulge_pred - bulge_obs) / o.forearm_bulge_sigma;
+    double cost = r_t * r_t + r_a * r_a + r_b * r_b + r_g * r_g;
     if (previous_H && previous_H->allFinite()) {
       const double a = std::acos(std::clamp(previous_H->normalized().dot(d_H), -1.0, 1.0));
       cost += (a / o.forearm_previous_sigma_rad) * (a / o.forearm_previous_sigma_rad);

@@ -63,6 +63,7 @@ constexpr Field kFields[] = {
     {"forearm_thickness_sigma", &RegistrationParams::forearm_thickness_sigma, nullptr, kMinSigmaRatio, 100.0, false, ""},
     {"forearm_axis_sigma_rad", &RegistrationParams::forearm_axis_sigma_rad, nullptr, kMinSigmaRad, 100.0, false, "rad"},
     {"forearm_bend_sigma_rad", &RegistrationParams::forearm_bend_sigma_rad, nullptr, kMinSigmaRad, 100.0, false, "rad"},
+    {"forearm_bulge_sigma", &RegistrationParams::forearm_bulge_sigma, nullptr, kMinSigmaRatio, 100.0, false, ""},
     {"forearm_previous_sigma_rad", &RegistrationParams::forearm_previous_sigma_rad, nullptr, kMinSigmaRad, 100.0, false,
      "rad"},
     {"prior_sigma_wrist_m", &RegistrationParams::prior_sigma_wrist_m, nullptr, kMinSigmaM, 100.0, false,
@@ -124,7 +125,7 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
                     "coverage_max_px", "coverage_huber_px", "digit_axis_sigma_px", "little_free",
                     "little_coupling_sigma_rad", "forearm_from_band", "forearm_max_bend_rad",
                     "forearm_thickness_sigma", "forearm_axis_sigma_rad", "forearm_bend_sigma_rad",
-                    "forearm_previous_sigma_rad", "prior_sigma_wrist_m",
+                    "forearm_previous_sigma_rad", "forearm_bulge_sigma", "prior_sigma_wrist_m",
                     "prior_sigma_rotation_rad", "prior_sigma_joint_rad", "lambda_initial",
                     "max_iterations", "cost_epsilon", "step_epsilon", "relative_epsilon"});
   RegistrationParams p;

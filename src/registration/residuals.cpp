@@ -246,34 +246,65 @@ double bracelet_length_px(const Pose& X_WH, double hand_width_m, const vision::C
   return (camera.project(ends[1]) - camera.project(ends[0])).norm();
 }
 
-double bracelet_band_thickness(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
-                               const RegistrationParams& params, const Vec2& across_px,
-                               std::array<Vec3, 2>* ends) {
+BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                                  const RegistrationParams& params, const Vec2& across_px, int samples_per_rim) {
   const Mat3 R = X_WH.R.toRotationMatrix();
   const Vec3 x = R.col(0), z = R.col(2);  // across the forearm; y_H runs along it
   const auto [a, b] = band_section(params, hand_width_m);
   const Vec3 p_W_camera = camera.X_WC().p;
-  constexpr int kSamples = 48;  // around each rim
+  constexpr int kMaxSamples = 96;
+  const int kSamples = std::clamp(samples_per_rim, 8, kMaxSamples);
+  std::array<std::array<Vec2, kMaxSamples>, 2> image{};
+  std::array<std::array<bool, kMaxSamples>, 2> near{};
+  BandProfile out;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  Vec3 p_lo = Vec3::Zero(), p_hi = Vec3::Zero();
-  for (const double along : {params.bracelet_offset_m - 0.5 * params.bracelet_width_m,
-                             params.bracelet_offset_m + 0.5 * params.bracelet_width_m}) {
+  for (int r = 0; r < 2; ++r) {
+    const double along = params.bracelet_offset_m + (r == 0 ? -0.5 : 0.5) * params.bracelet_width_m;
     const Vec3 rim_centre = X_WH * Vec3(0.0, -along, 0.0);
     for (int k = 0; k < kSamples; ++k) {
       const double phi = 2.0 * units::kPi * k / kSamples;
       const double c = std::cos(phi), sn = std::sin(phi);
       const Vec3 p = rim_centre + a * c * x + b * sn * z;
       const Vec3 outward = (c / a) * x + (sn / b) * z;  // the ellipse's normal (unnormalised)
-      if (outward.dot(p_W_camera - p) <= 0.0) continue;  // the far side
-      if (camera.depth(p) < detail::kMinImageDepth) return 0.0;
-      const double u = camera.project(p).dot(across_px);
-      if (u < lo) lo = u, p_lo = p;
-      if (u > hi) hi = u, p_hi = p;
+      near[r][k] = outward.dot(p_W_camera - p) > 0.0;  // else the far side
+      if (!near[r][k]) continue;
+      if (camera.depth(p) < detail::kMinImageDepth) return BandProfile{};
+      image[r][k] = camera.project(p);
+      const double u = image[r][k].dot(across_px);
+      if (u < lo) lo = u, out.ends[0] = p;
+      if (u > hi) hi = u, out.ends[1] = p;
     }
   }
-  if (!(hi > lo)) return 0.0;
-  if (ends) *ends = {p_lo, p_hi};
-  return hi - lo;
+  if (!(hi > lo)) return BandProfile{};
+  // The near side's patches between the rims (each seen once: the band is convex), split into
+  // triangles: their areas and centroids along across_px.
+  double area = 0, moment = 0;
+  auto triangle = [&](const Vec2& p0, const Vec2& p1, const Vec2& p2) {
+    const Vec2 e1 = p1 - p0, e2 = p2 - p0;
+    const double t = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    area += t;
+    moment += t * (p0 + p1 + p2).dot(across_px) / 3.0;
+  };
+  for (int k = 0; k < kSamples; ++k) {
+    const int k1 = (k + 1) % kSamples;
+    if (!(near[0][k] && near[0][k1] && near[1][k] && near[1][k1])) continue;
+    triangle(image[0][k], image[0][k1], image[1][k1]);
+    triangle(image[0][k], image[1][k1], image[1][k]);
+  }
+  out.lo_px = lo;
+  out.hi_px = hi;
+  out.area_px = area;
+  out.centroid_px = area > 0 ? moment / area : 0.5 * (lo + hi);
+  return out;
+}
+
+double bracelet_band_thickness(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                               const RegistrationParams& params, const Vec2& across_px,
+                               std::array<Vec3, 2>* ends) {
+  const BandProfile b = bracelet_band_profile(X_WH, hand_width_m, camera, params, across_px);
+  if (!(b.hi_px > b.lo_px)) return 0.0;
+  if (ends) *ends = b.ends;
+  return b.hi_px - b.lo_px;
 }
 
 void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, FrozenTargets* tg) {

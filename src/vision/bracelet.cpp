@@ -292,6 +292,7 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
     o.wrist_px = 0.5 * (o.end_a_px + o.end_b_px);
     o.length_px = t_max - t_min + 1.0;
     o.thickness_px = s_max - s_min + 1.0;
+    o.bulge_px = -0.5 * (s_min + s_max);  // s is measured from the centroid
     o.area_px = area;
     o.pieces = static_cast<int>(members.size());
     cand.centroid_px = c;

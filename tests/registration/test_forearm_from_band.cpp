@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -28,8 +31,9 @@ BandObservation draw_band(const Pose& X_WH, const Vec3& d_W, double width, const
   const double a = bracelet_radius_m(p, width);
   const double b = p.bracelet_depth_ratio * p.bracelet_radius_per_width * width + p.bracelet_standoff_m;
   std::vector<Vec2> pts;
-  for (int j = 0; j <= 10; ++j) {
-    const double along = p.bracelet_offset_m + p.bracelet_width_m * (j / 10.0 - 0.5);
+  constexpr int kAlong = 40;
+  for (int j = 0; j <= kAlong; ++j) {
+    const double along = p.bracelet_offset_m + p.bracelet_width_m * (static_cast<double>(j) / kAlong - 0.5);
     for (int k = 0; k < 720; ++k) {
       const double phi = 2.0 * 3.14159265358979 * k / 720;
       const Vec3 q = X_WH.p - along * y + a * std::cos(phi) * x + b * std::sin(phi) * z;
@@ -51,7 +55,18 @@ BandObservation draw_band(const Pose& X_WH, const Vec3& d_W, double width, const
     lo_u = std::min(lo_u, (q - mean).dot(u)), hi_u = std::max(hi_u, (q - mean).dot(u));
     lo_v = std::min(lo_v, (q - mean).dot(v)), hi_v = std::max(hi_v, (q - mean).dot(v));
   }
+  // The pixels the points fall in, as a detector sees the band: the bulge is their centroid
+  // against the middle of their extent across u, along (−u_y, u_x).
+  std::set<std::pair<long, long>> pixels;
+  for (const Vec2& q : pts) pixels.insert({std::lround(q.x()), std::lround(q.y())});
+  const Vec2 across(-u.y(), u.x());
+  double s_sum = 0, s_lo = 1e9, s_hi = -1e9;
+  for (const auto& [px, py] : pixels) {
+    const double s = Vec2(static_cast<double>(px), static_cast<double>(py)).dot(across);
+    s_sum += s, s_lo = std::min(s_lo, s), s_hi = std::max(s_hi, s);
+  }
   BandObservation band;
+  band.bulge_px = s_sum / static_cast<double>(pixels.size()) - 0.5 * (s_lo + s_hi);
   band.end_a_px = mean + lo_u * u;
   band.end_b_px = mean + hi_u * u;
   band.length_px = hi_u - lo_u;
@@ -90,6 +105,45 @@ TEST(ForearmFromBand, FindsTheBendTheBandShows) {
     }
   }
   EXPECT_EQ(checked, 9);
+}
+
+// A tilt toward the camera and one away from it give bands of nearly the same thickness and axis;
+// the crescent's bulge tells them apart without a track. Without the bulge, the sign is a guess.
+TEST(ForearmFromBand, TheCrescentsSideTellsATiltTowardTheCameraFromOneAway) {
+  RegistrationParams with_bulge, without_bulge;
+  without_bulge.forearm_bulge_sigma = 100.0;
+  const vision::Camera camera = vision::default_rig_camera();
+  const double width = 0.083;
+  const Vec3 target = camera.X_WC().p + 0.45 * camera.ray_direction_W(Vec2(320, 260));
+  const Pose X_WH = Pose::FromRotationVector(Vec3(0.2, -0.3, 0.4), target);
+  const Mat3 R = X_WH.R.toRotationMatrix();
+  int right_with = 0, right_without = 0, cases = 0;
+  for (const double bend_deg : {35.0, 50.0}) {
+    for (const double sign : {1.0, -1.0}) {
+      // Bent toward ±z_H (dorsal or palmar): toward or away from the camera above the hand.
+      const double bend = bend_deg * 3.14159265358979 / 180.0;
+      const Vec3 d_W = (std::cos(bend) * -R.col(1) + sign * std::sin(bend) * R.col(2)).normalized();
+      const Vec3 mirror_W = (std::cos(bend) * -R.col(1) - sign * std::sin(bend) * R.col(2)).normalized();
+      const BandObservation band = draw_band(X_WH, d_W, width, camera, with_bulge);
+      ASSERT_GT(band.length_px, 10.0);
+      for (const bool bulge : {true, false}) {
+        const auto est = forearm_from_band(X_WH, width, camera, bulge ? with_bulge : without_bulge, band, nullptr);
+        ASSERT_TRUE(est.has_value());
+        const double err = angle_deg(R * *est, d_W), err_mirror = angle_deg(R * *est, mirror_W);
+        std::printf("bend %.0f° sign %+.0f, %s bulge (%.2f of %.1f px): error %.1f°, to the mirror %.1f°\n", bend_deg,
+                    sign, bulge ? "with" : "without", band.bulge_px, band.thickness_px, err, err_mirror);
+        if (bulge) {
+          EXPECT_LT(err, 20.0) << "bend " << bend_deg << " sign " << sign;
+          right_with += err < err_mirror ? 1 : 0;
+        } else {
+          right_without += err < err_mirror ? 1 : 0;
+        }
+      }
+      ++cases;
+    }
+  }
+  EXPECT_EQ(right_with, cases);
+  EXPECT_LT(right_without, cases) << "the bulge is what tells the sign here";
 }
 
 TEST(ForearmFromBand, ABandThatIsNoEvidenceGivesNone) {

@@ -1,6 +1,7 @@
 // Red bracelets on drawn hands: wrist position, hand assignment, partly hidden or missing bands.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -206,6 +207,48 @@ TEST(Bracelet, ARingSeenEndOnIsMatchedWhateverTheAxisPredicted) {
   EXPECT_FALSE(detect(band, &pred)[1].found);
   pred.axis_px[1] = Vec2(1.0, 0.0);
   EXPECT_TRUE(detect(band, &pred)[1].found);
+}
+
+// A band seen obliquely shows a crescent (its near side); the bulge says on which side of its long
+// axis the arc's apex lies, in the frame of its own ends. A straight strip and a whole ring have none.
+TEST(Bracelet, ACrescentsBulgePointsToItsApex) {
+  for (const double angle_deg : {0.0, 35.0, 90.0, 160.0}) {
+    for (const int apex_side : {-1, 1}) {
+      cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));
+      const cv::Point centre(320, 240);
+      // Half an ellipse (half axes 70 along the band, 30 across), 10 px thick (bulge ≈ 0.13 ×
+      // thickness; a thin arc's is 0.28); its apex at
+      // centre + apex_side × 30 px along the ellipse's minor axis.
+      const double start = apex_side > 0 ? 0.0 : 180.0;
+      cv::ellipse(bgr, centre, cv::Size(70, 30), angle_deg, start, start + 180.0, cv::Scalar(30, 30, 210), 10);
+      const double a = angle_deg * 3.14159265358979 / 180.0;
+      const Vec2 minor(-std::sin(a), std::cos(a));  // image y grows downward: OpenCV's +90° point
+      const Vec2 apex_dir = apex_side * minor;
+      BraceletWorkspace ws;
+      cv::Mat mask;
+      ASSERT_TRUE(red_mask(bgr, BraceletParams{}, &mask).ok());
+      find_bracelet_candidates(mask, BraceletParams{}, &ws);
+      ASSERT_FALSE(ws.candidates.empty());
+      const BraceletObservation& o = ws.candidates.front().observation;
+      const Vec2 u = (o.end_b_px - o.end_a_px).normalized();
+      const Vec2 across(-u.y(), u.x());
+      const double along_apex = across.dot(apex_dir) * o.bulge_px;  // the bulge toward the apex
+      EXPECT_GT(along_apex, 0.08 * o.thickness_px) << angle_deg << " deg, apex side " << apex_side;
+      EXPECT_LT(along_apex, 0.35 * o.thickness_px) << angle_deg << " deg, apex side " << apex_side;
+    }
+  }
+  for (const bool ring : {false, true}) {
+    cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));
+    if (ring) cv::ellipse(bgr, cv::Point(320, 240), cv::Size(70, 30), 25.0, 0.0, 360.0, cv::Scalar(30, 30, 210), 10);
+    else cv::rectangle(bgr, cv::Point(250, 230), cv::Point(390, 252), cv::Scalar(30, 30, 210), cv::FILLED);
+    BraceletWorkspace ws;
+    cv::Mat mask;
+    ASSERT_TRUE(red_mask(bgr, BraceletParams{}, &mask).ok());
+    find_bracelet_candidates(mask, BraceletParams{}, &ws);
+    ASSERT_FALSE(ws.candidates.empty());
+    const BraceletObservation& o = ws.candidates.front().observation;
+    EXPECT_LT(std::abs(o.bulge_px), 0.03 * o.thickness_px) << (ring ? "ring" : "strip");
+  }
 }
 
 TEST(Bracelet, LoneBandNearTheMidlineIsAmbiguousWithoutPredictions) {

@@ -11,9 +11,10 @@
 /// forearm's image direction. Each candidate direction within the wrist's bend (a cone about the
 /// hand's axis) predicts both for the band around that forearm (hand::wrist_bend applied to the
 /// hand's pose); the estimate is the candidate whose prediction is nearest the detection, with a
-/// prior toward the in-line forearm and one toward the previous frame's estimate (the two signs of
-/// the tilt, toward or away from the camera, look alike). A search, not a descent: the cost has
-/// a minimum for each sign.
+/// prior toward the in-line forearm and one toward the previous frame's estimate. The two signs of
+/// a tilt, toward or away from the camera, give nearly the same thickness and axis; the side to
+/// which the crescent (the band's near side seen obliquely) bulges tells them apart, as far as
+/// the band is not seen end-on. A search, not a descent: the cost has a minimum for each sign.
 #include <optional>
 
 #include "spidar/core/types.hpp"
@@ -28,6 +29,9 @@ namespace spidar::registration {
 inline constexpr int kForearmBendSteps = 4;
 inline constexpr int kForearmAzimuthSteps = 8;
 inline constexpr int kForearmRefinements = 3;
+/// Points around each rim of a candidate's band (bracelet_band_profile): 15° apart, its extent
+/// within 1 % of the band's radius.
+inline constexpr int kForearmBandSamplesPerRim = 32;
 /// A band less solid than this (its red share of its oriented box) is no evidence: torn or mostly
 /// hidden. A crescent, the band's near side seen obliquely, fills about 0.35 of its box.
 inline constexpr double kForearmBandMinFill = 0.2;
@@ -38,6 +42,9 @@ struct BandObservation {
   double length_px = 0;     ///< extent along the long axis [px]
   double thickness_px = 0;  ///< extent across it [px]
   double fill = 0;          ///< share of its oriented box that is red, 0..1
+  /// The red's centroid minus the middle of its extent across the long axis, along
+  /// (−u_y, u_x) for u the unit from end_a_px to end_b_px [px] (a crescent's bulge).
+  double bulge_px = 0;
 };
 
 /// The forearm's direction (right-hand H coordinates, unit, toward the elbow) for a hand at pose

@@ -138,17 +138,19 @@ struct RegistrationParams {
   /// band's thickness and long axis, for the bracelet term and the forearm's outline (the paper's
   /// forearm is in line with the hand). Only with silhouette_term (forearms_from_bands): the
   /// paper's method keeps the paper's forearm. Measured 2026-11-28 (docs/measurements.md, "The
-  /// forearm's direction"): with bending wrists, registration study, five users, IoU +0.02..0.09
-  /// over the in-line forearm, within 0.03 of the true forearm given. Off by default: a band seen
-  /// nearly end-on does not tell a tilt toward the camera from one away from it, and the estimate
-  /// can keep the wrong one (a test pose: 42° off against 33° in line); with the in-line
-  /// simulated forearm, IoU −0.01..+0.05 by user, and the demo not yet measured with it.
-  bool forearm_from_band = false;
+  /// forearm's direction"): with bending wrists, registration study, five users, IoU +0.02..0.10
+  /// over the in-line forearm, within 0.01 of the true forearm given; the crescent's bulge
+  /// (forearm_bulge_sigma) tells a tilt toward the camera from one away. With a simulated forearm
+  /// that stays in line (the paper's model's), the demo's IoU is 0.007 lower with it than without.
+  bool forearm_from_band = true;
   double forearm_max_bend_rad = 1.2;        ///< the wrist's bend, at most (a cone) [rad], (0, π/2]
   double forearm_thickness_sigma = 0.3;     ///< σ of the band's thickness, predicted / detected − 1
   double forearm_axis_sigma_rad = 0.05;     ///< σ of the band's long axis's angle [rad]
   double forearm_bend_sigma_rad = 0.8;      ///< σ of the prior toward the in-line forearm [rad]
   double forearm_previous_sigma_rad = 0.3;  ///< σ of the prior toward the last estimate [rad]
+  /// σ of the band's bulge (vision::BraceletObservation::bulge_px) as a share of its thickness,
+  /// predicted − detected: the crescent's side, which tells a tilt toward the camera from one away.
+  double forearm_bulge_sigma = 0.1;
   // --- temporal prior (toward the previous frame's parameters) ---
   double prior_sigma_wrist_m = 0.02;     ///< [m]
   double prior_sigma_rotation_rad = 0.2; ///< [rad]

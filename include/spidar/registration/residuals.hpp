@@ -171,10 +171,23 @@ std::array<Vec3, 2> bracelet_band_ends(const Pose& X_WH, double hand_width_m, co
 double bracelet_length_px(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
                           const RegistrationParams& params);
 
-/// The band's thickness in the image for a hand at pose `X_WH`: its near side (the points of
-/// both rims, bracelet_width_m apart along the forearm around bracelet_offset_m, whose outward
-/// normal faces the camera; the section as in bracelet_band_ends) projected, and its extent along
-/// `across_px` (unit, image). `ends` (optional) receives the two points giving the extent (world).
+/// The band's near side in the image for a hand at pose `X_WH` (the points of both rims,
+/// bracelet_width_m apart along the forearm around bracelet_offset_m, whose outward normal faces
+/// the camera; the section as in bracelet_band_ends), projected and measured along `across_px`
+/// (unit, image), from `samples_per_rim` points around each rim (8..96). All zero when a sampled
+/// point is behind the camera.
+struct BandProfile {
+  double lo_px = 0, hi_px = 0;  ///< its extent along across_px (image coordinates dotted with it) [px]
+  double centroid_px = 0;       ///< its area's centroid along across_px [px]
+  double area_px = 0;           ///< its area [px²]
+  std::array<Vec3, 2> ends{Vec3::Zero(), Vec3::Zero()};  ///< the points giving lo and hi (world) [m]
+};
+BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                                  const RegistrationParams& params, const Vec2& across_px,
+                                  int samples_per_rim = 48);
+
+/// The band's thickness in the image for a hand at pose `X_WH`: the extent of its near side
+/// (bracelet_band_profile) along `across_px` (unit, image). `ends` (optional) receives the two points giving the extent (world).
 /// 0 when a sampled point is behind the camera.
 double bracelet_band_thickness(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
                                const RegistrationParams& params, const Vec2& across_px,

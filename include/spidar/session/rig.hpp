@@ -45,7 +45,7 @@ struct SimulatedRigParams {
   /// script's start; the wrists bend (up to 60°) when the hands turn (sim::user_elbows). Off: the
   /// forearms stay in line with the hands, as the registration's model has them. Only the scripted
   /// user's synthetic camera (not `interactive`, not another camera).
-  bool bending_wrists = false;
+  bool bending_wrists = true;
 };
 
 /// The simulated SPIDAR-8 held by a simulated user (the scene's script, or interactive hands

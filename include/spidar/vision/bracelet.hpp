@@ -65,6 +65,12 @@ struct BraceletObservation {
   Vec2 end_b_px = Vec2::Zero();
   double length_px = 0;          ///< extent along the principal axis [px]
   double thickness_px = 0;       ///< extent across it [px]
+  /// Where the red lies across the band, as a crescent's bulge: the red's centroid minus the
+  /// middle of its extent across the long axis, along the unit across = (−u_y, u_x) for u the unit
+  /// from end_a_px to end_b_px [px]. About +0.28 × thickness for a thin arc whose apex lies on the
+  /// +across side, 0 for a straight strip or a whole ring (a band seen obliquely shows its near side,
+  /// a crescent, and its bulge tells toward which side the forearm tilts).
+  double bulge_px = 0;
   double fill = 0;               ///< share of its oriented box (length × thickness) that is red, 0..1
   int area_px = 0;
   int pieces = 0;                ///< connected red pieces merged into this bracelet
