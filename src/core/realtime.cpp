@@ -104,4 +104,11 @@ Status release_starved_thread(pthread_t thread) {
   return Ok{};
 }
 
+ThreadCounters thread_counters() {
+  rusage u{};
+  if (getrusage(RUSAGE_THREAD, &u) != 0) return {};
+  auto count = [](long v) { return v > 0 ? static_cast<std::uint64_t>(v) : std::uint64_t{0}; };
+  return {count(u.ru_majflt), count(u.ru_minflt), count(u.ru_nvcsw), count(u.ru_nivcsw)};
+}
+
 }  // namespace spidar::core

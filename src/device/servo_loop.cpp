@@ -4,6 +4,8 @@
 #include "spidar/core/realtime.hpp"
 
 #include <optional>
+#include <tuple>
+#include <utility>
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -234,6 +236,13 @@ void ServoLoop::end_servo_thread(pthread_t servo_thread, std::int64_t window_ns)
 
 void ServoLoop::run() {
   if (servo_.on_thread_start) servo_.on_thread_start();
+  const core::ThreadCounters counters_at_start = core::thread_counters();
+  // The thread's page faults and preemptions since it started (for the report and a stall's message).
+  auto counters_since_start = [&counters_at_start] {
+    const core::ThreadCounters now = core::thread_counters();
+    return std::pair{now.major_faults - std::min(now.major_faults, counters_at_start.major_faults),
+                     now.involuntary_switches - std::min(now.involuntary_switches, counters_at_start.involuntary_switches)};
+  };
   std::optional<core::CpuLatencyRequest> cpu_latency;
   std::unique_ptr<core::IdleSpinner> idle_spinner;  // declared after: stopped before the request ends
   if (servo_.realtime) {
@@ -300,10 +309,13 @@ void ServoLoop::run() {
     // the cycle for its commands). A stall long enough to matter latches the safe state.
     if (wake - deadline > stall_limit) {
       device_.request_safe_state();
+      const auto [major, preempted] = counters_since_start();
       latch(kFaultDeadlineMiss,
             "cycle %llu woke %.3f ms after its deadline (bound stall_limit_s %.3f ms): the motors "
-            "held the previous commands that long",
-            cycle_no, static_cast<double>(wake - deadline) * 1e-6, servo_.stall_limit_s * 1e3);
+            "held the previous commands that long (the servo thread so far: %llu page faults "
+            "waiting for I/O, taken off its CPU %llu times)",
+            cycle_no, static_cast<double>(wake - deadline) * 1e-6, servo_.stall_limit_s * 1e3,
+            static_cast<unsigned long long>(major), static_cast<unsigned long long>(preempted));
     }
 
     reading.repeats = 0;  // backends that never repeat a reading do not touch it
@@ -399,6 +411,7 @@ void ServoLoop::run() {
     if (servo_.max_seconds > 0 && core::ns_to_s(end - first_wake_ns_) >= servo_.max_seconds) break;
   }
   device_.request_safe_state();
+  std::tie(major_faults_, involuntary_switches_) = counters_since_start();
   running_.store(false, std::memory_order_release);
 }
 
@@ -426,6 +439,8 @@ ServoStats ServoLoop::stats() const {
   s.realtime_scheduling = realtime_granted_;
   s.idle_spin = idle_spin_.load(std::memory_order_relaxed);
   s.released_at_end = released_at_end_.load(std::memory_order_acquire);
+  s.major_faults = major_faults_;
+  s.involuntary_switches = involuntary_switches_;
   return s;
 }
 

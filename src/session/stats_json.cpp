@@ -12,7 +12,9 @@ nlohmann::json servo_timing_json(const device::ServoStats& s) {
           {"cycle_us_p99", s.cycle_us_p99},
           {"cycle_us_max", s.cycle_us_max},
           {"realtime_scheduling", s.realtime_scheduling},
-          {"idle_spin", s.idle_spin}};
+          {"idle_spin", s.idle_spin},
+          {"servo_major_faults", s.major_faults},
+          {"servo_involuntary_switches", s.involuntary_switches}};
 }
 
 nlohmann::json physics_memory_json(const physics::World::MemoryUse& u) {

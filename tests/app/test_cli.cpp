@@ -310,6 +310,9 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_EQ(reg["comparison"]["method"], "joint-balls (paper)");
   EXPECT_EQ(j["shaped_fingers"], false);
   EXPECT_EQ(j["bending_wrists"], true);
+  // The servo thread's own page faults and preemptions (a stall's cause, the machine's or its).
+  EXPECT_TRUE(j["haptic"]["servo_major_faults"].is_number_unsigned());
+  EXPECT_TRUE(j["haptic"]["servo_involuntary_switches"].is_number_unsigned());
   const auto& c = j["composite"];
   // Measured: 0.16 % (depth) vs 15 % (paper) on a quiet machine, 6.6 % under load.
   EXPECT_LT(c["occlusion_error_pct"].get<double>(), 10.0);

@@ -1,6 +1,7 @@
 // Thread scheduling helpers: nice applies to the calling thread only and is range-checked.
 #include <gtest/gtest.h>
 
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -42,6 +43,28 @@ TEST(Realtime, CpuLatencyRequestHoldsTheFileOrSaysWhy) {
   }
   CpuLatencyRequest moved = std::move(r).value();  // moving keeps one open request
   EXPECT_FALSE(CpuLatencyRequest::open(-1).ok());
+}
+
+// The counters are the calling thread's own: pages first touched by another thread count there.
+TEST(Realtime, ThreadCountersCountTheCallingThreadsPageFaults) {
+  constexpr std::size_t kPages = 2048;
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  void* mem = mmap(nullptr, kPages * page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(mem, MAP_FAILED);
+  const ThreadCounters here_before = thread_counters();
+  ThreadCounters before, after;
+  std::thread t([&] {
+    before = thread_counters();
+    auto* bytes = static_cast<volatile unsigned char*>(mem);
+    for (std::size_t k = 0; k < kPages; ++k) bytes[k * page] = 1;  // each page's first touch
+    after = thread_counters();
+  });
+  t.join();
+  const ThreadCounters here_after = thread_counters();
+  munmap(mem, kPages * page);
+  EXPECT_GE(after.minor_faults + after.major_faults - before.minor_faults - before.major_faults, kPages / 2)
+      << "at most one fault per 2 pages (fault-around does not apply to anonymous memory)";
+  EXPECT_LT(here_after.minor_faults - here_before.minor_faults, kPages / 4) << "the other thread's faults";
 }
 
 }  // namespace

@@ -49,6 +49,16 @@ Result<int> online_cpu(int cpu);
 /// Pins the calling thread to `cpu` (0-based; −1 = the last online CPU). Error names the CPU.
 Status pin_to_cpu(int cpu);
 
+/// What the kernel counted for the calling thread (getrusage RUSAGE_THREAD): page faults that had
+/// to wait for I/O (major: a page read back, e.g. code the kernel dropped from memory) or not
+/// (minor), and the times the thread gave up its CPU by waiting (voluntary) or was taken off it
+/// (involuntary: preempted, or its time slice ended). All 0 where the call fails.
+struct ThreadCounters {
+  std::uint64_t major_faults = 0, minor_faults = 0;
+  std::uint64_t voluntary_switches = 0, involuntary_switches = 0;
+};
+ThreadCounters thread_counters();
+
 /// Lets `thread`, which its own scheduling starves, run again so that it can see a stop request
 /// and end: SCHED_OTHER (priority 0) on every CPU the calling thread may use. Called from another
 /// thread, e.g. for a thread pinned at SCHED_FIFO to a CPU that a higher-priority task holds, or

@@ -125,6 +125,11 @@ struct ServoStats {
   /// The servo thread did not end within a stall window of the stop request (the scheduler starved
   /// it) and was moved to normal scheduling on every CPU so that it could end.
   bool released_at_end = false;
+  /// The servo thread's own counts over the run (core::thread_counters): page faults that waited
+  /// for I/O, and the times it was taken off its CPU. A late wake with neither rising was the
+  /// machine's (a host that stopped the vCPU, a non-preemptible kernel section), not the thread's.
+  std::uint64_t major_faults = 0;
+  std::uint64_t involuntary_switches = 0;
 };
 
 /// How much later than ServoConfig::max_seconds the monitor ends a loop whose servo thread has not
@@ -210,6 +215,7 @@ class ServoLoop {
   std::uint64_t deadline_misses_ = 0;
   std::uint64_t stale_force_cycles_ = 0;
   std::uint64_t repeated_readings_ = 0, longest_repeat_ = 0;
+  std::uint64_t major_faults_ = 0, involuntary_switches_ = 0;  ///< the servo thread's, over the run
   FaultLog fault_log_;
   bool realtime_granted_ = false;
   std::atomic<bool> idle_spin_{false};  ///< the servo thread runs a core::IdleSpinner

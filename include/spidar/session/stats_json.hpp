@@ -9,8 +9,10 @@
 namespace spidar::session {
 
 /// The servo loop's timing: rate_hz, jitter_p50_us / _p99_us / _max_us (|period − nominal|),
-/// overruns, the cycle's compute time cycle_us_median / _p99 / _max, realtime_scheduling and
-/// idle_spin. Each report adds its own keys (faults, deadline misses, …) to it.
+/// overruns, the cycle's compute time cycle_us_median / _p99 / _max, realtime_scheduling,
+/// idle_spin, and the servo thread's servo_major_faults (page faults that waited for I/O) and
+/// servo_involuntary_switches (times it was taken off its CPU). Each report adds its own keys
+/// (faults, deadline misses, …) to it.
 nlohmann::json servo_timing_json(const device::ServoStats& s);
 
 /// MuJoCo's preallocated memory a run used (physics::World::memory_use): stack_words,
