@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <random>
 
 #include "spidar/vision/bracelet.hpp"
@@ -209,6 +210,16 @@ TEST(Bracelet, ARingSeenEndOnIsMatchedWhateverTheAxisPredicted) {
   EXPECT_TRUE(detect(band, &pred)[1].found);
 }
 
+// The best bracelet candidate in a frame, unassigned; nullopt when there is none.
+std::optional<BraceletObservation> best_candidate(const cv::Mat& bgr) {
+  BraceletWorkspace ws;
+  cv::Mat mask;
+  if (!red_mask(bgr, BraceletParams{}, &mask).ok()) return std::nullopt;
+  find_bracelet_candidates(mask, BraceletParams{}, &ws);
+  if (ws.candidates.empty()) return std::nullopt;
+  return ws.candidates.front().observation;
+}
+
 // A band seen obliquely shows a crescent (its near side); the bulge says on which side of its long
 // axis the arc's apex lies, in the frame of its own ends. A straight strip and a whole ring have none.
 TEST(Bracelet, ACrescentsBulgePointsToItsApex) {
@@ -224,12 +235,9 @@ TEST(Bracelet, ACrescentsBulgePointsToItsApex) {
       const double a = angle_deg * 3.14159265358979 / 180.0;
       const Vec2 minor(-std::sin(a), std::cos(a));  // image y grows downward: OpenCV's +90° point
       const Vec2 apex_dir = apex_side * minor;
-      BraceletWorkspace ws;
-      cv::Mat mask;
-      ASSERT_TRUE(red_mask(bgr, BraceletParams{}, &mask).ok());
-      find_bracelet_candidates(mask, BraceletParams{}, &ws);
-      ASSERT_FALSE(ws.candidates.empty());
-      const BraceletObservation& o = ws.candidates.front().observation;
+      const auto found = best_candidate(bgr);
+      ASSERT_TRUE(found.has_value());
+      const BraceletObservation& o = *found;
       const Vec2 u = (o.end_b_px - o.end_a_px).normalized();
       const Vec2 across(-u.y(), u.x());
       const double along_apex = across.dot(apex_dir) * o.bulge_px;  // the bulge toward the apex
@@ -241,12 +249,9 @@ TEST(Bracelet, ACrescentsBulgePointsToItsApex) {
     cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));
     if (ring) cv::ellipse(bgr, cv::Point(320, 240), cv::Size(70, 30), 25.0, 0.0, 360.0, cv::Scalar(30, 30, 210), 10);
     else cv::rectangle(bgr, cv::Point(250, 230), cv::Point(390, 252), cv::Scalar(30, 30, 210), cv::FILLED);
-    BraceletWorkspace ws;
-    cv::Mat mask;
-    ASSERT_TRUE(red_mask(bgr, BraceletParams{}, &mask).ok());
-    find_bracelet_candidates(mask, BraceletParams{}, &ws);
-    ASSERT_FALSE(ws.candidates.empty());
-    const BraceletObservation& o = ws.candidates.front().observation;
+    const auto found = best_candidate(bgr);
+    ASSERT_TRUE(found.has_value());
+    const BraceletObservation& o = *found;
     EXPECT_LT(std::abs(o.bulge_px), 0.03 * o.thickness_px) << (ring ? "ring" : "strip");
   }
 }
