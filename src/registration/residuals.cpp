@@ -253,7 +253,7 @@ BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const v
   const auto [a, b] = band_section(params, hand_width_m);
   const Vec3 p_W_camera = camera.X_WC().p;
   constexpr int kMaxSamples = 96;
-  const int kSamples = std::clamp(samples_per_rim, 8, kMaxSamples);
+  const int samples = std::clamp(samples_per_rim, 8, kMaxSamples);
   std::array<std::array<Vec2, kMaxSamples>, 2> image{};
   std::array<std::array<bool, kMaxSamples>, 2> near{};
   BandProfile out;
@@ -261,8 +261,8 @@ BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const v
   for (int r = 0; r < 2; ++r) {
     const double along = params.bracelet_offset_m + (r == 0 ? -0.5 : 0.5) * params.bracelet_width_m;
     const Vec3 rim_centre = X_WH * Vec3(0.0, -along, 0.0);
-    for (int k = 0; k < kSamples; ++k) {
-      const double phi = 2.0 * units::kPi * k / kSamples;
+    for (int k = 0; k < samples; ++k) {
+      const double phi = 2.0 * units::kPi * k / samples;
       const double c = std::cos(phi), sn = std::sin(phi);
       const Vec3 p = rim_centre + a * c * x + b * sn * z;
       const Vec3 outward = (c / a) * x + (sn / b) * z;  // the ellipse's normal (unnormalised)
@@ -285,8 +285,8 @@ BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const v
     area += t;
     moment += t * (p0 + p1 + p2).dot(across_px) / 3.0;
   };
-  for (int k = 0; k < kSamples; ++k) {
-    const int k1 = (k + 1) % kSamples;
+  for (int k = 0; k < samples; ++k) {
+    const int k1 = (k + 1) % samples;
     if (!(near[0][k] && near[0][k1] && near[1][k] && near[1][k1])) continue;
     triangle(image[0][k], image[0][k1], image[1][k1]);
     triangle(image[0][k], image[1][k1], image[1][k]);
