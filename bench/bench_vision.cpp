@@ -6,6 +6,7 @@
 #include "../tests/vision/synthetic_scene.hpp"
 #include "spidar/vision/bracelet.hpp"
 #include "spidar/vision/chroma_key.hpp"
+#include "spidar/vision/lens_undistortion.hpp"
 #include "spidar/vision/silhouette.hpp"
 
 namespace {
@@ -46,6 +47,28 @@ void ChromaKeyOnly(benchmark::State& state) {
   }
 }
 BENCHMARK(ChromaKeyOnly)->Unit(benchmark::kMillisecond);
+
+// A frame through a webcam's barrel lens (k1 −0.28, k2 0.09) undistorted into its pinhole camera,
+// as a session does on the frame thread before the pipeline (LensUndistortion::undistort); and
+// the maps' construction, once per calibration (arg 1).
+Intrinsics webcam() {
+  Intrinsics k;
+  k.distortion = {-0.28, 0.09, 0.0008, -0.0005, 0.0};
+  return k;
+}
+void LensUndistort(benchmark::State& state) {
+  const auto lens = LensUndistortion::create(webcam()).value();
+  cv::Mat out;
+  for (auto _ : state) {
+    lens.undistort(frame(), &out);
+    benchmark::DoNotOptimize(out.data);
+  }
+}
+BENCHMARK(LensUndistort)->Unit(benchmark::kMillisecond);
+void LensUndistortionCreate(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(LensUndistortion::create(webcam()).ok());
+}
+BENCHMARK(LensUndistortionCreate)->Unit(benchmark::kMillisecond);
 
 void BraceletsOnly(benchmark::State& state) {
   BraceletWorkspace ws;

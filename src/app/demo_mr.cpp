@@ -70,14 +70,13 @@ int run_mr_demo(const DemoOptions& o) {
   const auto truth_models = session::hand_models(hand_path, o.user_profile, true, &user_profile);
   const auto models = session::hand_models(resolve_data_path("configs/hands.yaml"), o.model_profile, false);
   const vision::Camera calibrated = vision::load_camera_file(resolve_data_path(o.camera)).camera;
-  if (const auto& d = calibrated.intrinsics().distortion; !d.is_zero()) {
-    // The synthetic camera renders a pinhole image; the registration would project with the lens.
-    std::ostringstream m;
-    m << "--camera " << o.camera << ": the simulated camera films a pinhole image, without lens distortion, "
-      << "but this calibration has distortion (k1 " << d.k1 << ", k2 " << d.k2 << ", p1 " << d.p1 << ", p2 "
-      << d.p2 << ", k3 " << d.k3 << "): the registration would project the hands where the film does not "
-      << "show them; give the simulated rig a camera file with distortion: [0, 0, 0, 0, 0]";
-    throw UsageError(m.str());
+  // A calibration with lens distortion: the synthetic camera films through that lens, and the
+  // session undistorts its frames into the lens's pinhole camera, as with a real camera
+  // (vision::LensUndistortion). A lens that cannot be undistorted is refused here.
+  try {
+    (void)session::pinhole_camera(calibrated);
+  } catch (const SpidarError& e) {
+    throw UsageError("--camera " + o.camera + ": " + e.what());
   }
   {
     // Scaling a calibration to another aspect ratio would make its pixels non-square.
@@ -153,8 +152,11 @@ int run_mr_demo(const DemoOptions& o) {
   rp.bending_wrists = o.bending_wrists;
   session::SimulatedRig rig(cfg, scene, camera, truth_models, rp);
   auto run = session::Session::create(rig, scene, *context, camera, models, sp);
+  // The camera the pipelines, the ground truth and the pictures share: the calibration's, or its
+  // lens's pinhole camera.
+  const vision::Camera& seen = run->camera();
 
-  session::TruthScorer scorer(camera, truth_models, sp.pipeline);
+  session::TruthScorer scorer(seen, truth_models, sp.pipeline);
   // The video is opened on the output thread (VideoSink::on_start), so that the encoder's threads
   // run at its niceness too.
   std::unique_ptr<session::VideoSink> video_sink;
@@ -162,7 +164,7 @@ int run_mr_demo(const DemoOptions& o) {
     video_sink = std::make_unique<session::VideoSink>((fs::path(o.out) / "mixed_reality.mp4").string(),
                                                       o.width, o.height, o.fps);
   session::KeyframeSink keyframes(
-      (fs::path(o.out) / "keyframes").string(), {1.9, 3.0, 4.5, 8.5, 10.2}, *mode, camera,
+      (fs::path(o.out) / "keyframes").string(), {1.9, 3.0, 4.5, 8.5, 10.2}, *mode, seen,
       [&scorer, &task](const session::FrameEvent& e) {
         return "t = " + std::to_string(e.t_s).substr(0, 4) + " s, " + task.phase(e.t_s) +
                ", IoU " + std::to_string(scorer.trace().frames.back().truth[0].iou).substr(0, 5);
@@ -188,7 +190,7 @@ int run_mr_demo(const DemoOptions& o) {
   // frame thread waits for its slots (one core busy, seeds 1–3: 7.0–9.8 % of the frames dropped
   // at nice 10, 0.55–2.2 % at 5; quiet, latency p95 28–29 ms at 5; docs/measurements.md).
   session::AsyncSinks off_path({&scorer, &output, &progress_sink}, 3, 5);
-  off_path.compare(camera, models, sp.pipeline, run->warm_up_frame());
+  off_path.compare(seen, models, sp.pipeline, run->warm_up_frame());
   off_path.compose_others(sp.pipeline.compositor);
   run->add_sink(window);
   run->add_sink(off_path);

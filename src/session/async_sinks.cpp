@@ -153,6 +153,12 @@ void AsyncSinks::copy_into(const FrameEvent& from, Slot& to) const {
     from.bgr->copyTo(to.bgr);
     to.e.bgr = &to.bgr;
   }
+  if (from.sensor_bgr == from.bgr) {
+    to.e.sensor_bgr = to.e.bgr;
+  } else if (from.sensor_bgr != nullptr) {  // through a lens
+    from.sensor_bgr->copyTo(to.sensor_bgr);
+    to.e.sensor_bgr = &to.sensor_bgr;
+  }
   if (from.measured != nullptr) {
     to.measured = *from.measured;
     to.e.measured = &to.measured;

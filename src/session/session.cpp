@@ -19,6 +19,13 @@ constexpr std::int64_t kFrameWaitNs = 5'000'000;
 Session::Session(Rig& rig, Scene& scene, render::Context& context, const SessionParams& params)
     : rig_(rig), scene_(scene), context_(context), params_(params) {}
 
+vision::Camera pinhole_camera(const vision::Camera& calibrated) {
+  if (calibrated.intrinsics().distortion.is_zero()) return calibrated;
+  auto lens = vision::LensUndistortion::create(calibrated.intrinsics());
+  if (!lens) throw SpidarError("camera: " + lens.error().message);
+  return vision::Camera(lens->pinhole(), calibrated.X_CW());
+}
+
 std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context& context,
                                          const vision::Camera& camera,
                                          const std::array<hand::HandModel, 2>& models,
@@ -26,7 +33,9 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
   if (params.warm_results < 1 || params.warm_results > 32)
     throw SpidarError("session: warm_results must be in 1..32, got " + std::to_string(params.warm_results));
   std::unique_ptr<Session> s(new Session(rig, scene, context, params));
-  s->camera_ = camera;
+  s->camera_ = pinhole_camera(camera);
+  if (!camera.intrinsics().distortion.is_zero())
+    s->lens_ = vision::LensUndistortion::create(camera.intrinsics()).value();  // pinhole_camera checked it
   // --- the haptic side: servo loop ↔ bridge ↔ physics thread (none when playing back) ---
   if (!rig.plays_back()) {
     HapticSideParams hp;
@@ -40,12 +49,12 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
     s->haptic_->set_before_step([monitor](physics::World& w) { monitor->before_step(w); });
   }
   // --- the frame side ---
-  auto pipe_r = pipeline::FramePipeline::create(context, camera, models, params.pipeline);
+  auto pipe_r = pipeline::FramePipeline::create(context, s->camera_, models, params.pipeline);
   if (!pipe_r) throw SpidarError(pipe_r.error().message);
   s->pipe_ = std::move(pipe_r).value();
   s->alt_params_ = pipeline::comparison_params(params.pipeline);
   if (params.compare && !params.defer_compare) {
-    auto alt_r = pipeline::FramePipeline::create(context, camera, models, s->alt_params_);
+    auto alt_r = pipeline::FramePipeline::create(context, s->camera_, models, s->alt_params_);
     if (!alt_r) throw SpidarError(alt_r.error().message);
     s->alt_ = std::move(alt_r).value();
   }
@@ -177,7 +186,7 @@ Session::Step Session::step() {
   if (!started_ || threads_stopped_) return Step::kNoFrame;
   try {
     if (!rig_.camera().take(&frame_)) return Step::kNoFrame;
-    const vision::Intrinsics& k = camera_.intrinsics();
+    const vision::Intrinsics& k = camera_.intrinsics();  // the lens's image size too
     if (frame_.bgr.cols != k.width || frame_.bgr.rows != k.height)
       throw SpidarError("camera: a frame of " + std::to_string(frame_.bgr.cols) + "x" +
                         std::to_string(frame_.bgr.rows) + " px, expected " + std::to_string(k.width) +
@@ -200,7 +209,10 @@ Session::Step Session::step() {
 
     e.cold_start = !pipe_->has_previous();
     result_ = results_.take();  // one no sink still holds (its images are reused, not reallocated)
-    if (auto st = pipe_->process(frame_.bgr, measured_, snapshot_, result_.get()); !st)
+    // Through a lens: the pinhole camera's image (camera_), which the pipelines and sinks see.
+    if (lens_) lens_->undistort(frame_.bgr, &undistorted_);
+    const cv::Mat& image = lens_ ? undistorted_ : frame_.bgr;
+    if (auto st = pipe_->process(image, measured_, snapshot_, result_.get()); !st)
       throw SpidarError(st.error().message);
     e.t_done_ns = core::monotonic_ns();
     // The comparison registration runs every frame (it must track), its rendering every
@@ -210,7 +222,7 @@ Session::Step Session::step() {
       if (!alt_) {
         e.compare_pending = render ? PendingComparison::kFitAndPicture : PendingComparison::kFit;
       } else {
-        if (auto st = pipeline::process_comparison(*alt_, *result_, frame_.bgr, measured_, snapshot_, render,
+        if (auto st = pipeline::process_comparison(*alt_, *result_, image, measured_, snapshot_, render,
                                                    &alt_result_);
             !st)
           throw SpidarError(st.error().message);
@@ -222,7 +234,8 @@ Session::Step Session::step() {
     e.index = frames_;
     e.t_exposure_ns = t_exp;
     e.t_s = t_s;
-    e.bgr = &frame_.bgr;
+    e.bgr = &image;
+    e.sensor_bgr = &frame_.bgr;
     e.measured = &measured_;
     e.scene = &snapshot_;
     e.result = result_.get();

@@ -82,7 +82,9 @@ void SessionRecorder::on_frame(const FrameEvent& e) {
   FrameRecord fr;
   fr.index = static_cast<std::int64_t>(e.index);
   fr.t_exposure_ns = e.t_exposure_ns;
-  fr.bgr = e.bgr->clone();  // written by the writer thread, after the source reused it
+  // The sensor's frame (through the lens, if any): a replay undistorts it as the session did.
+  // Cloned: written by the writer thread, after the source reused it.
+  fr.bgr = (e.sensor_bgr != nullptr ? e.sensor_bgr : e.bgr)->clone();
   fr.measured = *e.measured;
   fr.scene_poses.reserve(e.scene->shapes.size());
   for (const Shape& sh : e.scene->shapes) fr.scene_poses.push_back(sh.X_WS);

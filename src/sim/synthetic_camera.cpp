@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
+#include <utility>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -11,6 +13,7 @@
 #include "spidar/render/hand_skin.hpp"  // part ids
 #include "spidar/render/renderer.hpp"
 #include "spidar/sim/anatomical_hand.hpp"
+#include "spidar/vision/lens_undistortion.hpp"
 
 namespace spidar::sim {
 
@@ -39,7 +42,13 @@ Status validate(const SyntheticCameraParams& p) {
 }
 
 struct SyntheticCamera::Impl {
-  vision::Camera camera;
+  vision::Camera camera;  ///< as given (its lens, if any)
+  /// With lens distortion: the hands are drawn by the pinhole camera its frames undistort into
+  /// (the ground truth stays in that view, where the pipeline works), and the colour image is then
+  /// bent through the lens, as a real camera's is.
+  std::optional<vision::LensUndistortion> lens;
+  vision::Camera drawn;  ///< the camera the renderer draws with (pinhole)
+  cv::Mat through_lens;
   SyntheticCameraParams params;
   std::array<AnatomicalHand, 2> hands;
   /// Both hands' parts, left then right: posed in place every frame (MeshData::version).
@@ -103,6 +112,13 @@ Result<std::unique_ptr<SyntheticCamera>> SyntheticCamera::create(
     return Error{"synthetic camera: truth models must be {left, right}"};
   auto impl = std::make_unique<Impl>();
   impl->camera = camera;
+  impl->drawn = camera;
+  if (!camera.intrinsics().distortion.is_zero()) {
+    auto lens = vision::LensUndistortion::create(camera.intrinsics());
+    if (!lens) return Error{"synthetic camera: " + lens.error().message};
+    impl->lens = std::move(lens).value();
+    impl->drawn = vision::Camera(impl->lens->pinhole(), camera.X_CW());
+  }
   impl->params = params;
   AnatomicalHandParams k;
   k.forearm_length_m = params.forearm_length_m;
@@ -135,7 +151,22 @@ Result<std::unique_ptr<SyntheticCamera>> SyntheticCamera::create(
 }
 
 const vision::Camera& SyntheticCamera::camera() const { return impl_->camera; }
-void SyntheticCamera::set_camera(const vision::Camera& camera) { impl_->camera = camera; }
+Status SyntheticCamera::set_camera(const vision::Camera& camera) {
+  if (camera.width() != impl_->camera.width() || camera.height() != impl_->camera.height())
+    return Error{"synthetic camera: set_camera cannot change the image size"};
+  std::optional<vision::LensUndistortion> lens;
+  vision::Camera drawn = camera;
+  if (!camera.intrinsics().distortion.is_zero()) {
+    auto l = vision::LensUndistortion::create(camera.intrinsics());
+    if (!l) return Error{"synthetic camera: " + l.error().message};
+    lens = std::move(l).value();
+    drawn = vision::Camera(lens->pinhole(), camera.X_CW());
+  }
+  impl_->camera = camera;
+  impl_->lens = std::move(lens);
+  impl_->drawn = drawn;
+  return Ok{};
+}
 const SyntheticCameraParams& SyntheticCamera::params() const { return impl_->params; }
 
 Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous) {
@@ -160,7 +191,7 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
       }
     }
     s.build_scene(at);
-    if (auto st = s.renderer->render(s.scene, s.camera, s.render_params); !st) return st;
+    if (auto st = s.renderer->render(s.scene, s.drawn, s.render_params); !st) return st;
     const bool last = k == samples;
     if (auto st = s.renderer->read(&s.targets, last ? render::kColour | render::kHandDepth | render::kHandId
                                                    : render::kColour); !st)
@@ -190,7 +221,13 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
   cv::LUT(s.targets.hand_id, s.lut_only, out->hand_only);
   s.targets.hand_depth.copyTo(out->depth);
 
-  // Optics and sensor.
+  // Optics and sensor: the lens bends the image (beyond the pinhole view the screen goes on), the
+  // optics blur it, the sensor adds noise.
+  if (s.lens) {
+    const auto& c = p.screen_rgb;
+    s.lens->distort(out->bgr, &s.through_lens, cv::Scalar(255.0 * c[2], 255.0 * c[1], 255.0 * c[0]));
+    std::swap(out->bgr, s.through_lens);
+  }
   if (p.psf_sigma_px > 0) cv::GaussianBlur(out->bgr, out->bgr, cv::Size(0, 0), p.psf_sigma_px);
   if (p.noise_sigma > 0) {
     // Gaussian noise from a bank a little larger than the frame, drawn once; each frame takes it

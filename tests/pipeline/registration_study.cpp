@@ -74,6 +74,7 @@ struct Args {
   bool ceiling_scan = false;
   bool section_widths = false;  ///< --section-widths: the digits' sections against the model's, at the truth
   double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
+  double forearm_breadth = 0;  ///< --forearm-breadth B: the model skin's forearm_breadth
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
   std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below --dump-below
   double dump_below = 0.5;
@@ -131,6 +132,7 @@ int main(int argc, char** argv) {
     else if (k == "--ceiling-scan") a.ceiling_scan = true;
     else if (k == "--section-widths") a.section_widths = true;
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
+    else if (k == "--forearm-breadth") a.forearm_breadth = std::atof(next().c_str());
     else if (k == "--dump") a.dump_dir = next();
     else if (k == "--bending-wrists") a.bending_wrists = true;
     else if (k == "--oracle-forearm") a.oracle_forearm = true;
@@ -181,6 +183,7 @@ int main(int argc, char** argv) {
   const vision::Camera camera = vision::default_rig_camera();
   render::HandSkinParams model_skin = pipeline::FramePipelineParams{}.model_skin;
   if (a.forearm_cap > 0) model_skin.forearm_cap_depth = a.forearm_cap;
+  if (a.forearm_breadth > 0) model_skin.forearm_breadth = a.forearm_breadth;
   auto ceiling = sim::ModelCeiling::create(context, camera, truth_models, model_skin).value();
 
   // The ceiling's variants (--ceiling-scan): digit radii scaled, then the palm's fullness.

@@ -31,15 +31,16 @@ struct FitTrace final : FrameSink {
   std::map<std::size_t, std::array<hand::ParamVec, 2>> q;
 };
 
-TEST(RecordingRig, ASimulatedSessionRecordedAsPngReplaysThroughASessionToTheSameFits) {
-  TempFolder d("replay_session");
+/// Records a session of the simulated rig filmed by `camera` (320×240), replays it through a
+/// second session and checks that every frame is fitted again to the same fits.
+void record_and_replay(const vision::Camera& camera, const char* folder) {
+  TempFolder d(folder);
   const fs::path dir = d.path() / "rec";
   auto ctx = render::Context::create_headless();
   ASSERT_TRUE(ctx) << ctx.error().message;
   const auto config = strings::load_device_config("configs/spidar8.yaml");
   const auto user = hand_models("configs/hands.yaml", "user", true);
   const auto models = hand_models("configs/hands.yaml", "model", false);
-  const vision::Camera camera = scaled_camera(vision::load_camera_file("configs/camera.yaml").camera, 320, 240);
   auto scene = Scene::load("scenes/rubiks_cube.xml", user).value();
   SessionParams sp;
   sp.servo.rate_hz = 1000;
@@ -133,6 +134,22 @@ TEST(RecordingRig, ASimulatedSessionRecordedAsPngReplaysThroughASessionToTheSame
   EXPECT_GT(moved_mm, 0.01) << "the sizes never changed: the test does not exercise them";
   EXPECT_EQ(scorer.figures().compared_sizes, 2 * static_cast<int>(live.q.size()));
   EXPECT_LT(scorer.figures().max_dsize_mm, 1e-9);
+}
+
+TEST(RecordingRig, ASimulatedSessionRecordedAsPngReplaysThroughASessionToTheSameFits) {
+  record_and_replay(scaled_camera(vision::load_camera_file("configs/camera.yaml").camera, 320, 240),
+                    "replay_session");
+}
+
+// Through a lens: the recording keeps the frames as the sensor gave them (FrameEvent::sensor_bgr),
+// and the replay undistorts them as the live session did. (Had it kept the undistorted frames,
+// the replay would undistort them twice and fit other poses.)
+TEST(RecordingRig, ASessionThroughALensReplaysToTheSameFits) {
+  vision::Camera camera = scaled_camera(vision::load_camera_file("configs/camera.yaml").camera, 320, 240);
+  vision::Intrinsics k = camera.intrinsics();
+  k.distortion = {-0.28, 0.09, 0.0008, -0.0005, 0.0};
+  camera.set_intrinsics(k);
+  record_and_replay(camera, "replay_session_lens");
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ class AsyncSinks final : public FrameSink {
  private:
   struct Slot {
     FrameEvent e;  ///< points into this slot's copies
-    cv::Mat bgr;
+    cv::Mat bgr, sensor_bgr;
     device::FingertipSample measured;
     SceneSnapshot scene;
     pipeline::FrameResult result, compared;

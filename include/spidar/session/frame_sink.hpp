@@ -38,7 +38,12 @@ struct FrameEvent {
   /// Time of the exposure [s]: the script's time on the simulated rig, else since the session
   /// started.
   double t_s = 0;
-  const cv::Mat* bgr = nullptr;                   ///< the camera image
+  /// The camera image the pipelines saw: undistorted, where the camera's calibration has a lens
+  /// (Session::camera(), vision::LensUndistortion).
+  const cv::Mat* bgr = nullptr;
+  /// The frame as the camera delivered it, through its lens (what a recording keeps, so that its
+  /// replay undistorts it as the session did); the same as `bgr` without a lens.
+  const cv::Mat* sensor_bgr = nullptr;
   const device::FingertipSample* measured = nullptr;  ///< servo samples interpolated at exposure
   const SceneSnapshot* scene = nullptr;            ///< the virtual world the frame was rendered with
   const pipeline::FrameResult* result = nullptr;   ///< the main pipeline's fit and composite

@@ -68,7 +68,9 @@ class LiveSession {
   // --- for the GUI and the report ---
   const LiveConfig& config() const { return config_; }
   const strings::DeviceConfig& device_config() const { return rig_->device_config(); }
-  const vision::Camera& camera() const { return camera_; }
+  /// The camera the composite is drawn in: the calibration's, or its lens's pinhole camera (the
+  /// frames undistorted on arrival; Session::camera()).
+  const vision::Camera& camera() const { return session_->camera(); }
   const std::array<hand::HandModel, 2>& models() const { return models_; }
   /// The GUI's view model: the last processed frame, the bounded history, the run's means.
   const FrameStatsSink& view() const { return view_; }

@@ -68,6 +68,10 @@ class SyntheticCamera {
  public:
   /// `truth` gives the two hands' shapes (left, right: the user's true proportions, not
   /// necessarily the registration's). The context must stay alive and current on this thread.
+  /// A `camera` with lens distortion films through its lens: the colour image is bent as the lens
+  /// bends it (vision::LensUndistortion::distort), while the ground truth (masks, ids, depth)
+  /// stays in the view of its pinhole camera (session::pinhole_camera), where the frames are
+  /// undistorted into and the pipeline works. Error where the lens cannot be undistorted.
   static Result<std::unique_ptr<SyntheticCamera>> create(render::Context& context,
                                                          const vision::Camera& camera,
                                                          const std::array<hand::HandModel, 2>& truth,
@@ -80,8 +84,10 @@ class SyntheticCamera {
   /// mean of sub-frames from previous to poses (ground truth: at `poses`). Reuses out's buffers.
   Status film(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous = nullptr);
 
+  /// The camera as given (with its lens, if any).
   const vision::Camera& camera() const;
-  void set_camera(const vision::Camera& camera);
+  /// Another pose or calibration of the same image size (its lens as in create()).
+  Status set_camera(const vision::Camera& camera);
   const SyntheticCameraParams& params() const;
 
  private:
