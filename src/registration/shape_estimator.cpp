@@ -34,7 +34,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
                     "max_fingertip_cost", "shared_hands", "keyframe_prior_scale",
                     "keyframe_prior", "joint_balls", "palm_breadth_sigma_px", "palm_breadth_at",
-                    "palm_breadth_min_facing", "digit_axes", "digit_section_sigma"});
+                    "palm_breadth_min_facing", "digit_axes", "digit_section_sigma", "keyframe_window"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
@@ -45,6 +45,12 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
     if (v == "taken") p.keyframe_prior = KeyframePrior::kTaken;
     else if (v == "last") p.keyframe_prior = KeyframePrior::kLast;
     else b->fail("expected taken or last, got '" + v + "'");
+  }
+  if (auto b = node.find("keyframe_window")) {
+    const std::string v = b->as_string();
+    if (v == "newest") p.keyframe_window = KeyframeWindow::kNewest;
+    else if (v == "session") p.keyframe_window = KeyframeWindow::kSession;
+    else b->fail("expected newest or session, got '" + v + "'");
   }
   if (auto b = node.find("silhouette")) {
     const std::string v = b->as_string();
@@ -148,6 +154,14 @@ Eigen::Vector3d sizes_of(const hand::HandModel& m) {
   const hand::HandDimensions& d = m.shape.dimensions;
   return {d.length, d.width, d.thickness};
 }
+/// SplitMix64's finaliser: a well-mixed 64-bit hash of x.
+std::uint64_t mix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
 /// Hand h's sizes at the shared estimate β (in hand 0's sizes): β ⊙ (start_h ⊘ start_0).
 Eigen::Vector3d hand_sizes(const Eigen::Vector3d& beta, const std::vector<Eigen::Vector3d>& starts,
                            std::size_t h) {
@@ -156,7 +170,7 @@ Eigen::Vector3d hand_sizes(const Eigen::Vector3d& beta, const std::vector<Eigen:
 }  // namespace
 
 ShapeEstimator::ShapeEstimator(const hand::HandModel& start, const ShapeEstimatorParams& params)
-    : p_(params), models_{start}, starts_{sizes_of(start)} {
+    : p_(params), models_{start}, starts_{sizes_of(start)}, candidates_(1, 0) {
   estimate_.length_m = starts_[0].x();
   estimate_.width_m = starts_[0].y();
   estimate_.thickness = starts_[0].z();
@@ -170,6 +184,7 @@ ShapeEstimator::ShapeEstimator(const std::array<hand::HandModel, 2>& starts,
     : ShapeEstimator(starts[0], params) {
   models_.push_back(starts[1]);
   starts_.push_back(sizes_of(starts[1]));
+  candidates_.push_back(0);
 }
 
 ShapeEstimate ShapeEstimator::estimate(int hand) const {
@@ -454,6 +469,27 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     ++held;
     if (oldest == nullptr || k.serial < oldest->serial) oldest = &k;
   }
+  // Where it goes: a new slot, the oldest keyframe's, a random one's, or nowhere (KeyframeWindow).
+  constexpr std::size_t kNowhere = std::numeric_limits<std::size_t>::max();
+  std::size_t slot = keyframes_.size();
+  const auto capacity = static_cast<std::uint64_t>(std::max(p_.keyframes, 1));
+  const std::uint64_t n = ++candidates_.at(static_cast<std::size_t>(hand));  // this one's count
+  if (static_cast<std::uint64_t>(held) >= capacity) {
+    if (p_.keyframe_window == KeyframeWindow::kNewest) {
+      slot = static_cast<std::size_t>(oldest - keyframes_.data());
+    } else {
+      const std::uint64_t j = mix64(n * 2 + static_cast<std::uint64_t>(hand)) % n;  // uniform in [0, n)
+      slot = kNowhere;
+      std::uint64_t seen = 0;
+      for (std::size_t i = 0; i < keyframes_.size() && j < capacity; ++i)
+        if (keyframes_[i].hand == hand && seen++ == j) slot = i;
+    }
+  }
+  if (slot == kNowhere) {  // not kept; its digits' sections still count
+    if (p_.digit_section_sigma > 0 && image.camera != nullptr && !image.alpha.empty())
+      add_sections(hand, q, *image.camera, image.alpha, fit_params.matte_threshold);
+    return false;
+  }
   Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}};
   // The band's length is left out of the size estimate's refits: with it the default user's width
   // went 18 % narrow (demo, seeds 1–2), without it 4–8 % (the band measures the forearm, whose
@@ -474,10 +510,10 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
   }
   if (p_.digit_section_sigma > 0 && image.camera != nullptr && !image.alpha.empty())
     add_sections(hand, q, *image.camera, image.alpha, fit_params.matte_threshold);
-  if (held < std::max(p_.keyframes, 1))
+  if (slot == keyframes_.size())
     keyframes_.push_back(std::move(kf));
   else
-    keyframes_[static_cast<std::size_t>(oldest - keyframes_.data())] = std::move(kf);
+    keyframes_[slot] = std::move(kf);
   estimate_.keyframes = static_cast<int>(keyframes_.size());
   if (++new_since_solve_ < p_.solve_every || estimate_.keyframes < p_.min_keyframes) return false;
   if (pending_.valid()) return false;  // one re-estimate at a time: the next frame's offer starts it

@@ -395,6 +395,34 @@ TEST(ShapeEstimator, APriorAtTheTakenPoseKeepsTheTruthAFixedPoint) {
   EXPECT_LT(std::abs(drift_taken), std::abs(drift_last));
 }
 
+// KeyframeWindow::kSession keeps a uniform sample of every pose offered (reservoir sampling):
+// after n candidates it has kept about K (1 + ln(n / K)) of them, not n, so its re-estimates
+// (one per solve_every keyframes kept) come ever rarer; kNewest keeps every one. Both estimate
+// finite sizes near the truth's, and a replay of the same frames draws the same sample.
+TEST(ShapeEstimator, TheSessionWindowKeepsAUniformSampleOfThePoses) {
+  const hand::HandModel truth = resized(hand::default_hand_model(hand::Side::kRight), 0.1976, 0.0825).value();
+  ShapeEstimatorParams newest, session;
+  newest.digit_section_sigma = session.digit_section_sigma = 0.0;
+  newest.keyframes = session.keyframes = 8;
+  newest.solve_every = session.solve_every = 4;
+  session.keyframe_window = KeyframeWindow::kSession;
+  ShapeEstimator a(hand::default_hand_model(hand::Side::kRight), newest);
+  ShapeEstimator b(hand::default_hand_model(hand::Side::kRight), session);
+  ShapeEstimator c(hand::default_hand_model(hand::Side::kRight), session);
+  const Outcome oa = feed(a, 0, truth, test::reaching_hands(0)[1], 300, 7);
+  const Outcome ob = feed(b, 0, truth, test::reaching_hands(0)[1], 300, 7);
+  const Outcome oc = feed(c, 0, truth, test::reaching_hands(0)[1], 300, 7);
+  std::printf("solves: newest %d, session %d; widths %.4f, %.4f (truth 0.0825)\n", oa.estimate.solves,
+              ob.estimate.solves, oa.estimate.width_m, ob.estimate.width_m);
+  EXPECT_EQ(ob.estimate.keyframes, 8);
+  EXPECT_LT(ob.estimate.solves, oa.estimate.solves / 2);
+  EXPECT_GE(ob.estimate.solves, 2);
+  EXPECT_NEAR(ob.estimate.width_m, 0.0825, 0.0825 * 0.15);
+  EXPECT_NEAR(ob.estimate.length_m, 0.1976, 0.1976 * 0.15);
+  EXPECT_EQ(ob.estimate.width_m, oc.estimate.width_m);  // deterministic
+  EXPECT_EQ(ob.estimate.solves, oc.estimate.solves);
+}
+
 TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
   bool enabled = false;
@@ -415,6 +443,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.shared_hands, d.shared_hands);
   EXPECT_EQ(p.keyframe_prior_scale, d.keyframe_prior_scale);
   EXPECT_EQ(p.keyframe_prior, d.keyframe_prior);
+  EXPECT_EQ(p.keyframe_window, d.keyframe_window);
   EXPECT_EQ(p.joint_balls, d.joint_balls);
   EXPECT_EQ(p.palm_breadth_sigma_px, d.palm_breadth_sigma_px);
   EXPECT_EQ(p.palm_chord.at, d.palm_chord.at);
@@ -429,7 +458,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   const auto on = core::ConfigNode::Parse(
       "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n"
       "  max_fingertip_cost: 25\n  shared_hands: false\n  keyframe_prior_scale: 10\n"
-      "  keyframe_prior: taken\n  joint_balls: true\n", "on.yaml");
+      "  keyframe_prior: taken\n  joint_balls: true\n  keyframe_window: session\n", "on.yaml");
   const ShapeEstimatorParams q = parse_shape_estimator_params(on["personalisation"], &enabled);
   EXPECT_EQ(q.silhouette, ShapeSilhouette::kSpill);
   EXPECT_EQ(q.reach_min_miss_m, 0.0);
@@ -438,11 +467,13 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_FALSE(q.shared_hands);
   EXPECT_EQ(q.keyframe_prior_scale, 10.0);
   EXPECT_EQ(q.keyframe_prior, KeyframePrior::kTaken);
+  EXPECT_EQ(q.keyframe_window, KeyframeWindow::kSession);
   EXPECT_TRUE(q.joint_balls);
   EXPECT_EQ(p.silhouette, ShapeSilhouette::kNone);  // the shipped setting
   // An unknown choice names the file, line, key and the choices.
   expect_parse_error("personalisation:\n  silhouette: inward\n", "typo.yaml", "none, spill or both");
   expect_parse_error("personalisation:\n  keyframe_prior: first\n", "where.yaml", "taken or last");
+  expect_parse_error("personalisation:\n  keyframe_window: all\n", "window.yaml", "newest or session");
   expect_parse_error("personalisation:\n  shared_hands: sometimes\n", "maybe.yaml", "shared_hands");
   expect_parse_error("personalisation:\n  joint_balls: 3\n", "balls.yaml", "joint_balls");
   expect_parse_error("personalisation:\n  digit_axes: often\n", "axes.yaml", "digit_axes");

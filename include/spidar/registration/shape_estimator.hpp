@@ -63,11 +63,25 @@ enum class KeyframePrior {
   kLast,   ///< toward the keyframe's pose at the last re-estimate
 };
 
+/// Which keyframe a new one replaces once ShapeEstimatorParams::keyframes are held.
+enum class KeyframeWindow {
+  kNewest,   ///< the oldest: the window holds the last poses (and the estimate follows them)
+  kSession,  ///< a uniformly random one, kept with probability keyframes / n for the n-th (reservoir
+             ///< sampling): the window is a uniform sample of every pose since the start
+};
+
 struct ShapeEstimatorParams {
   double prior_sigma_length_m = 0.015;  ///< σ₀ of the starting profile's length [m]
   double prior_sigma_width_m = 0.008;   ///< σ₀ of its width [m]
   double prior_sigma_thickness = 0.1;   ///< σ₀ of its digits' thickness (1 = the proportions')
-  int keyframes = 24;                   ///< kept (the oldest is replaced)
+  int keyframes = 24;                   ///< kept (which is replaced: keyframe_window)
+  /// A hand's size does not change, so a window of the newest poses throws good evidence away and
+  /// lets the last part of a session decide: with kNewest the demo's right hand, 1 % narrow
+  /// through the turns, ended 5–10 % wide after the release and the withdrawal, whose fast motion
+  /// filled the window with open-hand poses. Each keyframe's pose is re-fitted at every
+  /// re-estimate, so an old one stays valid. The draws are a hash of the candidate's count
+  /// (deterministic: a replay draws the same).
+  KeyframeWindow keyframe_window = KeyframeWindow::kNewest;
   double min_pose_change = 0.08;        ///< a keyframe differs from every kept one by this (‖Δθ‖, m/rad)
   int solve_every = 10;                 ///< re-estimate after this many new keyframes
   int min_keyframes = 6;                ///< no estimate before this many keyframes
@@ -292,6 +306,7 @@ class ShapeEstimator {
   /// session only (the holding hand's hardly ever), and what they showed stays true.
   std::vector<double> section_sizes_;
   std::uint64_t next_serial_ = 0;
+  std::vector<std::uint64_t> candidates_;  ///< per hand: new poses offered (KeyframeWindow::kSession)
   int new_since_solve_ = 0;
   ShapeEstimate estimate_;  ///< in hand 0's sizes (β)
   std::future<Solve> pending_;
