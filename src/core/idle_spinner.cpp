@@ -1,4 +1,5 @@
 #include "spidar/core/idle_spinner.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include <pthread.h>
 #include <sched.h>
@@ -30,6 +31,7 @@ constexpr std::int64_t kMaxSleepNs = 1'000'000;
 }  // namespace
 
 void* IdleSpinner::spin(void* self_ptr) {
+  set_thread_name("spidar-spin");
   auto* self = static_cast<IdleSpinner*>(self_ptr);
   auto round = [self] {
     for (int i = 0; i < kPausesPerRound; ++i) cpu_pause();

@@ -1,4 +1,5 @@
 #include "spidar/core/side_task.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include <stdexcept>
 
@@ -67,6 +68,7 @@ void SideTask::wait() {
 }
 
 void SideTask::loop() {
+  set_thread_name("spidar-side");
   std::unique_lock lock(mutex_);
   for (;;) {
     wake_.wait(lock, [this] { return quit_ || state_.load(std::memory_order_acquire) == kOffered; });

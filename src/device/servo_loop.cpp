@@ -1,4 +1,5 @@
 #include "spidar/device/servo_loop.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include "spidar/core/idle_spinner.hpp"
 #include "spidar/core/realtime.hpp"
@@ -181,6 +182,7 @@ void ServoLoop::reset_faults() {
 }
 
 void ServoLoop::monitor(pthread_t servo_thread) {
+  core::set_thread_name("spidar-watchdog");
   // Detects a servo thread that stopped cycling (stuck in a read, starved): safe state at once.
   const auto window_ns = std::max<std::int64_t>(core::s_to_ns(servo_.stall_limit_s), 1'000'000);
   // The end by the wall clock, whether the servo thread runs or not.
@@ -235,6 +237,7 @@ void ServoLoop::end_servo_thread(pthread_t servo_thread, std::int64_t window_ns)
 }
 
 void ServoLoop::run() {
+  core::set_thread_name("spidar-servo");
   if (servo_.on_thread_start) servo_.on_thread_start();
   const core::ThreadCounters counters_at_start = core::thread_counters();
   // The thread's page faults and preemptions since it started (for the report and a stall's message).

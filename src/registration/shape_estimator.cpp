@@ -1,4 +1,5 @@
 #include "spidar/registration/shape_estimator.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include <Eigen/Cholesky>
 #include <opencv2/core.hpp>
@@ -522,6 +523,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
   if (p_.apply_after_frames <= 0) return apply(run_solve(std::move(job)));
   polls_since_start_ = 0;
   pending_ = std::async(std::launch::async, [job = std::move(job)]() mutable {
+    core::set_thread_name("spidar-shape");
     (void)core::set_nice(0);  // best effort: an ordinary share, below the frame thread's
     return run_solve(std::move(job));
   });

@@ -1,4 +1,5 @@
 #include "spidar/session/async_sinks.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -114,6 +115,7 @@ void AsyncSinks::on_start() {
   std::promise<void> ready;
   auto started = ready.get_future();
   thread_ = std::thread([this, &ready] {
+    core::set_thread_name("spidar-output");
     if (nice_ != 0) (void)core::set_nice(nice_);  // best effort: a normal share otherwise
     try {
       start_comparison();

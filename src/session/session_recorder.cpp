@@ -1,4 +1,5 @@
 #include "spidar/session/session_recorder.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -108,6 +109,7 @@ void SessionRecorder::note_error(const std::string& e) {
 }
 
 void SessionRecorder::run() {
+  core::set_thread_name("spidar-record");
   try {
     for (;;) {
       std::deque<FrameRecord> frames;

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/core/thread_name.hpp"
 #include "spidar/core/wait_until.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/session/frame_source.hpp"
@@ -90,7 +91,10 @@ class CaptureSource final : public ThreadedSource {
   ~CaptureSource() override { stop(); }
   Status start(std::int64_t t0_ns) override {
     t0_ns_ = t0_ns;
-    thread_ = std::thread([this] { run(); });
+    thread_ = std::thread([this] {
+      core::set_thread_name("spidar-capture");
+      run();
+    });
     return Ok{};
   }
 
@@ -127,7 +131,10 @@ class InteractiveSource final : public ThreadedSource {
   Status start(std::int64_t t0_ns) override {
     std::promise<Status> ready;
     auto done = ready.get_future();
-    thread_ = std::thread([this, t0_ns, &ready] { run(t0_ns, ready); });
+    thread_ = std::thread([this, t0_ns, &ready] {
+      core::set_thread_name("spidar-camera");
+      run(t0_ns, ready);
+    });
     Status st = done.get();
     if (!st) stop();
     return st;

@@ -1,4 +1,5 @@
 #include "spidar/sim/camera_thread.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -103,6 +104,7 @@ bool CameraThread::take() {
 void CameraThread::run(const vision::Camera& camera, const std::array<hand::HandModel, 2>& truth,
                        const SyntheticCameraParams& film_params, const RubiksTask& task,
                        std::function<void(Status)> ready) {
+  core::set_thread_name("spidar-camera");
   (void)core::set_nice(params_.nice);  // best effort (see CameraThreadParams::nice)
   // However the thread ends, a frame thread waiting for a frame is woken.
   struct WakeWaitersAtEnd {

@@ -1,4 +1,5 @@
 #include "spidar/sim/haptic_bridge.hpp"
+#include "spidar/core/thread_name.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -89,6 +90,7 @@ void PhysicsThread::stop() {
 }
 
 void PhysicsThread::run() {
+  core::set_thread_name("spidar-physics");
   if (rt_priority_ > 0) realtime_ = core::set_fifo_priority(rt_priority_).ok();
   const auto n = static_cast<int>(world_.proxies().size());
   std::vector<Vec3> p(n, Vec3::Zero()), v(n, Vec3::Zero());

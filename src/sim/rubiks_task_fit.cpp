@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "spidar/hand/kinematics.hpp"
+#include "spidar/core/thread_name.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 #include "spidar/sim/finger_hold.hpp"
 #include "spidar/sim/rubiks_task.hpp"
@@ -123,6 +124,7 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
   };
   std::exception_ptr right_failed;
   std::thread right([&] {
+    core::set_thread_name("spidar-fit");
     try {
       fit_hand(1);
     } catch (...) {

@@ -50,6 +50,20 @@ struct SyntheticCamera::Impl {
   vision::Camera drawn;  ///< the camera the renderer draws with (pinhole)
   cv::Mat through_lens;
   SyntheticCameraParams params;
+
+  /// camera, lens and drawn for `c`; nothing changes on error (a lens that cannot be undistorted).
+  Status set_camera(const vision::Camera& c) {
+    std::optional<vision::LensUndistortion> l;
+    if (!c.intrinsics().distortion.is_zero()) {
+      auto made = vision::LensUndistortion::create(c.intrinsics());
+      if (!made) return Error{"synthetic camera: " + made.error().message};
+      l = std::move(made).value();
+    }
+    drawn = l ? l->pinhole_camera(c.X_CW()) : c;
+    camera = c;
+    lens = std::move(l);
+    return Ok{};
+  }
   std::array<AnatomicalHand, 2> hands;
   /// Both hands' parts, left then right: posed in place every frame (MeshData::version).
   std::shared_ptr<std::vector<MeshData>> meshes;
@@ -111,14 +125,7 @@ Result<std::unique_ptr<SyntheticCamera>> SyntheticCamera::create(
   if (truth[0].side != hand::Side::kLeft || truth[1].side != hand::Side::kRight)
     return Error{"synthetic camera: truth models must be {left, right}"};
   auto impl = std::make_unique<Impl>();
-  impl->camera = camera;
-  impl->drawn = camera;
-  if (!camera.intrinsics().distortion.is_zero()) {
-    auto lens = vision::LensUndistortion::create(camera.intrinsics());
-    if (!lens) return Error{"synthetic camera: " + lens.error().message};
-    impl->lens = std::move(lens).value();
-    impl->drawn = vision::Camera(impl->lens->pinhole(), camera.X_CW());
-  }
+  if (auto st = impl->set_camera(camera); !st) return st.error();
   impl->params = params;
   AnatomicalHandParams k;
   k.forearm_length_m = params.forearm_length_m;
@@ -154,18 +161,7 @@ const vision::Camera& SyntheticCamera::camera() const { return impl_->camera; }
 Status SyntheticCamera::set_camera(const vision::Camera& camera) {
   if (camera.width() != impl_->camera.width() || camera.height() != impl_->camera.height())
     return Error{"synthetic camera: set_camera cannot change the image size"};
-  std::optional<vision::LensUndistortion> lens;
-  vision::Camera drawn = camera;
-  if (!camera.intrinsics().distortion.is_zero()) {
-    auto l = vision::LensUndistortion::create(camera.intrinsics());
-    if (!l) return Error{"synthetic camera: " + l.error().message};
-    lens = std::move(l).value();
-    drawn = vision::Camera(lens->pinhole(), camera.X_CW());
-  }
-  impl_->camera = camera;
-  impl_->lens = std::move(lens);
-  impl_->drawn = drawn;
-  return Ok{};
+  return impl_->set_camera(camera);
 }
 const SyntheticCameraParams& SyntheticCamera::params() const { return impl_->params; }
 

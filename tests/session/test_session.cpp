@@ -6,7 +6,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <string>
 #include <thread>
 #include <stdexcept>
 #include <vector>
@@ -72,6 +75,32 @@ TEST(Session, EverySinkSeesEveryProcessedFrameInOrderWithIncreasingTimes) {
   EXPECT_EQ(a.calls.back(), 'e');
   EXPECT_EQ(std::count(a.calls.begin(), a.calls.end(), 'e'), 1);
   EXPECT_FALSE(s.session->running());
+}
+
+/// The names of the process's threads now (/proc/self/task/*/comm).
+std::vector<std::string> thread_names() {
+  std::vector<std::string> out;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream in(task.path() / "comm");
+    std::string name;
+    if (std::getline(in, name)) out.push_back(name);
+  }
+  return out;
+}
+
+// A running session's threads carry their roles' names (core::set_thread_name), so that `top -H`,
+// `ps -L`, perf and gdb tell them apart on a busy machine.
+TEST(Session, ItsThreadsAreNamedForTheirRoles) {
+  SimulatedSetup s(0.6);
+  std::vector<std::string> seen;
+  FunctionSink look([&](const FrameEvent&) {
+    if (seen.empty()) seen = thread_names();
+  });
+  s.session->add_sink(look);
+  (void)s.session->run();
+  ASSERT_FALSE(seen.empty()) << "no frame processed";
+  for (const char* role : {"spidar-servo", "spidar-watchdog", "spidar-physics", "spidar-camera"})
+    EXPECT_NE(std::find(seen.begin(), seen.end(), role), seen.end()) << role;
 }
 
 TEST(Session, WarmUpHappensOnceAndTheFirstRealFrameIsAColdStart) {

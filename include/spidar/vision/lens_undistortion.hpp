@@ -30,6 +30,8 @@ class LensUndistortion {
   const Intrinsics& lens() const { return lens_; }
   /// The pinhole camera's intrinsics: the lens's image size, no distortion.
   const Intrinsics& pinhole() const { return pinhole_; }
+  /// The pinhole camera at the lens camera's pose `X_CW` (undistortion does not turn the view).
+  Camera pinhole_camera(const Pose& X_CW) const { return Camera(pinhole_, X_CW); }
 
   /// The sensor's frame (lens().width × lens().height, any depth and channel count) → the pinhole
   /// camera's image, bilinear. Reuses `pinhole_image`'s buffer.
