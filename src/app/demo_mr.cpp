@@ -220,6 +220,7 @@ int run_mr_demo(const DemoOptions& o) {
   MrSummary summary;
   summary.seconds = end.t_last_s;
   summary.wall_s = end.wall_s;
+  summary.thread_cpu = end.thread_cpu;
   summary.dropped = static_cast<int>(end.camera_frames) - static_cast<int>(trace.frames.size());
   summary.camera_skipped = static_cast<int>(end.camera_skipped);
   summary.output_waits = off_path.waits();

@@ -350,6 +350,11 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"frames", frames},
       {"seconds", s.seconds},
       {"wall_seconds", s.wall_s},
+      {"threads", [&] {  // CPU seconds by thread name over the run (start-up included)
+         nlohmann::json by_name = nlohmann::json::object();
+         for (const core::ThreadCpu& c : s.thread_cpu) by_name[c.name] = {{"cpu_s", c.cpu_s}, {"count", c.threads}};
+         return by_name;
+       }()},
       {"dropped_frames", s.dropped},
       {"image", {{"width", s.width}, {"height", s.height}}},
       {"scene", s.scene},

@@ -294,8 +294,10 @@ void Session::stop_threads() {
 SessionSummary Session::stop(const std::string& ended_by) {
   if (summary_) return *summary_;
   const double wall_s = seconds();
+  std::vector<core::ThreadCpu> thread_cpu = core::thread_cpu_by_name();  // while they all still run
   stop_threads();
   SessionSummary s;
+  s.thread_cpu = std::move(thread_cpu);
   s.ended_by = ended_by;
   s.wall_s = wall_s;
   s.t_last_s = t_last_s_;

@@ -305,6 +305,12 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   EXPECT_LE(j["haptic"]["cycle_us_median"].get<double>(), j["haptic"]["cycle_us_p99"].get<double>());
   EXPECT_LE(j["haptic"]["cycle_us_p99"].get<double>(), j["haptic"]["cycle_us_max"].get<double>() + 1.0);
   EXPECT_GT(j["physics"]["step_ms_median"].get<double>(), 0.0);
+  // CPU by thread name: the servo, physics and camera threads are there under their roles' names.
+  for (const char* role : {"spidar-servo", "spidar-physics", "spidar-camera"}) {
+    ASSERT_TRUE(j["threads"].contains(role)) << j["threads"].dump();
+    EXPECT_GE(j["threads"][role]["cpu_s"].get<double>(), 0.0);
+    EXPECT_GE(j["threads"][role]["count"].get<int>(), 1);
+  }
   const auto& reg = j["registration"];
   // Measured at 320x240 on a quiet machine: IoU 0.77, fingertips 1.9 mm, joints 7.2 px; with
   // other tests running beside it (dropped frames, late fits) IoU 0.62.

@@ -4,7 +4,11 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
+#include <ctime>
 #include <fstream>
+#include <vector>
 #include <string>
 #include <thread>
 
@@ -33,6 +37,37 @@ TEST(ThreadName, NamesTheCallingThreadAsTheSystemSeesItCutTo15Characters) {
   EXPECT_EQ(read_back, "spidar-a-long-t");
   // The caller's own name is left alone.
   EXPECT_NE(thread_name(), "spidar-a-long-t");
+}
+
+// A thread that burned 60 ms of its own CPU time shows at least 50 ms under its name (the
+// kernel counts in 10 ms ticks), and a sleeping one next to nothing.
+TEST(ThreadName, TheProcesssThreadsCpuTimeIsSummedByName) {
+  std::atomic<bool> measured{false};
+  std::vector<ThreadCpu> seen;
+  std::thread sleeper([&] {
+    set_thread_name("spidar-sleeper");
+    while (!measured.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  });
+  std::thread busy([&] {
+    set_thread_name("spidar-busytest");
+    timespec t{};
+    do clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    while (t.tv_sec == 0 && t.tv_nsec < 60'000'000);
+    seen = thread_cpu_by_name();
+    measured = true;
+  });
+  busy.join();
+  sleeper.join();
+  auto find = [&](const std::string& n) {
+    for (const ThreadCpu& c : seen)
+      if (c.name == n) return c;
+    return ThreadCpu{};
+  };
+  EXPECT_GE(find("spidar-busytest").cpu_s, 0.05);
+  EXPECT_EQ(find("spidar-busytest").threads, 1);
+  EXPECT_EQ(find("spidar-sleeper").threads, 1);
+  EXPECT_LT(find("spidar-sleeper").cpu_s, find("spidar-busytest").cpu_s);
+  for (std::size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i - 1].cpu_s, seen[i].cpu_s);  // most first
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "spidar/core/scene_snapshot.hpp"
+#include "spidar/core/thread_name.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/session/cube_monitor.hpp"
@@ -84,6 +85,9 @@ struct SessionSummary {
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;
   std::string camera_error;            ///< why the camera stopped, if it failed
+  /// CPU time by thread name just before the session's threads stopped (core::thread_cpu_by_name:
+  /// the frame thread under the program's name, spidar-servo, spidar-physics, spidar-camera, ...).
+  std::vector<core::ThreadCpu> thread_cpu;
 };
 
 class FrameSink {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "spidar/core/thread_name.hpp"
 #include "spidar/device/servo_loop.hpp"
 #include "spidar/physics/world.hpp"
 #include "spidar/session/truth_scorer.hpp"
@@ -51,6 +52,7 @@ struct MrSummary {
   std::uint64_t mujoco_warnings = 0;   ///< MuJoCo warnings in the process (physics::mujoco_warnings)
   std::vector<physics::World::WarningCount> mujoco_warning_kinds;  ///< the world's, by kind
   std::string mujoco_log;              ///< OUT/mujoco_log.txt when there were warnings
+  std::vector<core::ThreadCpu> thread_cpu;  ///< SessionSummary::thread_cpu (report.json `threads`)
 };
 
 /// Writes report.json and the plots into `out`, prints the summary; returns the exit code.
