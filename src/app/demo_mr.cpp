@@ -28,6 +28,7 @@
 #include "spidar/session/session.hpp"
 #include "spidar/session/truth_scorer.hpp"
 #include "spidar/vision/camera_config.hpp"
+#include "spidar/vision/lens_undistortion.hpp"
 
 namespace spidar::app {
 
@@ -73,11 +74,8 @@ int run_mr_demo(const DemoOptions& o) {
   // A calibration with lens distortion: the synthetic camera films through that lens, and the
   // session undistorts its frames into the lens's pinhole camera, as with a real camera
   // (vision::LensUndistortion). A lens that cannot be undistorted is refused here.
-  try {
-    (void)session::pinhole_camera(calibrated);
-  } catch (const SpidarError& e) {
-    throw UsageError("--camera " + o.camera + ": " + e.what());
-  }
+  if (auto st = vision::LensUndistortion::check(calibrated.intrinsics()); !st)
+    throw UsageError("--camera " + o.camera + ": camera: " + st.error().message);
   {
     // Scaling a calibration to another aspect ratio would make its pixels non-square.
     const double a = static_cast<double>(o.width) / o.height;

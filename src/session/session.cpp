@@ -19,21 +19,6 @@ constexpr std::int64_t kFrameWaitNs = 5'000'000;
 Session::Session(Rig& rig, Scene& scene, render::Context& context, const SessionParams& params)
     : rig_(rig), scene_(scene), context_(context), params_(params) {}
 
-namespace {
-/// The calibration's lens, if it has distortion; SpidarError where it cannot be undistorted.
-std::optional<vision::LensUndistortion> lens_of(const vision::Camera& calibrated) {
-  if (calibrated.intrinsics().distortion.is_zero()) return std::nullopt;
-  auto lens = vision::LensUndistortion::create(calibrated.intrinsics());
-  if (!lens) throw SpidarError("camera: " + lens.error().message);
-  return std::move(lens).value();
-}
-}  // namespace
-
-vision::Camera pinhole_camera(const vision::Camera& calibrated) {
-  const auto lens = lens_of(calibrated);
-  return lens ? lens->pinhole_camera(calibrated.X_CW()) : calibrated;
-}
-
 std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context& context,
                                          const vision::Camera& camera,
                                          const std::array<hand::HandModel, 2>& models,
@@ -41,7 +26,9 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
   if (params.warm_results < 1 || params.warm_results > 32)
     throw SpidarError("session: warm_results must be in 1..32, got " + std::to_string(params.warm_results));
   std::unique_ptr<Session> s(new Session(rig, scene, context, params));
-  s->lens_ = lens_of(camera);
+  auto lens = vision::LensUndistortion::of(camera.intrinsics());
+  if (!lens) throw SpidarError("camera: " + lens.error().message);
+  s->lens_ = std::move(lens).value();
   s->camera_ = s->lens_ ? s->lens_->pinhole_camera(camera.X_CW()) : camera;
   // --- the haptic side: servo loop ↔ bridge ↔ physics thread (none when playing back) ---
   if (!rig.plays_back()) {

@@ -53,15 +53,11 @@ struct SyntheticCamera::Impl {
 
   /// camera, lens and drawn for `c`; nothing changes on error (a lens that cannot be undistorted).
   Status set_camera(const vision::Camera& c) {
-    std::optional<vision::LensUndistortion> l;
-    if (!c.intrinsics().distortion.is_zero()) {
-      auto made = vision::LensUndistortion::create(c.intrinsics());
-      if (!made) return Error{"synthetic camera: " + made.error().message};
-      l = std::move(made).value();
-    }
-    drawn = l ? l->pinhole_camera(c.X_CW()) : c;
+    auto l = vision::LensUndistortion::of(c.intrinsics());
+    if (!l) return Error{"synthetic camera: " + l.error().message};
+    drawn = l.value() ? l.value()->pinhole_camera(c.X_CW()) : c;
     camera = c;
-    lens = std::move(l);
+    lens = std::move(l).value();
     return Ok{};
   }
   std::array<AnatomicalHand, 2> hands;

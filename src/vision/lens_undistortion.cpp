@@ -32,7 +32,7 @@ double corner_radius(const Intrinsics& in) {
 
 }  // namespace
 
-Result<LensUndistortion> LensUndistortion::create(const Intrinsics& lens) {
+Result<Intrinsics> LensUndistortion::pinhole_of(const Intrinsics& lens) {
   if (auto st = validate_intrinsics(lens); !st) return st.error();
   const Distortion& d = lens.distortion;
   // The radial mapping r ↦ r (1 + k1 r² + k2 r⁴ + k3 r⁶) must rise until it reaches the sensor's
@@ -53,8 +53,6 @@ Result<LensUndistortion> LensUndistortion::create(const Intrinsics& lens) {
       return Error{m.str()};
     }
   }
-  LensUndistortion out;
-  out.lens_ = lens;
   const cv::Mat K = k_of(lens), D = detail::distortion_to_cv(d);
   const cv::Size size(lens.width, lens.height);
   cv::Mat K1;
@@ -77,7 +75,29 @@ Result<LensUndistortion> LensUndistortion::create(const Intrinsics& lens) {
       << "a real lens's calibration does not (recalibrate)";
     return Error{m.str()};
   }
-  out.pinhole_ = p;
+  return p;
+}
+
+Status LensUndistortion::check(const Intrinsics& lens) {
+  if (auto p = pinhole_of(lens); !p) return p.error();
+  return Ok{};
+}
+
+Result<std::optional<LensUndistortion>> LensUndistortion::of(const Intrinsics& calibration) {
+  if (calibration.distortion.is_zero()) return std::optional<LensUndistortion>{};
+  auto lens = create(calibration);
+  if (!lens) return lens.error();
+  return std::optional<LensUndistortion>(std::move(lens).value());
+}
+
+Result<LensUndistortion> LensUndistortion::create(const Intrinsics& lens) {
+  auto p = pinhole_of(lens);
+  if (!p) return p.error();
+  LensUndistortion out;
+  out.lens_ = lens;
+  out.pinhole_ = p.value();
+  const cv::Mat K = k_of(lens), D = detail::distortion_to_cv(lens.distortion), K1 = k_of(out.pinhole_);
+  const cv::Size size(lens.width, lens.height);
   cv::initUndistortRectifyMap(K, D, cv::noArray(), K1, size, CV_16SC2, out.undistort_xy_, out.undistort_frac_);
   // The inverse (sensor pixel → pinhole image) by OpenCV's iterative undistortion of every
   // sensor pixel, run to convergence (cv::initInverseRectificationMap's default 5 iterations

@@ -60,19 +60,14 @@ struct SessionParams {
   int frame_nice = -5;
 };
 
-/// The camera a session's pipelines work in for a calibration: itself without lens distortion,
-/// else the pinhole camera its frames are undistorted into (vision::LensUndistortion; same pose
-/// and image size). Throws SpidarError naming the coefficients where the lens cannot be
-/// undistorted (it folds the image).
-vision::Camera pinhole_camera(const vision::Camera& calibrated);
-
 class Session {
  public:
   /// Builds the servo loop, the physics thread and the pipelines (nothing started; a rig that
   /// plays back gets the pipelines only, `scene` gives the shapes its poses apply to). `context`
   /// must be current on the calling thread (the frame thread) and outlive the session, as must
   /// the rig and the scene. `camera`: the camera's calibration; with lens distortion its frames
-  /// are undistorted as they arrive, and the pipelines work with its pinhole camera (camera()). `drive`: the device the servo loop drives if not the rig's own (a
+  /// are undistorted as they arrive, and the pipelines work with its pinhole camera (camera()).
+  /// Throws SpidarError naming the coefficients where the lens cannot be undistorted. `drive`: the device the servo loop drives if not the rig's own (a
   /// wrapper around it, e.g. one that records every cycle). Throws SpidarError saying what failed.
   static std::unique_ptr<Session> create(Rig& rig, Scene& scene, render::Context& context,
                                          const vision::Camera& camera,
@@ -129,7 +124,7 @@ class Session {
   std::uint64_t camera_frames() const;
 
   /// The camera the pipelines work in: the calibration given, or, where it has lens distortion,
-  /// the pinhole camera its frames are undistorted into (pinhole_camera()).
+  /// the pinhole camera its frames are undistorted into (vision::LensUndistortion).
   const vision::Camera& camera() const { return camera_; }
   Rig& rig() { return rig_; }
   Scene& scene() { return scene_; }

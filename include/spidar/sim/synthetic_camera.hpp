@@ -70,7 +70,7 @@ class SyntheticCamera {
   /// necessarily the registration's). The context must stay alive and current on this thread.
   /// A `camera` with lens distortion films through its lens: the colour image is bent as the lens
   /// bends it (vision::LensUndistortion::distort), while the ground truth (masks, ids, depth)
-  /// stays in the view of its pinhole camera (session::pinhole_camera), where the frames are
+  /// stays in the view of its pinhole camera (vision::LensUndistortion), where the frames are
   /// undistorted into and the pipeline works. Error where the lens cannot be undistorted.
   static Result<std::unique_ptr<SyntheticCamera>> create(render::Context& context,
                                                          const vision::Camera& camera,
