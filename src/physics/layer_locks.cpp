@@ -14,7 +14,7 @@ namespace {
 
 constexpr int kFaceAxis[6] = {2, 2, 1, 1, 0, 0};    // U D F B R L
 constexpr int kFaceSign[6] = {+1, -1, -1, +1, +1, -1};
-constexpr double kLayerShare = 9.0 / 26.0;        // a layer's share of the cube's cubelets
+constexpr double kPieces = 26.0;                  // the cube's cubelets (a layer holds 9)
 
 Vec3 vec(const mjtNum* p) { return {p[0], p[1], p[2]}; }
 Quat quat(const mjtNum* q) { return Quat(q[0], q[1], q[2], q[3]).normalized(); }
@@ -41,6 +41,7 @@ std::shared_ptr<LayerLocks> LayerLocks::Create(const mjModel* m, int core_body,
   l->core_ = core_body;
   l->pieces_ = pieces;
   l->tau_.resize(pieces.size());
+  l->riding_.resize(pieces.size());
   l->params_ = params;
   l->pitch_ = pitch;
   l->piece_of_body_.assign(static_cast<std::size_t>(m->nbody), -1);
@@ -118,13 +119,26 @@ void LayerLocks::measure(const mjModel* m, const mjData* d) {
   Vec3 all = Vec3::Zero();
   for (const Vec3& t : tau) all += t;
   const Quat q_core = quat(d->xquat + 4 * core_);
+  // While a layer turns, its pieces ride on its centre, not on the core: a force on one of them
+  // twists the turning layer (or the cube), never a layer across it, which on a real cube cannot
+  // move until the turning one is back at a click. So another layer's twist counts only its
+  // pieces outside the turning layer, and their share of the cube's rigid motion.
+  std::vector<char>& riding = riding_;
+  const std::size_t n = pieces_.size();
+  riding.assign(n, 0);
+  if (turning_ >= 0)
+    for (std::size_t i = 0; i < n; ++i) riding[i] = in_layer(d, static_cast<int>(i), turning_) ? 1 : 0;
   for (int f = 0; f < 6; ++f) {
     Vec3 layer = Vec3::Zero();
-    for (int i = 0; i < static_cast<int>(pieces_.size()); ++i)
-      if (in_layer(d, i, f)) layer += tau[static_cast<std::size_t>(i)];
+    int count = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (in_layer(d, static_cast<int>(i), f) && (f == turning_ || !riding[i])) {
+        layer += tau[i];
+        ++count;
+      }
     Vec3 axis = Vec3::Zero();
     axis[kFaceAxis[f]] = kFaceSign[f];
-    twist_[f] = (q_core * axis).dot(layer - kLayerShare * all);
+    twist_[f] = (q_core * axis).dot(layer - (count / kPieces) * all);
   }
 }
 

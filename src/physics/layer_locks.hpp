@@ -9,7 +9,9 @@
 ///   twist_f = τ_layer − (9 / 26) τ_all      (about face f's outward axis through the centre),
 ///
 /// the part of the torque on the layer that its locks must carry (τ_all spread over the 26
-/// cubelets by mass would move the cube rigidly). When |twist_f| exceeds the breakaway torque for
+/// cubelets by mass would move the cube rigidly). While a layer turns, the layers across it count
+/// only their pieces outside it (6 of 9, and 6 / 26 of τ_all): the pieces they share ride on the
+/// turning layer's centre, so a hand turning that layer does not twist the layers across it. When |twist_f| exceeds the breakaway torque for
 /// the breakaway time (and `dominance` times every other layer's), layer f unlocks: its centre's weld is switched off
 /// (the centre turns on its hinge, with the detent) and the other eight cubelets of the layer are
 /// welded to the centre instead of the core. When the layer rests near a click, twisted less than
@@ -76,6 +78,7 @@ class LayerLocks {
   double candidate_s_ = 0, settle_s_ = 0;
   std::array<double, 6> twist_{};
   std::vector<Vec3> tau_;  ///< per piece, reused
+  std::vector<char> riding_;  ///< per piece: in the turning layer (measure()), reused
   int unlocks_ = 0;
 };
 
