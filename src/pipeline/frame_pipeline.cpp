@@ -1,6 +1,7 @@
 #include "spidar/pipeline/frame_pipeline.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <opencv2/core.hpp>
@@ -75,6 +76,18 @@ hand::HandModel fit_model(hand::HandModel model, const FramePipelineParams& p) {
   return model;
 }
 
+/// The fastest of a hand's measured fingertips between two samples `dt_s` apart [m/s]; infinity
+/// when none is measured in both or dt_s is not positive (an unknown speed passes no gate).
+double fastest_fingertip_m_s(const std::array<Vec3, hand::kFingertipCount>& before,
+                             const registration::HandObservation& now, double dt_s) {
+  double fastest = -1.0;
+  if (dt_s > 0)
+    for (int f = 0; f < hand::kFingertipCount; ++f)
+      if (now.fingertip_valid[f] && before[f].allFinite())
+        fastest = std::max(fastest, (now.p_W_fingertip[f] - before[f]).norm() / dt_s);
+  return fastest < 0 ? std::numeric_limits<double>::infinity() : fastest;
+}
+
 /// The fit's fingertip cost per measured fingertip (dimensionless: 1 = each σ from the strings);
 /// 0 when no fingertip is measured.
 double fingertip_cost_per_tip(const registration::FitReport& report, const registration::HandObservation& obs) {
@@ -127,6 +140,11 @@ struct FramePipeline::Impl {
   /// The forearms' directions estimated from their bands (registration/forearm_from_band.hpp),
   /// world, from the last frame that showed them.
   std::array<std::optional<Vec3>, 2> estimated_toward_elbow_W;
+  /// Each hand's fingertips from the strings at the previous frame (world [m]; NaN = not measured)
+  /// and that frame's sample time [ns]: how fast the hand moves (ShapeEstimatorParams::max_keyframe_speed_m_s).
+  std::array<std::array<Vec3, hand::kFingertipCount>, 2> previous_tips_W{};
+  std::int64_t previous_tips_t_ns = 0;
+  bool have_previous_tips = false;
 
   Status key_and_evidence(const cv::Mat& bgr, const vision::ChromaKeyResult* matte, FrameResult* out);
   Status find_bracelets(const cv::Mat& bgr, FrameResult* out);
@@ -205,6 +223,7 @@ void FramePipeline::reset() {
   for (int h = 0; h < 2; ++h) s.models[h] = fit_model(s.start[h], s.params);
   s.make_estimators();
   s.estimated_toward_elbow_W = {};
+  s.have_previous_tips = false;
 }
 Status FramePipeline::warm_start(const std::array<hand::HandParams, 2>& fits) {
   for (int h = 0; h < 2; ++h)
@@ -369,6 +388,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
   if (p.personalise_shape)
     for (registration::ShapeEstimator& e : s.shape)
       if (e.poll()) s.take_sizes(e);
+  std::array<std::array<Vec3, hand::kFingertipCount>, 2> next_tips_W{};
   for (int h = 0; h < 2; ++h) {
     registration::HandObservation obs;
     obs.forearm_H = s.forearm_H[h];
@@ -510,13 +530,24 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     // Only a fit that agrees with the strings is evidence on the sizes: a broken one (a lost
     // bracelet, a local minimum) would pull them toward whatever explains it.
     // (A frame without all four fingertips makes no keyframe anyway: ShapeEstimator::add_frame.)
-    if (p.personalise_shape && fingertip_cost_per_tip(report, obs) <= p.shape_estimator.max_fingertip_cost) {
+    // A fast hand's frame mixes times (ShapeEstimatorParams::max_keyframe_speed_m_s).
+    const double speed_gate = p.shape_estimator.max_keyframe_speed_m_s;
+    const bool still = speed_gate <= 0 ||
+                       (s.have_previous_tips &&
+                        fastest_fingertip_m_s(s.previous_tips_W[h], obs, 1e-9 * double(tips.t_ns - s.previous_tips_t_ns)) <=
+                            speed_gate);
+    for (int f = 0; f < hand::kFingertipCount; ++f)
+      next_tips_W[h][f] = obs.fingertip_valid[f] ? obs.p_W_fingertip[f] : Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (p.personalise_shape && still && fingertip_cost_per_tip(report, obs) <= p.shape_estimator.max_fingertip_cost) {
       registration::ShapeEstimator& e = s.estimator_of(h);
       if (e.add_frame(s.index_in_estimator(h), q, obs, hand_image, p.registration)) s.take_sizes(e);
     }
     out->shapes[h] = s.estimator_of(h).estimate(s.index_in_estimator(h));
   }
   s.previous = out->hands;
+  s.previous_tips_W = next_tips_W;
+  s.previous_tips_t_ns = tips.t_ns;
+  s.have_previous_tips = true;
   if (s.have_previous) ++s.warm_frames;
   s.have_previous = true;
   tm.registration_ms = ms_since(t0);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -392,6 +393,68 @@ TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
   EXPECT_GT(keyframes[0][0], 2);
   EXPECT_EQ(keyframes[0][1], 0);
   EXPECT_GT(keyframes[1][1], 2);  // the test can fail: the broken fits would be offered
+}
+
+// A frame of a moving hand mixes times (the camera's rows exposed one after another, the strings
+// sampled at one instant), so the size estimator takes frames only while the hand is slower than
+// ShapeEstimatorParams::max_keyframe_speed_m_s, its fingertips' speed taken from the strings'
+// samples and their times. The script's hands grasp and lift the cube here: a gate at half the
+// slowest frame's speed (its fastest fingertip's, measured by the test from the samples) lets no
+// frame through; one at 100 m/s lets the frames through (all but the first, whose speed is not
+// known; a speed read from wrong times, infinite or negative, would pass no gate).
+TEST_F(FramePipelineTest, FastHandsAreNoEvidenceOnTheHandsSizes) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  p.personalise_shape = true;
+  p.shape_estimator.min_pose_change = 0.02;  // keyframes from a short stretch of the script
+  sim::RubiksTask task({});
+  task.fit_to_hands(truth_models_);
+  const double t0 = 1.8;
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(t0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  std::array<double, 3> gates{0.0, 0.0, 100.0};  // off, below the script's speed (set below), above it
+  std::array<std::array<int, 2>, 3> keyframes{};
+  double slowest = std::numeric_limits<double>::infinity();  // the slowest hand's fastest fingertip [m/s]
+  for (std::size_t g = 0; g < gates.size(); ++g) {
+    if (g == 1) {
+      ASSERT_GT(slowest, 1e-4);  // the hands move in every frame of this stretch
+      gates[1] = 0.5 * slowest;
+    }
+    FramePipelineParams q = p;
+    q.shape_estimator.max_keyframe_speed_m_s = gates[g];
+    auto pipe = FramePipeline::create(*context_, camera_, models_, q).value();
+    sim::UserHands user(truth_models_, task);
+    sim::SyntheticFrame frame;
+    FrameResult r;
+    std::optional<device::FingertipSample> before;
+    for (double t = t0; t < t0 + 1.0; t += 1.0 / 30) {
+      auto sample = pose_user(user, task, t);
+      sample.t_ns = std::llround(t * 1e9);
+      if (before && g == 0) {
+        for (int h = 0; h < 2; ++h) {  // the device's fingers 0–3 are the left hand's, 4–7 the right's
+          double fastest = 0;
+          for (int f = 4 * h; f < 4 * h + 4; ++f)
+            fastest = std::max(fastest, (device::fingertip_position(sample, f) - device::fingertip_position(*before, f)).norm() /
+                                            (1e-9 * double(sample.t_ns - before->t_ns)));
+          slowest = std::min(slowest, fastest);
+        }
+      }
+      before = sample;
+      const auto& truth = user.params();
+      ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+      ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());
+    }
+    for (int h = 0; h < 2; ++h) keyframes[g][h] = r.shapes[h].keyframes;
+  }
+  std::printf("keyframes, left / right: no gate %d / %d, %.4f m/s %d / %d, 100 m/s %d / %d\n", keyframes[0][0],
+              keyframes[0][1], gates[1], keyframes[1][0], keyframes[1][1], keyframes[2][0], keyframes[2][1]);
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_GT(keyframes[0][h], 2) << h;
+    EXPECT_EQ(keyframes[1][h], 0) << h;
+    EXPECT_GT(keyframes[2][h], 2) << h;
+  }
 }
 
 // The comparison fit takes the main fit's sizes (use_model_sizes) and keeps its own joint box.

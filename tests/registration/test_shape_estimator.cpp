@@ -439,6 +439,7 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.max_relative_change, d.max_relative_change);
   EXPECT_EQ(p.reach_min_miss_m, d.reach_min_miss_m);
   EXPECT_EQ(p.max_fingertip_cost, d.max_fingertip_cost);
+  EXPECT_EQ(p.max_keyframe_speed_m_s, d.max_keyframe_speed_m_s);
   EXPECT_EQ(p.apply_after_frames, 15);  // the sessions re-estimate on a thread of their own
   EXPECT_EQ(p.shared_hands, d.shared_hands);
   EXPECT_EQ(p.keyframe_prior_scale, d.keyframe_prior_scale);
@@ -494,6 +495,12 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
                      "expected a value in (1e-05, 0.1], got 1e-300");
   expect_parse_error("personalisation:\n  max_relative_change: 5\n", "big.yaml",
                      "expected a value in (0, 0.5], got 5");
+  // The keyframes' speed gate [m/s]: 0 is off; no negative or absurd speed.
+  const auto gate = core::ConfigNode::Parse("personalisation:\n  max_keyframe_speed_m_s: 0.1\n", "gate.yaml");
+  EXPECT_EQ(parse_shape_estimator_params(gate["personalisation"], &enabled).max_keyframe_speed_m_s, 0.1);
+  expect_parse_error("personalisation:\n  max_keyframe_speed_m_s: -0.1\n", "gate.yaml",
+                     "personalisation.max_keyframe_speed_m_s: expected a value in [0, 100], got -0.1");
+  expect_parse_error("personalisation:\n  max_keyframe_speed_m_s: 1e9\n", "gate.yaml", "max_keyframe_speed_m_s");
   const auto sections = core::ConfigNode::Parse("personalisation:\n  digit_section_sigma: 0.15\n", "sec.yaml");
   EXPECT_EQ(parse_shape_estimator_params(sections["personalisation"], &enabled).digit_section_sigma, 0.15);
   // An estimate that could never start (more keyframes needed than kept) is refused.

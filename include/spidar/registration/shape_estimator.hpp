@@ -130,6 +130,12 @@ struct ShapeEstimatorParams {
   /// (24–28 % off, IoU 0.726), 10 % off with it (IoU 0.745–0.746). A model of the wrong size
   /// cannot bring its caps to the strings, so the gate also keeps out the frames that say so.
   double max_fingertip_cost = 4.0;
+  /// The frame pipeline offers a frame to the estimator only when the hand's fingertips moved at
+  /// most this fast since the previous frame (the fastest of the four, from the strings) [m/s];
+  /// 0 = no gate. A moving hand's frame mixes times: the camera's rows are exposed one after
+  /// another during its readout, and the strings are sampled at one instant, so its image and its
+  /// fingertips disagree by the motion, which the sizes would absorb.
+  double max_keyframe_speed_m_s = 0.0;
   /// A session's two hands are one person's: the frame pipeline keeps one estimate for both
   /// (their sizes stay in the ratio of their starting profiles), so either hand's keyframes are
   /// evidence on both. The hand that holds the cube shows the camera the back of its palm, its
@@ -317,7 +323,7 @@ class ShapeEstimator {
 /// prior_sigma_length_m, prior_sigma_width_m, prior_sigma_thickness, keyframes, min_pose_change,
 /// solve_every, min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m,
 /// freeze_sigma_thickness, max_relative_change,
-/// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, shared_hands,
+/// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, max_keyframe_speed_m_s, shared_hands,
 /// keyframe_prior_scale, keyframe_prior (taken or last), palm_breadth_sigma_px, palm_breadth_at,
 /// palm_breadth_min_facing.
 /// Throws core::ConfigError naming file:line: key and the expected range.
