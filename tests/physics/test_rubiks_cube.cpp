@@ -2,6 +2,10 @@
 
 #include <mujoco/mujoco.h>
 
+#include <string>
+#include <utility>
+#include <vector>
+
 #include "spidar/core/units.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
 
@@ -10,6 +14,26 @@ namespace {
 
 std::unique_ptr<World> cube_world() {
   return World::Load(std::string(SPIDAR_SOURCE_DIR) + "/scenes/rubiks_cube.xml").value();
+}
+
+/// The cube's cubelets: body id and name (`cubelet_XYZ`, X Y Z its indices 0–2 along the cube's
+/// x, y and z axes).
+std::vector<std::pair<int, std::string>> cubelets(const mjModel* m) {
+  std::vector<std::pair<int, std::string>> out;
+  for (int b = 0; b < m->nbody; ++b) {
+    const char* n = mj_id2name(m, mjOBJ_BODY, b);
+    const std::string name = n ? n : "";
+    if (name.rfind("cubelet_", 0) == 0) out.emplace_back(b, name);
+  }
+  return out;
+}
+
+/// Body b's applied force set to `force` [N] tangential about the world z axis through c (positive
+/// counter-clockwise seen from above).
+void push_about_z(mjData* d, const Vec3& c, int b, double force) {
+  const Vec3 r(d->xpos[3 * b] - c.x(), d->xpos[3 * b + 1] - c.y(), 0);
+  const Vec3 t = r.norm() > 1e-4 ? Vec3(Vec3::UnitZ().cross(r) / r.norm()) : Vec3::Zero();
+  for (int i = 0; i < 3; ++i) d->xfrc_applied[6 * b + i] = force * t[i];
 }
 
 TEST(RubiksCube, StartsSolvedAndScrambleIsUndone) {
@@ -64,12 +88,10 @@ TEST(RubiksCube, TwistsBelowTheBreakawayLeaveTheCubeRigid) {
   // 0.3 N tangential on each cubelet about each of its faces' axes, alternating sense by face:
   // under 0.12 N·m of twist per layer, the breakaway (the detent alone gives way at 0.02 N·m).
   const int core = w->body_id("cube");
+  const auto pieces = cubelets(m);
   for (int k = 0; k < 1000; ++k) {
     const Vec3 c = w->body_pose(core).p;
-    for (int b = 0; b < m->nbody; ++b) {
-      const char* n = mj_id2name(m, mjOBJ_BODY, b);
-      const std::string name = n ? n : "";
-      if (name.rfind("cubelet_", 0) != 0) continue;
+    for (const auto& [b, name] : pieces) {
       const int ix = name[8] - '1', iy = name[9] - '1', iz = name[10] - '1';
       Vec3 f = Vec3::Zero();
       const Vec3 r(d->xpos[3 * b] - c.x(), d->xpos[3 * b + 1] - c.y(), d->xpos[3 * b + 2] - c.z());
@@ -99,12 +121,10 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
   // the layer is past the detent's midpoint (55°); then let go. 1.2 N on each of the top 9
   // cubelets and −0.1 N on the bottom 9 twist the top layer by ~0.15 N·m against the rest, above
   // the locks' 0.12 N·m breakaway and 1.7 times the bottom layer's twist (the locks need 1.5).
-  std::vector<int> top, rest;
-  for (int b = 0; b < m->nbody; ++b) {
-    const char* n = mj_id2name(m, mjOBJ_BODY, b);
-    const std::string name = n ? n : "";
-    if (name.rfind("cubelet_", 0) != 0) continue;
-    (name.back() == '2' ? top : rest).push_back(b);
+  std::vector<int> top, bottom;
+  for (const auto& [b, name] : cubelets(m)) {
+    if (name.back() == '2') top.push_back(b);
+    if (name.back() == '0') bottom.push_back(b);
   }
   const int core = w->body_id("cube");
   bool pushing = true;
@@ -112,14 +132,8 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
   for (int k = 0; k < 2000; ++k) {
     if (cube.face_angle('U') > units::deg_to_rad(55)) pushing = false;
     const Vec3 c = w->body_pose(core).p;
-    auto push = [&](int b, double f) {
-      Vec3 r(d->xpos[3 * b] - c.x(), d->xpos[3 * b + 1] - c.y(), 0);
-      const Vec3 t = r.norm() > 1e-4 ? Vec3(Vec3::UnitZ().cross(r) / r.norm()) : Vec3::Zero();
-      for (int i = 0; i < 3; ++i) d->xfrc_applied[6 * b + i] = pushing ? f * t[i] : 0.0;
-    };
-    for (int b : top) push(b, 1.2);
-    for (int b : rest)
-      if (std::string(mj_id2name(m, mjOBJ_BODY, b)).back() == '0') push(b, -0.1);
+    for (int b : top) push_about_z(d, c, b, pushing ? 1.2 : 0.0);
+    for (int b : bottom) push_about_z(d, c, b, pushing ? -0.1 : 0.0);
     w->step(parked, v);
     peak = std::max(peak, cube.face_angle('U'));
   }
@@ -148,10 +162,10 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
 // real cube cannot move until the top one is back at a click. With the top layer unlocked a few
 // degrees past its click (where another layer may take over), the shared pieces are pushed along
 // −y (the cube's axes), 5 N each, and the top layer's centre is given the opposite force and
-// torque (so nothing slides, tips or turns), for longer than the breakaway time. Counted as the right layer's (before this), the
-// pushes twist it by 3 · 19 mm · 5 N = 0.29 N·m, past the 0.12 N·m breakaway, and it broke away:
-// in the demo, on a busy machine, the right layer took over from the top layer a hand was turning,
-// and the turn failed. They must not count.
+// torque (so nothing slides, tips or turns), for longer than the breakaway time. Counted as the
+// right layer's (before this), the pushes twist it by 3 · 19 mm · 5 N = 0.29 N·m, past the
+// 0.12 N·m breakaway, and it broke away: in the demo, on a busy machine, the right layer took over
+// from the top layer a hand was turning, and the turn failed. They must not count.
 TEST(RubiksCube, PiecesRidingOnATurningLayerDoNotTwistTheLayersAcrossIt) {
   auto w = cube_world();
   auto cube = RubiksCube::Attach(*w).value();
@@ -160,10 +174,7 @@ TEST(RubiksCube, PiecesRidingOnATurningLayerDoNotTwistTheLayersAcrossIt) {
   std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
   w->place_proxies(parked);
   std::vector<int> top, bottom, shared;  // shared: in the top layer and the right one (x index 2)
-  for (int b = 0; b < m->nbody; ++b) {
-    const char* n = mj_id2name(m, mjOBJ_BODY, b);
-    const std::string name = n ? n : "";
-    if (name.rfind("cubelet_", 0) != 0) continue;
+  for (const auto& [b, name] : cubelets(m)) {
     if (name.back() == '2') top.push_back(b);
     if (name.back() == '0') bottom.push_back(b);
     if (name.back() == '2' && name[8] == '2') shared.push_back(b);
@@ -182,13 +193,8 @@ TEST(RubiksCube, PiecesRidingOnATurningLayerDoNotTwistTheLayersAcrossIt) {
   for (; k < 2000 && cube.face_angle('U') < units::deg_to_rad(3); ++k) {
     clear();
     const Vec3 c = w->body_pose(core).p;
-    auto push = [&](int b, double force) {
-      Vec3 r(d->xpos[3 * b] - c.x(), d->xpos[3 * b + 1] - c.y(), 0);
-      const Vec3 t = r.norm() > 1e-4 ? Vec3(Vec3::UnitZ().cross(r) / r.norm()) : Vec3::Zero();
-      for (int i = 0; i < 3; ++i) d->xfrc_applied[6 * b + i] = force * t[i];
-    };
-    for (int b : top) push(b, 1.2);
-    for (int b : bottom) push(b, -0.1);
+    for (int b : top) push_about_z(d, c, b, 1.2);
+    for (int b : bottom) push_about_z(d, c, b, -0.1);
     w->step(parked, v);
   }
   ASSERT_EQ(cube.turning_face(), 'U') << "the top layer did not break away (" << k << " steps)";

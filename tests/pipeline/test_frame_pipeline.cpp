@@ -65,6 +65,18 @@ class FramePipelineTest : public ::testing::Test {
     return s;
   }
 
+  // The shipped keyer and bracelet detector, estimating the hands' sizes from keyframes of a short
+  // stretch of the script.
+  static FramePipelineParams personalising_params() {
+    const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+    FramePipelineParams p;
+    p.chroma_key = vc.chroma_key;
+    p.bracelet = vc.bracelet;
+    p.personalise_shape = true;
+    p.shape_estimator.min_pose_change = 0.02;
+    return p;
+  }
+
   // The shipped keyer and bracelet detector, with the silhouette term.
   static FramePipelineParams keyed_params() {
     const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
@@ -342,12 +354,7 @@ TEST_F(FramePipelineTest, SideBySideStagesGiveTheSerialResults) {
 // estimator (ShapeEstimatorParams::max_fingertip_cost), while the left hand's are; with the
 // gate open, the broken fits become keyframes.
 TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
-  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
-  FramePipelineParams p;
-  p.chroma_key = vc.chroma_key;
-  p.bracelet = vc.bracelet;
-  p.personalise_shape = true;
-  p.shape_estimator.min_pose_change = 0.02;  // keyframes from a short stretch of the script
+  FramePipelineParams p = personalising_params();
   p.shape_estimator.shared_hands = true;     // one estimate for both hands (checked below)
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models_);
@@ -403,12 +410,7 @@ TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
 // frame through; one at 100 m/s lets the frames through (all but the first, whose speed is not
 // known; a speed read from wrong times, infinite or negative, would pass no gate).
 TEST_F(FramePipelineTest, FastHandsAreNoEvidenceOnTheHandsSizes) {
-  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
-  FramePipelineParams p;
-  p.chroma_key = vc.chroma_key;
-  p.bracelet = vc.bracelet;
-  p.personalise_shape = true;
-  p.shape_estimator.min_pose_change = 0.02;  // keyframes from a short stretch of the script
+  FramePipelineParams p = personalising_params();
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models_);
   const double t0 = 1.8;
