@@ -370,6 +370,7 @@ int main(int argc, char** argv) {
     hands.update(t, g);
     device::FingertipSample s;
     s.finger_count = 8;
+    s.t_ns = std::llround(t * 1e9);  // the script's time: the pipeline's speeds and motion model use it
     for (int f = 0; f < 8; ++f) s.p_W[f] = {g[f].x(), g[f].y(), g[f].z()};
     const auto& truth = hands.params();
     if (!film->film({&truth[0], &truth[1]}, &frame).ok()) return 1;
