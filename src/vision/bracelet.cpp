@@ -398,27 +398,35 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
   }
 
   // 2. Hands still without a bracelet: by image side, among candidates no hand took and that no
-  //    prediction claims.
+  //    other hand's prediction claims. A band near a hand's own prediction that its match refused
+  //    (its axis past 60° from the predicted one, or ambiguous) stays open to that hand: when the
+  //    previous fit's rotation has gone wrong, its predicted axis is wrong too, and refusing the
+  //    band on it would keep the fit from ever getting its wrist back (the demo's right hand, as
+  //    the wrist unwound after the release: lost for the last second of a run in about one in
+  //    seven).
   const double mid = 0.5 * (bgr.cols - 1);
   auto hand_of_side = [&](double x) {
     const bool left_side = x < mid;
     return (left_side == p.left_hand_on_image_left) ? 0 : 1;
   };
+  // claims[i][h]: candidate i lies within the gate of hand h's prediction.
+  auto claims = [&](int i, int h) {
+    return pred && pred->wrist_px[h] &&
+           (cands[i].observation.wrist_px - *pred->wrist_px[h]).norm() <= p.max_prediction_distance_px;
+  };
+  const bool need[2] = {chosen[0] < 0, chosen[1] < 0};
   std::vector<int> free;
   for (int i = 0; i < static_cast<int>(cands.size()) && free.size() < 2; ++i) {
     if (i == chosen[0] || i == chosen[1]) continue;
-    bool claimed = false;
-    for (int h = 0; h < 2 && pred; ++h) {
-      if (pred->wrist_px[h] && (cands[i].observation.wrist_px - *pred->wrist_px[h]).norm() <=
-                                   p.max_prediction_distance_px)
-        claimed = true;
-    }
+    // Claimed by a hand that has its band (then it is no one's), or by both hands.
+    const bool claimed = (claims(i, 0) && (!need[0] || claims(i, 1))) || (claims(i, 1) && !need[1]);
     if (!claimed) free.push_back(i);
   }
+  // A free band claimed by one hand's prediction goes to that hand only.
+  auto may_take = [&](int h, int i) { return !claims(i, 1 - h); };
   // A hand whose prediction found nothing (the previous fit lost it, or the band moved fast) may
   // take an unclaimed band on its side, trusted a little less: a wrong prediction must not lock
   // a visible bracelet out for good.
-  const bool need[2] = {chosen[0] < 0, chosen[1] < 0};
   const double factor[2] = {pred && pred->wrist_px[0] ? 0.7 : 1.0, pred && pred->wrist_px[1] ? 0.7 : 1.0};
   if (need[0] && need[1] && free.size() == 2) {
     int a = free[0], b = free[1];
@@ -427,19 +435,20 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
                                  (xa > mid + p.centre_margin_px && xb > mid + p.centre_margin_px);
     if (same_side_clear) {
       // Both clearly on one side: only the better one is trusted, for that side's hand.
-      finish(hand_of_side(xa), a, 0.5 * factor[hand_of_side(xa)]);
+      const int h = hand_of_side(xa);
+      if (may_take(h, a)) finish(h, a, 0.5 * factor[h]);
     } else {
       if (xa > xb) std::swap(a, b);  // a is the leftmost
       const int ha = p.left_hand_on_image_left ? 0 : 1;
-      finish(ha, a, factor[ha]);
-      finish(1 - ha, b, factor[1 - ha]);
+      if (may_take(ha, a)) finish(ha, a, factor[ha]);
+      if (may_take(1 - ha, b)) finish(1 - ha, b, factor[1 - ha]);
     }
   } else {
     for (int i : free) {
       const double x = cands[i].centroid_px.x();
       if (std::abs(x - mid) <= p.centre_margin_px) continue;  // ambiguous side
       const int h = hand_of_side(x);
-      if (need[h] && chosen[h] < 0) finish(h, i, factor[h]);
+      if (need[h] && chosen[h] < 0 && may_take(h, i)) finish(h, i, factor[h]);
     }
   }
   return out;

@@ -187,7 +187,10 @@ TEST(Bracelet, BandDirectionsTellHandsApartWhenWristsProjectClose) {
 
 // A forearm pointing at the camera shows its band as a ring, nearly round: its principal
 // direction is arbitrary, so a predicted axis must not refuse it (the demo's regrasp lost the
-// right bracelet for 14 frames that way). An elongated band at the wrong angle still is refused.
+// right bracelet for 14 frames that way). An elongated band at the wrong angle is refused by the
+// prediction; it is the hand's only by its image side, trusted less (a wrong predicted axis must
+// not lock a visible band out for good: the demo's right hand lost its band for the last second,
+// its fit's rotation gone wrong as the wrist unwound), and on the other side it stays refused.
 TEST(Bracelet, ARingSeenEndOnIsMatchedWhateverTheAxisPredicted) {
   cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));  // the blue screen (BGR)
   const cv::Point centre(450, 120);
@@ -201,13 +204,27 @@ TEST(Bracelet, ARingSeenEndOnIsMatchedWhateverTheAxisPredicted) {
     ASSERT_TRUE(obs[1].found) << "predicted axis at " << a << " rad";
     EXPECT_LT((obs[1].wrist_px - Vec2(centre.x, centre.y)).norm(), 3.0);
   }
-  // A band (aspect 4) across the predicted axis: refused, as before.
+  // A band (aspect 4) across the predicted axis: not matched by the prediction (a predicted match
+  // is trusted fully), taken by the image side at 0.7.
   cv::Mat band(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));
   cv::rectangle(band, cv::Point(410, 105), cv::Point(490, 125), cv::Scalar(30, 30, 210), cv::FILLED);
-  pred.axis_px[1] = Vec2(0.0, 1.0);
-  EXPECT_FALSE(detect(band, &pred)[1].found);
   pred.axis_px[1] = Vec2(1.0, 0.0);
-  EXPECT_TRUE(detect(band, &pred)[1].found);
+  const auto along = detect(band, &pred)[1];
+  ASSERT_TRUE(along.found);
+  pred.axis_px[1] = Vec2(0.0, 1.0);
+  const auto across = detect(band, &pred)[1];
+  ASSERT_TRUE(across.found);
+  EXPECT_LT((across.wrist_px - along.wrist_px).norm(), 1e-9);
+  EXPECT_LE(across.confidence, 0.7 * along.confidence + 1e-9);
+  // The same band on the left hand's side of the image, predicted for the right hand across its
+  // axis: the right hand does not get it by side, nor the left hand (the right's prediction
+  // claims it).
+  cv::Mat left_band(480, 640, CV_8UC3, cv::Scalar(200, 90, 40));
+  cv::rectangle(left_band, cv::Point(150, 105), cv::Point(230, 125), cv::Scalar(30, 30, 210), cv::FILLED);
+  pred.wrist_px = {std::nullopt, Vec2(187, 116)};
+  const auto refused = detect(left_band, &pred);
+  EXPECT_FALSE(refused[1].found);
+  EXPECT_FALSE(refused[0].found);
 }
 
 // The best bracelet candidate in a frame, unassigned; nullopt when there is none.
