@@ -11,10 +11,11 @@
 /// the part of the torque on the layer that its locks must carry (τ_all spread over the 26
 /// cubelets by mass would move the cube rigidly). While a layer turns, the layers across it count
 /// only their pieces outside it (6 of 9, and 6 / 26 of τ_all): the pieces they share ride on the
-/// turning layer's centre, so a hand turning that layer does not twist the layers across it. When |twist_f| exceeds the breakaway torque for
-/// the breakaway time (and `dominance` times every other layer's), layer f unlocks: its centre's weld is switched off
-/// (the centre turns on its hinge, with the detent) and the other eight cubelets of the layer are
-/// welded to the centre instead of the core. When the layer rests near a click, twisted less than
+/// turning layer's centre, so a hand turning that layer does not twist the layers across it.
+/// When |twist_f| exceeds the breakaway torque for the breakaway time (and `dominance` times every
+/// other layer's), layer f unlocks: its centre's weld is switched off (the centre turns on its
+/// hinge, with the detent) and the other eight cubelets of the layer are welded to the centre
+/// instead of the core. When the layer rests near a click, twisted less than
 /// the breakaway torque, for the settle time, all nine lock to the core again at the exact click.
 /// Only one layer turns at a time: while one is unlocked but lies within 10° of a click (say a
 /// grasp holds it a little off it), another layer twisted past the breakaway for the breakaway

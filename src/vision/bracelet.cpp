@@ -409,7 +409,7 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
     const bool left_side = x < mid;
     return (left_side == p.left_hand_on_image_left) ? 0 : 1;
   };
-  // claims[i][h]: candidate i lies within the gate of hand h's prediction.
+  // Whether candidate i lies within the gate of hand h's prediction.
   auto claims = [&](int i, int h) {
     return pred && pred->wrist_px[h] &&
            (cands[i].observation.wrist_px - *pred->wrist_px[h]).norm() <= p.max_prediction_distance_px;
@@ -418,9 +418,9 @@ Result<std::array<BraceletObservation, 2>> detect_bracelets(const cv::Mat& bgr,
   std::vector<int> free;
   for (int i = 0; i < static_cast<int>(cands.size()) && free.size() < 2; ++i) {
     if (i == chosen[0] || i == chosen[1]) continue;
-    // Claimed by a hand that has its band (then it is no one's), or by both hands.
-    const bool claimed = (claims(i, 0) && (!need[0] || claims(i, 1))) || (claims(i, 1) && !need[1]);
-    if (!claimed) free.push_back(i);
+    // Open when no prediction claims it, or only the prediction of a hand still without a band.
+    const int claimants = int(claims(i, 0)) + int(claims(i, 1));
+    if (claimants == 0 || (claimants == 1 && need[claims(i, 0) ? 0 : 1])) free.push_back(i);
   }
   // A free band claimed by one hand's prediction goes to that hand only.
   auto may_take = [&](int h, int i) { return !claims(i, 1 - h); };

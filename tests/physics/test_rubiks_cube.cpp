@@ -16,6 +16,16 @@ std::unique_ptr<World> cube_world() {
   return World::Load(std::string(SPIDAR_SOURCE_DIR) + "/scenes/rubiks_cube.xml").value();
 }
 
+/// The cube scene with its fingertip proxies parked out of the way, stepped with no coupling.
+struct ParkedCube {
+  std::unique_ptr<World> w = cube_world();
+  RubiksCube cube = RubiksCube::Attach(*w).value();
+  std::vector<Vec3> parked = std::vector<Vec3>(8, Vec3(0, 0.3, 0.3));
+  std::vector<Vec3> v = std::vector<Vec3>(8, Vec3::Zero());
+  ParkedCube() { w->place_proxies(parked); }
+  void step() { w->step(parked, v); }
+};
+
 /// The cube's cubelets: body id and name (`cubelet_XYZ`, X Y Z its indices 0–2 along the cube's
 /// x, y and z axes).
 std::vector<std::pair<int, std::string>> cubelets(const mjModel* m) {
@@ -78,12 +88,11 @@ TEST(RubiksCube, FourQuarterTurnsOfEveryFaceAreIdentity) {
 }
 
 TEST(RubiksCube, TwistsBelowTheBreakawayLeaveTheCubeRigid) {
-  auto w = cube_world();
-  auto cube = RubiksCube::Attach(*w).value();
+  ParkedCube rig;
+  auto& w = rig.w;
+  auto& cube = rig.cube;
   const mjModel* m = w->model();
   mjData* d = w->data();
-  std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
-  w->place_proxies(parked);
   // Every layer twisted at once, each by less than the breakaway torque (a firm, off-centre grasp):
   // 0.3 N tangential on each cubelet about each of its faces' axes, alternating sense by face:
   // under 0.12 N·m of twist per layer, the breakaway (the detent alone gives way at 0.02 N·m).
@@ -100,7 +109,7 @@ TEST(RubiksCube, TwistsBelowTheBreakawayLeaveTheCubeRigid) {
       if (iy != 0) f += 0.3 * iy * Vec3::UnitY().cross(r).normalized();
       for (int i = 0; i < 3; ++i) d->xfrc_applied[6 * b + i] = f.allFinite() ? f[i] : 0.0;
     }
-    w->step(parked, v);
+    rig.step();
   }
   for (char face : std::string("UDFBRL")) {
     EXPECT_LT(std::abs(cube.face_angle(face)), units::deg_to_rad(0.5)) << face;
@@ -111,12 +120,11 @@ TEST(RubiksCube, TwistsBelowTheBreakawayLeaveTheCubeRigid) {
 }
 
 TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
-  auto w = cube_world();
-  auto cube = RubiksCube::Attach(*w).value();
+  ParkedCube rig;
+  auto& w = rig.w;
+  auto& cube = rig.cube;
   const mjModel* m = w->model();
   mjData* d = w->data();
-  std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
-  w->place_proxies(parked);
   // Like two hands: push the top layer's cubelets around +z, hold the bottom layer back, until
   // the layer is past the detent's midpoint (55°); then let go. 1.2 N on each of the top 9
   // cubelets and −0.1 N on the bottom 9 twist the top layer by ~0.15 N·m against the rest, above
@@ -134,7 +142,7 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
     const Vec3 c = w->body_pose(core).p;
     for (int b : top) push_about_z(d, c, b, pushing ? 1.2 : 0.0);
     for (int b : bottom) push_about_z(d, c, b, pushing ? -0.1 : 0.0);
-    w->step(parked, v);
+    rig.step();
     peak = std::max(peak, cube.face_angle('U'));
   }
   // The top layer went past the midpoint and clicked into the next quarter turn; the bottom,
@@ -167,12 +175,11 @@ TEST(RubiksCube, PushedLayerTurnsNinetyDegreesAndSnaps) {
 // 0.12 N·m breakaway, and it broke away: in the demo, on a busy machine, the right layer took over
 // from the top layer a hand was turning, and the turn failed. They must not count.
 TEST(RubiksCube, PiecesRidingOnATurningLayerDoNotTwistTheLayersAcrossIt) {
-  auto w = cube_world();
-  auto cube = RubiksCube::Attach(*w).value();
+  ParkedCube rig;
+  auto& w = rig.w;
+  auto& cube = rig.cube;
   const mjModel* m = w->model();
   mjData* d = w->data();
-  std::vector<Vec3> parked(8, Vec3(0, 0.3, 0.3)), v(8, Vec3::Zero());
-  w->place_proxies(parked);
   std::vector<int> top, bottom, shared;  // shared: in the top layer and the right one (x index 2)
   for (const auto& [b, name] : cubelets(m)) {
     if (name.back() == '2') top.push_back(b);
@@ -195,7 +202,7 @@ TEST(RubiksCube, PiecesRidingOnATurningLayerDoNotTwistTheLayersAcrossIt) {
     const Vec3 c = w->body_pose(core).p;
     for (int b : top) push_about_z(d, c, b, 1.2);
     for (int b : bottom) push_about_z(d, c, b, -0.1);
-    w->step(parked, v);
+    rig.step();
   }
   ASSERT_EQ(cube.turning_face(), 'U') << "the top layer did not break away (" << k << " steps)";
   ASSERT_EQ(cube.layer_unlocks(), 1);
@@ -224,7 +231,7 @@ TEST(RubiksCube, PiecesRidingOnATurningLayerDoNotTwistTheLayersAcrossIt) {
       d->xfrc_applied[6 * u_centre + i] = -3.0 * F_W[i];
       d->xfrc_applied[6 * u_centre + 3 + i] = T[i];
     }
-    w->step(parked, v);
+    rig.step();
     max_twist_r = std::max(max_twist_r, std::abs(cube.layer_twist('R')));
   }
   // The top layer stayed where another layer could have taken over, and nothing else turned.
