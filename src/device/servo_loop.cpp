@@ -218,19 +218,25 @@ void ServoLoop::monitor(pthread_t servo_thread) {
 }
 
 void ServoLoop::end_servo_thread(pthread_t servo_thread, std::int64_t window_ns) {
+  // Released again every window until the thread has ended, not once: a thread that had not yet
+  // reached its own set-up when first released (starved on the held CPU at normal priority) goes
+  // on to raise its priority and pin itself there, and is starved anew.
   const std::int64_t requested = core::monotonic_ns();
+  std::int64_t next_release = requested + window_ns;
   while (running_.load(std::memory_order_acquire)) {
-    if (core::monotonic_ns() - requested >= window_ns) {
+    if (core::monotonic_ns() >= next_release) {
       // Starved (or stuck in a read): let it run anywhere at normal priority. Harmless to a
       // thread that is merely slow, since it is ending anyway.
-      released_at_end_.store(true, std::memory_order_release);
+      const bool first = !released_at_end_.exchange(true, std::memory_order_acq_rel);
       device_.request_safe_state();
       const Status st = core::release_starved_thread(servo_thread);
-      spdlog::warn("servo loop: the servo thread had not ended {:.0f} ms after the stop request "
-                   "(starved by the scheduler?); moved it to normal scheduling on every CPU{}{}",
-                   static_cast<double>(core::monotonic_ns() - requested) * 1e-6,
-                   st.ok() ? "" : ": ", st.ok() ? "" : st.error().message);
-      return;
+      if (first || !st.ok()) {
+        spdlog::warn("servo loop: the servo thread had not ended {:.0f} ms after the stop request "
+                     "(starved by the scheduler?); moved it to normal scheduling on every CPU{}{}",
+                     static_cast<double>(core::monotonic_ns() - requested) * 1e-6,
+                     st.ok() ? "" : ": ", st.ok() ? "" : st.error().message);
+      }
+      next_release = core::monotonic_ns() + window_ns;
     }
     core::sleep_until_ns(core::monotonic_ns() + 1'000'000);
   }

@@ -9,6 +9,8 @@
 // hog's own end, 30 s later. The hog cannot outlive the test (it stops at 30 s by itself).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <thread>
 
@@ -69,6 +71,37 @@ TEST(ServoLoopStarved, StopReturnsOnTimeWhenItsCpuIsHeld) {
   EXPECT_LT(seconds_since(t0), 5.0) << "stop() waited for the hog";
   EXPECT_FALSE(loop.running());
   EXPECT_TRUE(loop.stats().released_at_end);
+}
+
+// What failed one CI run in several (ASan, ctest -j2, 2026-11-28): the servo thread had not yet
+// reached its set-up when stop() came (started on the held CPU at normal priority, the other CPU
+// busy). The monitor released it once; it then raised its priority, pinned itself to the held CPU
+// and was starved until the hog ended. Here the thread is held back deterministically until
+// after that first release; the monitor must release it again.
+TEST(ServoLoopStarved, StopReturnsOnTimeWhenTheThreadPinsItselfAfterTheRelease) {
+  SPIDAR_STARVE_SERVO_CPU(hog);
+  SimulatedSpidar sim(spidar8(), {}, testing::hovering(spidar8()));
+  ASSERT_TRUE(sim.open().ok());
+  std::atomic<bool> stop_called{false};
+  ServoConfig cfg;
+  cfg.realtime = true;
+  // Until well after the stop request and the monitor's first release (one stall window).
+  const auto hold = std::chrono::duration<double>(3 * std::max(cfg.stall_limit_s, 1e-3));
+  cfg.on_thread_start = [&stop_called, hold] {
+    while (!stop_called.load()) std::this_thread::sleep_for(1ms);
+    std::this_thread::sleep_for(hold);
+  };
+  ServoLoop loop(sim, spidar8(), cfg, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  std::this_thread::sleep_for(50ms);
+  const auto t0 = std::chrono::steady_clock::now();
+  stop_called.store(true);
+  loop.stop();
+  EXPECT_LT(seconds_since(t0), 5.0) << "stop() waited for the hog: the thread was released only once";
+  EXPECT_FALSE(loop.running());
+  const ServoStats s = loop.stats();
+  EXPECT_TRUE(s.realtime_scheduling) << "the thread never went real-time: the test tested nothing";
+  EXPECT_TRUE(s.released_at_end);
 }
 
 }  // namespace
