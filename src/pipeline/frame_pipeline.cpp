@@ -118,6 +118,9 @@ struct FramePipeline::Impl {
   std::array<hand::HandParams, 2> previous;
   bool have_previous = false;
   std::uint64_t warm_frames = 0;  ///< frames fitted from a previous one since the last cold start
+  /// Per hand: the wrist's other depth explained the evidence better at its last try, not yet
+  /// taken (FramePipelineParams::other_depth_confirm).
+  std::array<bool, 2> other_depth_won{false, false};
   /// The silhouette term's coverage direction: both hands' outlines at the previous fits and the
   /// silhouette pixels each owns (registration/coverage.hpp).
   std::array<registration::ProjectedHand, 2> outlines;
@@ -217,6 +220,7 @@ void FramePipeline::reset() {
   Impl& s = *impl_;
   s.have_previous = false;
   s.warm_frames = 0;
+  s.other_depth_won = {false, false};
   // A cold start forgets the sizes learnt too: a session's warm-up frame (a blank screen) must
   // not stay among the estimator's keyframes, or a replay, which has no warm-up, would not
   // reach the live run's sizes.
@@ -232,6 +236,7 @@ Status FramePipeline::warm_start(const std::array<hand::HandParams, 2>& fits) {
                    " hand's parameters are not finite"};
   impl_->previous = fits;
   impl_->have_previous = true;
+  impl_->other_depth_won = {false, false};
   return Ok{};
 }
 bool FramePipeline::has_previous() const { return impl_->have_previous; }
@@ -498,21 +503,28 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       }
       // The wrist's other depth along its band's ray (registration/wrist_depth.hpp): fitted from
       // there every other_depth_every-th warm frame, kept when it explains the evidence clearly
-      // better (the prior left out of the comparison: it holds the basin the warm fit is in).
+      // better (the prior left out of the comparison: it holds the basin the warm fit is in), at
+      // two tries in a row.
       const auto every = static_cast<std::uint64_t>(std::max(p.other_depth_every, 0));
       if (every > 0 && s.warm_frames % every == static_cast<std::uint64_t>(h) % every) {
+        bool won = false;
         if (auto start = registration::other_wrist_depth(s.models[h], q, obs, s.camera)) {
           registration::FitReport other;
           const hand::HandParams q2 = fit_from(*start, nullptr, p.other_depth_rounds, &other);
           other.iterations += report.iterations;
-          if (q2.q.allFinite() && other.terms.evidence() < p.other_depth_keep * report.terms.evidence()) {
+          won = q2.q.allFinite() && other.terms.evidence() < p.other_depth_keep * report.terms.evidence();
+          // Taken at its second win in a row (other_depth_confirm): one frame's evidence can
+          // favour a wrong depth by far, and the fit then sits there until the next try.
+          if (won && (!p.other_depth_confirm || s.other_depth_won[h])) {
             q = q2;
             report = other;
             ++out->depth_switches;
+            won = false;
           } else {
             report.iterations = other.iterations;
           }
         }
+        s.other_depth_won[h] = won;
       }
     }
     // A digit stalled short of its string: try again from it re-posed on its own (its prior mean

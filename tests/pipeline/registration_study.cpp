@@ -275,6 +275,7 @@ int main(int argc, char** argv) {
     else if (key == "other_depth_every") p.other_depth_every = std::atoi(value.c_str());
     else if (key == "other_depth_rounds") p.other_depth_rounds = std::atoi(value.c_str());
     else if (key == "other_depth_keep") p.other_depth_keep = std::atof(value.c_str());
+    else if (key == "other_depth_confirm") p.other_depth_confirm = std::atoi(value.c_str()) != 0;
     else if (key.rfind("shape.", 0) == 0) shape_keys += "  " + key.substr(6) + ": " + value + "\n";
     else reg_keys += "  " + key + ": " + value + "\n";
   }

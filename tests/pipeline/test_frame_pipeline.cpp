@@ -21,6 +21,7 @@
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/registration/shape_estimator.hpp"
+#include "spidar/registration/wrist_depth.hpp"
 #include "spidar/sim/frame_truth.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
@@ -510,6 +511,57 @@ TEST_F(FramePipelineTest, WarmStartFitsTheNextFrameFromTheGivenPoses) {
   EXPECT_GT(c.fits[0].iterations + c.fits[1].iterations, r.fits[0].iterations + r.fits[1].iterations)
       << "cold " << c.fits[0].iterations << "+" << c.fits[1].iterations << ", warm " << r.fits[0].iterations << "+"
       << r.fits[1].iterations;
+}
+
+// The wrist's other depth along the band's ray (FramePipelineParams::other_depth_every) is taken
+// only at its second win in a row (other_depth_confirm). Both pipelines are warm-started with the
+// right hand at the wrong depth (registration::other_wrist_depth of the truth) and fit the same
+// frame again and again: every try from the other (true) depth wins. With one win enough, the
+// first try switches; with two, the try after it (other_depth_every frames later), and not the
+// first. Either way the wrist ends at the true depth.
+TEST_F(FramePipelineTest, TheWristsOtherDepthIsTakenAtItsSecondWinInARow) {
+  sim::RubiksTask task({});
+  sim::UserHands user(truth_models_, task);
+  const double t = 7.8;  // turn 2 begins: the right forearm points along the camera's ray
+  const auto sample = pose_user(user, task, t);
+  const auto truth = user.params();
+  sim::SyntheticFrame frame;
+  ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+  registration::HandObservation obs;  // what other_wrist_depth uses: the caps and the wrist pixel
+  for (int f = 0; f < hand::kFingertipCount; ++f) {
+    obs.p_W_fingertip[f] = device::fingertip_position(sample, 4 + f);
+    obs.fingertip_valid[f] = true;
+  }
+  obs.wrist_px = camera_.project(truth[1].p_W_wrist());
+  const auto wrong = registration::other_wrist_depth(truth_models_[1], truth[1], obs, camera_);
+  ASSERT_TRUE(wrong.has_value());
+  ASSERT_GT((wrong->p_W_wrist() - truth[1].p_W_wrist()).norm(), 0.05) << "no wrong depth to start from";
+
+  std::array<int, 2> first_switch{-1, -1};  // frame index of the right hand's first switch
+  std::array<double, 2> end_m{};            // the right wrist's distance from the truth at the end
+  for (int confirm = 0; confirm < 2; ++confirm) {
+    FramePipelineParams p = keyed_params();
+    p.other_depth_confirm = confirm == 1;
+    auto pipe = FramePipeline::create(*context_, camera_, truth_models_, p).value();
+    ASSERT_TRUE(pipe->warm_start({truth[0], *wrong}).ok());
+    FrameResult r;
+    for (int k = 0; k < 4 * p.other_depth_every; ++k) {
+      ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());
+      const bool right_far = (r.hands[1].p_W_wrist() - truth[1].p_W_wrist()).norm() > 0.03;
+      if (k == 0) ASSERT_TRUE(right_far) << "the warm fit left the wrong depth by itself: nothing to switch";
+      if (first_switch[confirm] < 0 && !right_far) first_switch[confirm] = k;
+    }
+    end_m[confirm] = (r.hands[1].p_W_wrist() - truth[1].p_W_wrist()).norm();
+  }
+  std::printf("first switch at frame %d (one win) and %d (two wins in a row); wrist at the end %.1f / %.1f mm "
+              "from the truth\n",
+              first_switch[0], first_switch[1], 1e3 * end_m[0], 1e3 * end_m[1]);
+  const int every = FramePipelineParams{}.other_depth_every;
+  ASSERT_GE(first_switch[0], 0) << "no switch with one win";
+  EXPECT_LT(first_switch[0], every);
+  EXPECT_EQ(first_switch[1], first_switch[0] + every);
+  EXPECT_LT(end_m[0], 0.01);
+  EXPECT_LT(end_m[1], 0.01);
 }
 
 // Forearm directions given to the pipeline (a rig that tracks the forearms, the study's oracle):

@@ -71,6 +71,13 @@ struct FramePipelineParams {
   int other_depth_every = 3;
   int other_depth_rounds = 2;
   double other_depth_keep = 0.7;
+  /// Take the other depth only when it wins two tries in a row (other_depth_every frames apart).
+  /// A single frame's evidence sometimes favours a depth far off: demo, seeds 1–10, with one try
+  /// the right hand's wrist jumped 10–15 cm deep at the start of turn 2 in 3 runs, for 3–15 frames
+  /// (joints 22–32 px, IoU 0.76–0.80, until a later try switched back); with two, in none (joints
+  /// 4.97–5.38 px against 5.05–5.83). A wrong depth held for good is still left, one try later
+  /// (0.1 s at 30 fps).
+  bool other_depth_confirm = true;
   /// A fit whose cap misses its string by more than this [m] is tried again from each such digit
   /// re-posed on its own (registration/fingertip_reach.hpp: the straight-finger local minimum),
   /// and the re-fit kept if it explains the evidence better; 0 = never.
