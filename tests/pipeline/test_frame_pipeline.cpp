@@ -548,7 +548,9 @@ TEST_F(FramePipelineTest, TheWristsOtherDepthIsTakenAtItsSecondWinInARow) {
     for (int k = 0; k < 4 * p.other_depth_every; ++k) {
       ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());
       const bool right_far = (r.hands[1].p_W_wrist() - truth[1].p_W_wrist()).norm() > 0.03;
-      if (k == 0) ASSERT_TRUE(right_far) << "the warm fit left the wrong depth by itself: nothing to switch";
+      if (k == 0) {
+        ASSERT_TRUE(right_far) << "the warm fit left the wrong depth by itself: nothing to switch";
+      }
       if (first_switch[confirm] < 0 && !right_far) first_switch[confirm] = k;
     }
     end_m[confirm] = (r.hands[1].p_W_wrist() - truth[1].p_W_wrist()).norm();
