@@ -507,24 +507,25 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       // two tries in a row.
       const auto every = static_cast<std::uint64_t>(std::max(p.other_depth_every, 0));
       if (every > 0 && s.warm_frames % every == static_cast<std::uint64_t>(h) % every) {
-        bool won = false;
+        bool pending = false;  // won this try, not taken yet
         if (auto start = registration::other_wrist_depth(s.models[h], q, obs, s.camera)) {
           registration::FitReport other;
           const hand::HandParams q2 = fit_from(*start, nullptr, p.other_depth_rounds, &other);
           other.iterations += report.iterations;
-          won = q2.q.allFinite() && other.terms.evidence() < p.other_depth_keep * report.terms.evidence();
+          const bool won = q2.q.allFinite() && other.terms.evidence() < p.other_depth_keep * report.terms.evidence();
           // Taken at its second win in a row (other_depth_confirm): one frame's evidence can
           // favour a wrong depth by far, and the fit then sits there until the next try.
-          if (won && (!p.other_depth_confirm || s.other_depth_won[h])) {
+          const bool take = won && (!p.other_depth_confirm || s.other_depth_won[h]);
+          pending = won && !take;
+          if (take) {
             q = q2;
             report = other;
             ++out->depth_switches;
-            won = false;
           } else {
             report.iterations = other.iterations;
           }
         }
-        s.other_depth_won[h] = won;
+        s.other_depth_won[h] = pending;
       }
     }
     // A digit stalled short of its string: try again from it re-posed on its own (its prior mean
