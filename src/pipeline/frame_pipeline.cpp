@@ -385,16 +385,19 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
 
   // Successive adjustment of both hands.
   auto t0 = Clock::now();
-  out->restarts = 0;
-  out->depth_switches = 0;
-  out->reaches = 0;
   // A size re-estimate running on its own thread takes effect here, a fixed number of frames after
   // it started (ShapeEstimatorParams::apply_after_frames), so the fits stay reproducible.
   if (p.personalise_shape)
     for (registration::ShapeEstimator& e : s.shape)
       if (e.poll()) s.take_sizes(e);
   std::array<std::array<Vec3, hand::kFingertipCount>, 2> next_tips_W{};
-  for (int h = 0; h < 2; ++h) {
+  // Each hand's fit writes only that hand's outputs and state (its model, estimator, counters):
+  // the two can run side by side.
+  struct HandCounts {
+    int restarts = 0, depth_switches = 0, reaches = 0;
+  };
+  std::array<HandCounts, 2> counts{};
+  auto fit_hand = [&](int h) {
     registration::HandObservation obs;
     obs.forearm_H = s.forearm_H[h];
     // The forearm's bend from this frame's band, from the previous fit's pose (forearm_from_band.hpp);
@@ -499,7 +502,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
         } else {
           report.iterations = again.iterations;
         }
-        ++out->restarts;
+        ++counts[h].restarts;
       }
       // The wrist's other depth along its band's ray (registration/wrist_depth.hpp): fitted from
       // there every other_depth_every-th warm frame, kept when it explains the evidence clearly
@@ -520,7 +523,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
           if (take) {
             q = q2;
             report = other;
-            ++out->depth_switches;
+            ++counts[h].depth_switches;
           } else {
             report.iterations = other.iterations;
           }
@@ -534,7 +537,7 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     if (p.reach_min_miss_m > 0 &&
         registration::refit_reaching(s.solver, s.models[h], obs, hand_image, cold ? nullptr : &s.previous[h],
                                      {.min_miss_m = p.reach_min_miss_m}, &q, &report))
-      ++out->reaches;
+      ++counts[h].reaches;
     out->hands[h] = q;
     out->fits[h] = report;
     out->toward_elbow_W[h] = hand::hand_pose(s.have_previous ? s.previous[h] : q).R * obs.forearm_H;
@@ -556,7 +559,14 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
       if (e.add_frame(s.index_in_estimator(h), q, obs, hand_image, p.registration)) s.take_sizes(e);
     }
     out->shapes[h] = s.estimator_of(h).estimate(s.index_in_estimator(h));
-  }
+  };
+  // Side by side only with an estimator per hand: one shared by both takes both hands' frames.
+  const bool own_estimators = s.shape.size() == 2;
+  core::run_side_by_side(p.side_by_side && own_estimators ? &s.side : nullptr, [&] { fit_hand(0); },
+                         [&] { fit_hand(1); });
+  out->restarts = counts[0].restarts + counts[1].restarts;
+  out->depth_switches = counts[0].depth_switches + counts[1].depth_switches;
+  out->reaches = counts[0].reaches + counts[1].reaches;
   s.previous = out->hands;
   s.previous_tips_W = next_tips_W;
   s.previous_tips_t_ns = tips.t_ns;

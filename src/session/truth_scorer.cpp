@@ -54,13 +54,15 @@ void TruthScorer::on_frame(const FrameEvent& e) {
   const auto camera_index = static_cast<std::int64_t>(filmed.index);
   m.dropped_before = static_cast<int>(std::max<std::int64_t>(0, camera_index - last_camera_index_ - 1));
   last_camera_index_ = camera_index;
+  // The simulated camera reads a frame's ground-truth images after handing over its image.
+  const sim::SyntheticFrame& images = filmed.wait_for_truth_images();
   const std::int64_t t_scoring_ns = core::monotonic_ns();
-  auto main_m = sim::measure_frame(filmed.frame, result, mode_, result.models, truth_models_, filmed.truth,
+  auto main_m = sim::measure_frame(images, result, mode_, result.models, truth_models_, filmed.truth,
                                    camera_, &ws_);
   if (!main_m) throw SpidarError(main_m.error().message);
   m.truth[0] = *main_m;
   if (e.compared != nullptr) {
-    auto alt_m = sim::measure_frame(filmed.frame, *e.compared, mode_, e.compared->models, truth_models_,
+    auto alt_m = sim::measure_frame(images, *e.compared, mode_, e.compared->models, truth_models_,
                                     filmed.truth, camera_, &ws_);
     if (!alt_m) throw SpidarError(alt_m.error().message);
     m.truth[1] = *alt_m;
@@ -69,7 +71,7 @@ void TruthScorer::on_frame(const FrameEvent& e) {
     // Its own context, current here whatever else this thread renders (Session::step makes the
     // frame thread's current again before the next frame).
     if (auto st = context_->make_current(); !st) throw SpidarError("ground truth: " + st.error().message);
-    auto c = ceiling_->iou(filmed.truth, filmed.frame.hand_only, filmed.frame.toward_elbow_W);
+    auto c = ceiling_->iou(filmed.truth, images.hand_only, images.toward_elbow_W);
     if (!c) throw SpidarError(c.error().message);
     m.ceiling_iou = *c;
     m.ceiling_measured = true;

@@ -15,6 +15,7 @@
 namespace spidar::sim {
 
 void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to) {
+  from.wait_for_truth_images();
   to->index = from.index;
   to->t_exposure_ns = from.t_exposure_ns;
   to->t_script_s = from.t_script_s;
@@ -28,6 +29,8 @@ void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to) {
   to->truth = from.truth;
   to->cap_residual_m = from.cap_residual_m;
   to->film_ms = from.film_ms;
+  to->truth_images_ms = from.truth_images_ms;
+  to->truth_images.set();
 }
 
 Result<std::unique_ptr<CameraThread>> CameraThread::prepare(
@@ -168,12 +171,14 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
       out.truth = user.params();
       out.cap_residual_m = user.cap_residual_m();
       const HandPoses poses{&out.truth[0], &out.truth[1]};
-      if (auto st = film.value()->film(poses, &out.frame); !st) {
+      out.truth_images.reset();  // nobody sees this frame yet
+      if (auto st = film.value()->film_image(poses, &out.frame); !st) {
         error_ = st.error().message;
         break;
       }
       out.film_ms = core::ns_to_s(core::monotonic_ns() - t_start) * 1e3;
       core::sleep_until_ns(t_exp + params_.readout_ns);  // not before the sensor has read it out
+      const std::shared_ptr<FilmedFrame> writing = frame;  // kept from the pool until its truth is in
       {
         std::lock_guard lock(newest_mutex_);
         // Counted before anyone can take it: filmed() is never behind the frames taken.
@@ -181,6 +186,18 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
         newest_ = std::move(frame);  // a newer frame replaces one not taken (back to the pool)
       }
       arrived_.notify_all();
+      // The ground-truth images after the publication: the frame thread works on the image
+      // meanwhile. Done on every path, so that no reader waits for ever.
+      const std::int64_t t_truth = core::monotonic_ns();
+      const Status truth_status = film.value()->film_truth(&out.frame);
+      out.truth_images_ms = core::ns_to_s(core::monotonic_ns() - t_truth) * 1e3;
+      if (!truth_status) {
+        for (cv::Mat* m : {&out.frame.mask, &out.frame.hand_index, &out.frame.hand_only, &out.frame.depth})
+          m->release();
+        error_ = truth_status.error().message;
+      }
+      writing->truth_images.set();
+      if (!truth_status) break;
     } else {
       // No fingertips yet at this exposure (the device's first samples come later on a busy
       // machine): an exposure let pass too, so a frame's index gap is always filmed + skipped.

@@ -78,6 +78,8 @@ struct SyntheticCamera::Impl {
   cv::Mat lut_index, lut_only;
   cv::RNG rng;
 
+  /// A film_image whose ground truth film_truth has not read yet (it is in the renderer's targets).
+  bool truth_pending = false;
   /// Where each forearm pointed in the last build_scene.
   std::array<std::optional<Vec3>, 2> toward_elbow;
 
@@ -162,8 +164,14 @@ Status SyntheticCamera::set_camera(const vision::Camera& camera) {
 const SyntheticCameraParams& SyntheticCamera::params() const { return impl_->params; }
 
 Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous) {
+  if (auto st = film_image(poses, out, previous); !st) return st;
+  return film_truth(out);
+}
+
+Status SyntheticCamera::film_image(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous) {
   if (out == nullptr) return Error{"synthetic camera: no output frame given"};
   Impl& s = *impl_;
+  s.truth_pending = false;
   const SyntheticCameraParams& p = s.params;
   const int samples = previous ? p.motion_blur_samples : 1;
   // Motion blur: sub-frames from the previous pose (exclusive) to the current one (last, so the
@@ -184,10 +192,7 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
     }
     s.build_scene(at);
     if (auto st = s.renderer->render(s.scene, s.drawn, s.render_params); !st) return st;
-    const bool last = k == samples;
-    if (auto st = s.renderer->read(&s.targets, last ? render::kColour | render::kHandDepth | render::kHandId
-                                                   : render::kColour); !st)
-      return st;
+    if (auto st = s.renderer->read(&s.targets, render::kColour); !st) return st;
     if (samples > 1) {
       if (k == 1) s.targets.colour.convertTo(s.accumulator, CV_32FC3);
       else cv::accumulate(s.targets.colour, s.accumulator);
@@ -196,22 +201,7 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
   if (samples > 1) s.accumulator.convertTo(out->bgr, CV_8UC3, 1.0 / samples);
   else s.targets.colour.copyTo(out->bgr);
 
-  // Ground truth at `poses`.
   out->toward_elbow_W = s.toward_elbow;
-  cv::compare(s.targets.hand_id, 0, out->mask, cv::CMP_GT);
-  if (s.lut_index.empty()) {
-    s.lut_index.create(1, 256, CV_8UC1);
-    s.lut_only.create(1, 256, CV_8UC1);
-    for (int i = 0; i < 256; ++i) {
-      const render::HandId d = render::decode_hand_id(static_cast<std::uint8_t>(i));
-      s.lut_index.at<std::uint8_t>(i) = i == 0 ? 0 : static_cast<std::uint8_t>(d.hand + 1);
-      s.lut_only.at<std::uint8_t>(i) =
-          i != 0 && d.finger != render::kBraceletPart && d.finger != render::kForearmPart ? 255 : 0;
-    }
-  }
-  cv::LUT(s.targets.hand_id, s.lut_index, out->hand_index);
-  cv::LUT(s.targets.hand_id, s.lut_only, out->hand_only);
-  s.targets.hand_depth.copyTo(out->depth);
 
   // Optics and sensor: the lens bends the image (beyond the pinhole view the screen goes on), the
   // optics blur it, the sensor adds noise.
@@ -239,6 +229,31 @@ Status SyntheticCamera::film(const HandPoses& poses, SyntheticFrame* out, const 
     cv::add(out->bgr, s.noise_plus(at), out->bgr);        // saturates at 255
     cv::subtract(out->bgr, s.noise_minus(at), out->bgr);  // saturates at 0
   }
+  s.truth_pending = true;
+  return Ok{};
+}
+
+Status SyntheticCamera::film_truth(SyntheticFrame* out) {
+  if (out == nullptr) return Error{"synthetic camera: no output frame given"};
+  Impl& s = *impl_;
+  if (!s.truth_pending) return Error{"synthetic camera: film_truth without a film_image before it"};
+  s.truth_pending = false;
+  // Ground truth at the poses of the last film_image (its last render is still in the renderer).
+  if (auto st = s.renderer->read(&s.targets, render::kHandDepth | render::kHandId); !st) return st;
+  cv::compare(s.targets.hand_id, 0, out->mask, cv::CMP_GT);
+  if (s.lut_index.empty()) {
+    s.lut_index.create(1, 256, CV_8UC1);
+    s.lut_only.create(1, 256, CV_8UC1);
+    for (int i = 0; i < 256; ++i) {
+      const render::HandId d = render::decode_hand_id(static_cast<std::uint8_t>(i));
+      s.lut_index.at<std::uint8_t>(i) = i == 0 ? 0 : static_cast<std::uint8_t>(d.hand + 1);
+      s.lut_only.at<std::uint8_t>(i) =
+          i != 0 && d.finger != render::kBraceletPart && d.finger != render::kForearmPart ? 255 : 0;
+    }
+  }
+  cv::LUT(s.targets.hand_id, s.lut_index, out->hand_index);
+  cv::LUT(s.targets.hand_id, s.lut_only, out->hand_only);
+  s.targets.hand_depth.copyTo(out->depth);
   return Ok{};
 }
 

@@ -78,6 +78,9 @@ class FramePipelineTest : public ::testing::Test {
     return p;
   }
 
+  // SideBySideStagesGiveTheSerialResults, with or without the sizes estimated online.
+  void side_by_side_matches_serial(bool personalise);
+
   // The shipped keyer and bracelet detector, with the silhouette term.
   static FramePipelineParams keyed_params() {
     const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
@@ -303,16 +306,25 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
   ASSERT_TRUE(context_->make_current().ok());
 }
 
-// The matte and silhouette evidence on a helper thread beside the bracelets on the caller
-// (FramePipelineParams::side_by_side) give exactly the serial pipeline's fits, mattes, bracelets
-// and pictures, frame after frame (each stage writes only its own outputs).
+// The matte and silhouette evidence on a helper thread beside the bracelets on the caller, and
+// the left hand's fit beside the right's (FramePipelineParams::side_by_side), give exactly the
+// serial pipeline's fits, sizes, mattes, bracelets and pictures, frame after frame (each stage
+// and each hand writes only its own outputs), with the sizes estimated online or fixed.
 TEST_F(FramePipelineTest, SideBySideStagesGiveTheSerialResults) {
+  for (bool personalise : {false, true}) {
+    SCOPED_TRACE(personalise ? "sizes estimated online" : "fixed sizes");
+    side_by_side_matches_serial(personalise);
+  }
+}
+
+void FramePipelineTest::side_by_side_matches_serial(bool personalise) {
   const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
-  FramePipelineParams p;
+  FramePipelineParams p = personalise ? personalising_params() : FramePipelineParams{};
   p.chroma_key = vc.chroma_key;
   p.bracelet = vc.bracelet;
   p.registration.silhouette_term = true;  // the evidence stage on the helper does its whole work
   p.registration.silhouette_inward = true;
+  if (personalise) p.shape_estimator.shared_hands = false;  // an estimator per hand
   sim::RubiksTask task({});
   for (int h = 0; h < 2; ++h)
     p.initial_r_W_hand[h] = task.nominal(1.5, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
@@ -324,7 +336,7 @@ TEST_F(FramePipelineTest, SideBySideStagesGiveTheSerialResults) {
   sim::UserHands user(truth_models_, task);
   sim::SyntheticFrame frame;
   FrameResult a, b;
-  int found = 0;
+  int found = 0, resized = 0;
   for (double t = 1.5; t < 2.3; t += 1.0 / 30) {
     const auto sample = pose_user(user, task, t);
     const auto& truth = user.params();
@@ -340,12 +352,22 @@ TEST_F(FramePipelineTest, SideBySideStagesGiveTheSerialResults) {
         EXPECT_EQ((a.bracelets[h].wrist_px - b.bracelets[h].wrist_px).norm(), 0.0) << t;
       }
       ASSERT_EQ((a.hands[h].q - b.hands[h].q).norm(), 0.0) << "hand " << h << " at " << t;
+      EXPECT_EQ(a.models[h].shape.dimensions.length, b.models[h].shape.dimensions.length) << t;
+      EXPECT_EQ(a.models[h].shape.dimensions.width, b.models[h].shape.dimensions.width) << t;
+      EXPECT_EQ(a.fits[h].iterations, b.fits[h].iterations) << t;
+      if (a.models[h].shape.dimensions.width != models_[h].shape.dimensions.width) ++resized;
     }
+    EXPECT_EQ(a.restarts, b.restarts) << t;
+    EXPECT_EQ(a.depth_switches, b.depth_switches) << t;
+    EXPECT_EQ(a.reaches, b.reaches) << t;
     EXPECT_EQ(cv::norm(a.composite, b.composite, cv::NORM_INF), 0.0) << t;
     EXPECT_GT(a.timings.key_ms, 0.0);
     EXPECT_GT(a.timings.bracelet_ms, 0.0);
   }
   EXPECT_GT(found, 20);  // the bracelets were seen: the stage on the caller did its work
+  if (personalise) {
+    EXPECT_GT(resized, 0);  // the estimators on both threads did their work
+  }
 }
 
 // A fit that cannot agree with the strings is no evidence on the hand's sizes: with the right

@@ -286,6 +286,37 @@ TEST(SyntheticCamera, MotionBlurAndNoiseLeaveGroundTruthAtTheCurrentPose) {
   EXPECT_GT(cv::countNonZero(noise.reshape(1) < 0), noise.total());
 }
 
+// film_image hands over the image alone and film_truth reads that film's ground truth after it
+// (sim::CameraThread publishes in between): together they give what film gives, and a
+// film_truth without its film_image is an error, not a stale or empty truth.
+TEST(SyntheticCamera, TheImageAndItsGroundTruthCanBeFilmedApart) {
+  SPIDAR_REQUIRE_GL();
+  const vision::Camera cam = vision::default_rig_camera();
+  auto whole = SyntheticCamera::create(*gl_context(), cam, render::test::truth_models()).value();
+  auto apart = SyntheticCamera::create(*gl_context(), cam, render::test::truth_models()).value();
+  const auto q = render::test::reaching_hands(), other = render::test::reaching_hands(-0.03);
+  SyntheticFrame a, b;
+  EXPECT_FALSE(apart->film_truth(&b).ok());  // nothing filmed yet
+  ASSERT_TRUE(whole->film({&q[0], &q[1]}, &a).ok());
+  ASSERT_TRUE(apart->film_image({&q[0], &q[1]}, &b).ok());
+  EXPECT_TRUE(b.mask.empty());  // the image only
+  EXPECT_EQ(cv::norm(a.bgr, b.bgr, cv::NORM_INF), 0.0);  // the same seed: the same noise
+  ASSERT_TRUE(apart->film_truth(&b).ok());
+  for (auto [x, y] : {std::pair{&a.mask, &b.mask}, {&a.hand_index, &b.hand_index}, {&a.hand_only, &b.hand_only}}) {
+    ASSERT_EQ(x->size(), y->size());
+    EXPECT_EQ(cv::countNonZero(*x != *y), 0);
+  }
+  EXPECT_GT(cv::countNonZero(b.mask), 20000);
+  cv::Mat same_depth = (a.depth == b.depth) | (a.depth != a.depth);
+  EXPECT_EQ(cv::countNonZero(same_depth == 0), 0);
+  EXPECT_FALSE(apart->film_truth(&b).ok());  // read once per film_image
+  // The truth read after another film_image is that film's, not the first one's.
+  SyntheticFrame c;
+  ASSERT_TRUE(apart->film_image({&other[0], &other[1]}, &c).ok());
+  ASSERT_TRUE(apart->film_truth(&c).ok());
+  EXPECT_GT(cv::countNonZero(c.mask != b.mask), 500);
+}
+
 TEST(SyntheticCamera, RejectsBadParams) {
   SyntheticCameraParams p;
   p.motion_blur_samples = 0;

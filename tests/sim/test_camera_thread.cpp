@@ -323,5 +323,41 @@ TEST(CameraThread, AHeldFrameIsNotFilmedOver) {
   EXPECT_NE(held.front().frame.get(), held.back().frame.get());
 }
 
+// A frame is published as soon as its image is ready; its ground-truth images follow
+// (FilmedFrame::truth_images). Once waited for, they are that frame's own: the mask lies where the
+// image is not blue screen, at every frame taken while the camera goes on filming.
+TEST(CameraThread, AFramesGroundTruthFollowsItsImageAndIsItsOwn) {
+  const Filmed filmed;
+  CameraThreadParams params;
+  params.fps = 60;
+  params.t0_ns = core::monotonic_ns();
+  const std::atomic<std::int64_t> t0{params.t0_ns};
+  auto thread = filmed.start(filmed.nominal_from(&t0), params);
+  ASSERT_TRUE(thread.ok()) << thread.error().message;
+  CameraThread& cam = *thread.value();
+  int checked = 0;
+  for (int i = 0; i < 4000 && checked < 6; ++i) {  // waits for frames, not for a time
+    if (!cam.wait_for_frame(core::monotonic_ns() + 50'000'000) || !cam.take()) continue;
+    const auto f = cam.shared();
+    ASSERT_NE(f, nullptr);
+    const SyntheticFrame& images = f->wait_for_truth_images();
+    ASSERT_TRUE(f->truth_images.done());
+    ASSERT_EQ(images.mask.size(), images.bgr.size()) << cam.error();
+    // Not blue screen: blue well above red in the screen's colour, below it on skin.
+    std::vector<cv::Mat> ch;
+    cv::split(images.bgr, ch);
+    cv::Mat screen = ch[0] > ch[2] + 60;
+    const double hand_px = cv::countNonZero(images.mask);
+    ASSERT_GT(hand_px, 5000);
+    const double wrong = cv::countNonZero(screen & images.mask) + cv::countNonZero(~screen & ~images.mask);
+    EXPECT_LT(wrong / hand_px, 0.05) << "frame " << f->index;
+    EXPECT_GE(f->truth_images_ms, 0.0);
+    ++checked;
+  }
+  cam.stop();
+  EXPECT_EQ(checked, 6) << cam.error();
+  EXPECT_TRUE(cam.error().empty()) << cam.error();
+}
+
 }  // namespace
 }  // namespace spidar::sim

@@ -42,11 +42,12 @@ struct FramePipelineParams {
   /// the frame's path.
   bool other_composite = true;
   int silhouette_margin_px = 40;        ///< distance-transform margin (inward silhouette only)
-  /// Run the image's two independent stages side by side on two threads: the chroma key and the
-  /// silhouette evidence built on it on a helper thread (core/side_task.hpp), the bracelets on the
-  /// calling thread. The results are the same either way (test
-  /// FramePipelineTest.SideBySideStagesGiveTheSerialResults); on two cores it shortens the frame
-  /// by the shorter of the two (FrameTimings then overlap: their sum exceeds total_ms).
+  /// Run independent stages side by side on two threads (core/side_task.hpp): the chroma key and
+  /// the silhouette evidence built on it on a helper thread beside the bracelets on the calling
+  /// thread; then the left hand's fit on the helper beside the right hand's (with an estimator
+  /// per hand: ShapeEstimatorParams::shared_hands off). The results are the same either way
+  /// (test FramePipelineTest.SideBySideStagesGiveTheSerialResults); on two cores it shortens the
+  /// frame by the shorter of each pair (FrameTimings then overlap: their sum exceeds total_ms).
   bool side_by_side = true;
   /// The distance transform at full (1) or half (2) resolution (vision/silhouette.hpp): half costs
   /// about a quarter and moves a pulled point's target by at most ~2 px.

@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "spidar/core/done_flag.hpp"
 #include "spidar/core/result.hpp"
 #include "spidar/core/recycling_pool.hpp"
 #include "spidar/device/servo_types.hpp"
@@ -30,13 +31,25 @@ struct FilmedFrame {
   std::uint64_t index = 0;         ///< frame number since start (gaps: frames not taken)
   std::int64_t t_exposure_ns = 0;  ///< host monotonic time of the exposure [ns]
   double t_script_s = 0;           ///< the scenario's time at the exposure [s]
+  /// The image (frame.bgr, frame.toward_elbow_W) is complete when the frame is published; its
+  /// ground-truth images (frame.mask, hand_index, hand_only, depth) only once truth_images is
+  /// done: the camera thread reads them after publishing, off the frame's latency. Their readers
+  /// wait first (wait_for_truth_images). Done by default: a frame made otherwise is complete.
   SyntheticFrame frame;
+  core::DoneFlag truth_images{true};
   std::array<hand::HandParams, 2> truth;  ///< the user's hands at the exposure
   std::array<double, 2> cap_residual_m{};  ///< UserHands::cap_residual_m
-  double film_ms = 0;              ///< cost of posing and filming [ms]
+  double film_ms = 0;              ///< cost of posing and filming the image, to its publication [ms]
+  double truth_images_ms = 0;      ///< then reading its ground-truth images [ms] (once they are done)
+
+  /// Blocks until the ground-truth images are written; then `frame` is complete.
+  const SyntheticFrame& wait_for_truth_images() const {
+    truth_images.wait();
+    return frame;
+  }
 };
 
-/// A deep copy (the images copied into `to`'s buffers when they fit, so a reused `to` allocates
+/// A deep copy, once `from`'s ground-truth images are done (the images copied into `to`'s buffers when they fit, so a reused `to` allocates
 /// nothing). A FilmedFrame taken from CameraThread::frame() is only valid until the next take();
 /// CameraThread::shared() keeps one for longer without a copy.
 void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to);

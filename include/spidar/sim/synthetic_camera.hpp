@@ -80,9 +80,17 @@ class SyntheticCamera {
   SyntheticCamera(const SyntheticCamera&) = delete;
   SyntheticCamera& operator=(const SyntheticCamera&) = delete;
 
-  /// Films one frame at `poses`. With `previous` and motion_blur_samples > 1 the image is the
-  /// mean of sub-frames from previous to poses (ground truth: at `poses`). Reuses out's buffers.
+  /// Films one frame at `poses`: film_image, then film_truth. With `previous` and
+  /// motion_blur_samples > 1 the image is the mean of sub-frames from previous to poses (ground
+  /// truth: at `poses`). Reuses out's buffers.
   Status film(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous = nullptr);
+  /// What the camera delivers only: out->bgr and out->toward_elbow_W (the ground-truth images are
+  /// left as they were). The ground truth of this film stays in the renderer for film_truth: a
+  /// camera can hand the image over first and read its truth after (sim::CameraThread).
+  Status film_image(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous = nullptr);
+  /// The ground-truth images of the last film_image (out->mask, hand_index, hand_only, depth).
+  /// Error if there was none since the last film_truth, or the last film_image failed.
+  Status film_truth(SyntheticFrame* out);
 
   /// The camera as given (with its lens, if any).
   const vision::Camera& camera() const;
