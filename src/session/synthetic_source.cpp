@@ -25,10 +25,11 @@ class SyntheticSource final : public FrameSource {
           [&dev](device::FingertipSample* o, std::size_t max) { return dev.truth_samples(o, max); }, t_ns,
           std::span(truth_buf_));
       const auto s = device::interpolate_samples({truth_buf_.data(), n}, t_ns);
-      if (!s) return false;
+      if (!s) return sim::Truth::kNone;
       for (std::size_t f = 0; f < out.size() && f < 8; ++f)
         out[f] = device::fingertip_position(*s, static_cast<int>(f));
-      return true;
+      // Newest first: exact once a sample at or after t_ns has come, else the newest held.
+      return truth_buf_[0].t_ns >= t_ns ? sim::Truth::kExact : sim::Truth::kHeld;
     };
     sim::SyntheticCameraParams cp;
     cp.seed = seed_;

@@ -43,6 +43,8 @@ Result<std::unique_ptr<CameraThread>> CameraThread::prepare(
                                  std::pair{"first_exposure_ns", params.first_exposure_ns}})
     if (ns < 0 || ns > 1'000'000'000)
       return Error{std::string("camera thread: ") + name + " must be in [0, 1e9] ns, got " + std::to_string(ns)};
+  if (params.truth_poll_ns < 1000 || params.truth_poll_ns > 1'000'000'000)
+    return Error{"camera thread: truth_poll_ns must be in [1e3, 1e9] ns, got " + std::to_string(params.truth_poll_ns)};
   if (params.warm_frames < 0 || params.warm_frames > 64)
     return Error{"camera thread: warm_frames must be in 0..64, got " + std::to_string(params.warm_frames)};
   std::unique_ptr<CameraThread> c(new CameraThread());
@@ -157,10 +159,20 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
   std::uint64_t index = 0;
   std::int64_t t_exp = t0_ns + params_.first_exposure_ns;
   while (!stop_.load(std::memory_order_acquire)) {
-    core::sleep_until_ns(t_exp + std::min(params_.truth_wait_ns, params_.readout_ns));
+    // The ground truth at the exposure: asked from the exposure on until it is exact, a held one
+    // taken at the end of the wait.
+    const std::int64_t give_up = t_exp + std::min(params_.truth_wait_ns, params_.readout_ns);
+    core::sleep_until_ns(t_exp);
+    Truth had = Truth::kNone;
+    while (!stop_.load(std::memory_order_acquire)) {
+      had = truth_at_(t_exp, caps);
+      const std::int64_t now = core::monotonic_ns();
+      if (had == Truth::kExact || now >= give_up) break;
+      core::sleep_until_ns(std::min(give_up, now + params_.truth_poll_ns));
+    }
     if (stop_.load(std::memory_order_acquire)) break;
     const std::int64_t t_start = core::monotonic_ns();
-    if (truth_at_(t_exp, caps)) {
+    if (had != Truth::kNone) {
       const double t_script = core::ns_to_s(t_exp - t0_ns);
       user.update(t_script, caps);
       std::shared_ptr<FilmedFrame> frame = pool_.take();  // nobody holds it: its buffers are reused

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -49,7 +50,7 @@ struct Filmed {
   TruthAt nominal_from(const std::atomic<std::int64_t>* t0_ns) const {
     return [this, t0_ns](std::int64_t t_ns, std::span<Vec3> out) {
       caps_at(t0_ns->load(), t_ns, out);
-      return true;
+      return Truth::kExact;
     };
   }
   Result<std::unique_ptr<CameraThread>> start(TruthAt truth_at, const CameraThreadParams& params) const {
@@ -72,10 +73,10 @@ TEST(CameraThread, ExposuresWithoutTruthCountAsSkipped) {
   TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
     if (t_ns < t0 + 200'000'000) {
       ++refused;
-      return false;
+      return Truth::kNone;
     }
     filmed.caps(core::ns_to_s(t_ns - t0), out);
-    return true;
+    return Truth::kExact;
   };
   auto thread = filmed.start(truth_at, params);
   ASSERT_TRUE(thread.ok()) << thread.error().message;
@@ -118,7 +119,7 @@ TEST(CameraThread, TheFirstExposureComesAfterTheDevicesFirstSample) {
       if (have) filmed.caps_at(t0, t_ns, out);
       const std::lock_guard lock(m);
       asked.emplace_back(t_ns, have);
-      return have;
+      return have ? Truth::kExact : Truth::kNone;
     };
     auto thread = filmed.start(truth_at, params);
     ASSERT_TRUE(thread.ok()) << thread.error().message;
@@ -134,7 +135,7 @@ TEST(CameraThread, TheFirstExposureComesAfterTheDevicesFirstSample) {
   }
   CameraThreadParams bad;
   bad.first_exposure_ns = -1;
-  TruthAt any = [](std::int64_t, std::span<Vec3>) { return false; };
+  TruthAt any = [](std::int64_t, std::span<Vec3>) { return Truth::kNone; };
   auto refused = filmed.prepare(any, bad);
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.error().message.find("first_exposure_ns"), std::string::npos) << refused.error().message;
@@ -156,7 +157,7 @@ TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
   TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
     if (t0.load() == 0) ++asked_before_begin;
     filmed.caps_at(t0.load(), t_ns, out);
-    return true;
+    return Truth::kExact;
   };
   CameraThreadParams params;
   params.fps = 30;
@@ -193,9 +194,8 @@ TEST(CameraThread, APreparedCameraFilmsFromItsBeginOnly) {
 }
 
 // The posing and filming run during the sensor's readout, not after it: the truth is asked for
-// once the fingertip sample at the exposure can be there (truth_wait_ns after it), and no frame is
-// published before its readout has ended (readout_ns after the exposure), however fast the
-// filming. A readout of a second (longer than any stall of a loaded machine, and than the frame
+// from the exposure on (an exact source is used at once), and no frame is published before its
+// readout has ended (readout_ns after the exposure), however fast the filming. A readout of a second (longer than any stall of a loaded machine, and than the frame
 // period: the frames overlap) makes both visible at any speed; a negative one is refused.
 TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
   const Filmed filmed;
@@ -214,7 +214,7 @@ TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
       asked_after.push_back(now - t_ns);
     }
     filmed.caps_at(t0, t_ns, out);
-    return true;
+    return Truth::kExact;
   };
   auto thread = filmed.start(truth_at, params);
   ASSERT_TRUE(thread.ok()) << thread.error().message;
@@ -229,7 +229,7 @@ TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
   for (std::int64_t d : published_after) EXPECT_GE(d, params.readout_ns) << "published before its readout";
   const std::lock_guard lock(m);
   ASSERT_GE(asked_after.size(), 3u);
-  for (std::int64_t d : asked_after) EXPECT_GE(d, params.truth_wait_ns) << "truth asked before its sample";
+  for (std::int64_t d : asked_after) EXPECT_GE(d, 0) << "truth asked before the exposure";
   // The truth was asked for before the readout ended (a frame filmed after it would add the
   // filming to the latency): at least one of them, whatever the machine's load.
   EXPECT_LT(*std::min_element(asked_after.begin(), asked_after.end()), params.readout_ns);
@@ -239,6 +239,78 @@ TEST(CameraThread, FilmsDuringTheReadoutAndPublishesAfterIt) {
   auto refused = filmed.prepare(truth_at, bad);
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.error().message.find("readout_ns"), std::string::npos) << refused.error().message;
+}
+
+// The camera waits for the exposure's exact ground truth (the device's sample after it), asking
+// every truth_poll_ns, and films with the newest sample held only when truth_wait_ns has passed
+// without it: a source exact 3 ms after each exposure is filmed exact with a wait of 10 ms; one
+// that only ever holds is filmed held, after the wait.
+TEST(CameraThread, WaitsForTheExposuresExactTruthAndHoldsOnlyPastTheWait) {
+  const Filmed filmed;
+  for (const bool ever_exact : {true, false}) {
+    SCOPED_TRACE(ever_exact ? "exact 3 ms after the exposure" : "held only");
+    CameraThreadParams params;
+    params.fps = 10;
+    params.readout_ns = 20'000'000;
+    params.truth_wait_ns = 10'000'000;
+    params.truth_poll_ns = 200'000;
+    std::atomic<std::int64_t> t0{0};
+    std::mutex m;
+    struct Ask {
+      std::int64_t exposure, after;
+      Truth had;
+    };
+    std::vector<Ask> asks;
+    TruthAt truth_at = [&](std::int64_t t_ns, std::span<Vec3> out) {
+      const std::int64_t after = core::monotonic_ns() - t_ns;
+      const Truth had = ever_exact && after >= 3'000'000 ? Truth::kExact : Truth::kHeld;
+      filmed.caps_at(t0.load(), t_ns, out);
+      const std::lock_guard lock(m);
+      asks.push_back({t_ns, after, had});
+      return had;
+    };
+    auto thread = filmed.prepare(truth_at, params);  // its GL context and warm-up done
+    ASSERT_TRUE(thread.ok()) << thread.error().message;
+    CameraThread& cam = *thread.value();
+    t0 = core::monotonic_ns();
+    cam.begin(t0.load());
+    int taken = 0;
+    for (int i = 0; i < 4000 && taken < 3; ++i)  // waits for frames, not for a time
+      if (cam.wait_for_frame(core::monotonic_ns() + 50'000'000) && cam.take()) ++taken;
+    cam.stop();
+    ASSERT_EQ(taken, 3) << cam.error();
+    const std::lock_guard lock(m);
+    // Per exposure, its asks in order (the last one is what was filmed). What is checked is the
+    // logic, not the timing (a loaded machine may delay any ask): asks from the exposure on; the
+    // asks stop at the first exact truth; a held truth is filmed only at the end of the wait.
+    std::map<std::int64_t, std::vector<Ask>> by_exposure;
+    for (const Ask& a : asks) {
+      EXPECT_GE(a.after, 0) << "asked before the exposure";
+      by_exposure[a.exposure].push_back(a);
+    }
+    int polled = 0, exact = 0, waited = 0;
+    for (const auto& [exposure, list] : by_exposure) {
+      for (std::size_t k = 0; k + 1 < list.size(); ++k)
+        EXPECT_NE(list[k].had, Truth::kExact) << "asked again after the exact truth";
+      if (list.size() >= 2) ++polled;
+      if (list.back().had == Truth::kExact) ++exact;
+      if (list.back().after >= params.truth_wait_ns - params.truth_poll_ns) ++waited;
+      if (!ever_exact) {
+        EXPECT_EQ(list.back().had, Truth::kHeld);
+      }
+    }
+    EXPECT_GE(polled, 1);  // asked again, not one late look
+    if (ever_exact) {
+      EXPECT_GE(exact, 1);
+    } else {
+      EXPECT_GE(waited, 1);  // the held truth taken at the end of the wait
+    }
+  }
+  CameraThreadParams bad;
+  bad.truth_poll_ns = 0;
+  auto refused = filmed.prepare(filmed.nominal_from(nullptr), bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("truth_poll_ns"), std::string::npos) << refused.error().message;
 }
 
 // The frame thread sleeps in wait_for_frame until a frame is published (it is woken, not polling):

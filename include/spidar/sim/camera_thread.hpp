@@ -49,13 +49,20 @@ struct FilmedFrame {
   }
 };
 
-/// A deep copy, once `from`'s ground-truth images are done (the images copied into `to`'s buffers when they fit, so a reused `to` allocates
-/// nothing). A FilmedFrame taken from CameraThread::frame() is only valid until the next take();
+/// A deep copy, once `from`'s ground-truth images are done (the images copied into `to`'s
+/// buffers when they fit, so a reused `to` allocates nothing). A FilmedFrame taken from CameraThread::frame() is only valid until the next take();
 /// CameraThread::shared() keeps one for longer without a copy.
 void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to);
 
-/// Fills `out` with the true fingertip caps at t_ns (8 of them); false if there are none yet.
-using TruthAt = std::function<bool(std::int64_t t_ns, std::span<Vec3> out)>;
+/// What a ground-truth source had at a time.
+enum class Truth {
+  kNone,   ///< no fingertips yet (`out` untouched)
+  kHeld,   ///< the newest sample, from before the time (the one after it has not come yet)
+  kExact,  ///< samples on both sides of the time, interpolated (or an exact source)
+};
+
+/// Fills `out` with the true fingertip caps at t_ns (8 of them) and says how they were had.
+using TruthAt = std::function<Truth(std::int64_t t_ns, std::span<Vec3> out)>;
 
 struct CameraThreadParams {
   double fps = 30.0;
@@ -67,11 +74,15 @@ struct CameraThreadParams {
   std::int64_t first_exposure_ns = 5'000'000;
   /// The sensor's readout [ns]: a frame is published no earlier than this after its exposure.
   std::int64_t readout_ns = 2'000'000;
-  /// Wait after the exposure before posing and filming [ns]: the simulated device's fingertip
-  /// sample at the exposure (one servo period, 1 ms, and a margin) is then there to interpolate.
-  /// The posing and filming (the simulation's own cost, which a real sensor does not have) run
-  /// during the readout, not after it.
+  /// The longest wait after the exposure for its exact ground truth [ns]: the camera asks from
+  /// the exposure on, every truth_poll_ns, until the simulated device's fingertip sample after
+  /// the exposure has come (Truth::kExact: on average half a servo period later, at most one and
+  /// its delay); past this wait it films with the newest sample held (Truth::kHeld). The posing
+  /// and filming (the simulation's own cost, which a real sensor does not have) run during the
+  /// readout, not after it. [0, 1e9].
   std::int64_t truth_wait_ns = 1'200'000;
+  /// How often the camera asks for the exact ground truth during truth_wait_ns [ns]. [1e3, 1e9].
+  std::int64_t truth_poll_ns = 100'000;
   /// The thread's niceness (core::set_nice, best effort): the simulated camera is hardware, which
   /// films at its rate whatever the host does, so it goes before the frame thread and the outputs
   /// that share the CPU with it. Needs CAP_SYS_NICE below 0; without it, a normal share.
