@@ -201,11 +201,11 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
       // The ground-truth images after the publication: the frame thread works on the image
       // meanwhile. Done on every path, so that no reader waits for ever.
       const std::int64_t t_truth = core::monotonic_ns();
-      const Status truth_status = film.value()->film_truth(&out.frame);
-      out.truth_images_ms = core::ns_to_s(core::monotonic_ns() - t_truth) * 1e3;
+      const Status truth_status = film.value()->film_truth(&writing->frame);
+      writing->truth_images_ms = core::ns_to_s(core::monotonic_ns() - t_truth) * 1e3;
       if (!truth_status) {
-        for (cv::Mat* m : {&out.frame.mask, &out.frame.hand_index, &out.frame.hand_only, &out.frame.depth})
-          m->release();
+        SyntheticFrame& f = writing->frame;
+        for (cv::Mat* m : {&f.mask, &f.hand_index, &f.hand_only, &f.depth}) m->release();
         error_ = truth_status.error().message;
       }
       writing->truth_images.set();

@@ -50,8 +50,9 @@ struct FilmedFrame {
 };
 
 /// A deep copy, once `from`'s ground-truth images are done (the images copied into `to`'s
-/// buffers when they fit, so a reused `to` allocates nothing). A FilmedFrame taken from CameraThread::frame() is only valid until the next take();
-/// CameraThread::shared() keeps one for longer without a copy.
+/// buffers when they fit, so a reused `to` allocates nothing). A FilmedFrame taken from
+/// CameraThread::frame() is only valid until the next take(); CameraThread::shared() keeps one
+/// for longer without a copy.
 void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to);
 
 /// What a ground-truth source had at a time.
