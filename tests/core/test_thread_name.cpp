@@ -40,12 +40,14 @@ TEST(ThreadName, NamesTheCallingThreadAsTheSystemSeesItCutTo15Characters) {
 }
 
 // A thread that burned 60 ms of its own CPU time shows at least 50 ms under its name (the
-// kernel counts in 10 ms ticks), and a sleeping one next to nothing.
+// kernel counts in 10 ms ticks), and a sleeping one next to nothing. The measurement waits until
+// the sleeper has named itself: on a loaded machine it may not even have started by then.
 TEST(ThreadName, TheProcesssThreadsCpuTimeIsSummedByName) {
-  std::atomic<bool> measured{false};
+  std::atomic<bool> named{false}, measured{false};
   std::vector<ThreadCpu> seen;
   std::thread sleeper([&] {
     set_thread_name("spidar-sleeper");
+    named = true;
     while (!measured.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   });
   std::thread busy([&] {
@@ -53,6 +55,7 @@ TEST(ThreadName, TheProcesssThreadsCpuTimeIsSummedByName) {
     timespec t{};
     do clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     while (t.tv_sec == 0 && t.tv_nsec < 60'000'000);
+    while (!named.load()) std::this_thread::yield();
     seen = thread_cpu_by_name();
     measured = true;
   });
