@@ -74,6 +74,20 @@ TEST(LiveRun, HeadlessRunsForSecondsAndExitsCleanly) {
   EXPECT_GT(j["registration"]["iou_vs_silhouette_mean"].get<double>(), 0.3) << r.out;
 }
 
+/// Whether process `pid` catches signal `sig` (the SigCgt mask of /proc/PID/status), waiting up
+/// to `limit` for it to install its handler.
+bool catches_within(pid_t pid, int sig, std::chrono::milliseconds limit) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  do {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+    std::string line;
+    while (std::getline(in, line))
+      if (line.rfind("SigCgt:", 0) == 0 && ((std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1u)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  } while (std::chrono::steady_clock::now() < until);
+  return false;
+}
+
 TEST(LiveRun, SigtermAndSigintEndTheSessionCleanly) {
   for (int sig : {SIGINT, SIGTERM}) {
     const fs::path out = temp_dir("signal") / "out.json";
@@ -85,7 +99,10 @@ TEST(LiveRun, SigtermAndSigintEndTheSessionCleanly) {
       execl(SPIDAR_MR, SPIDAR_MR, "run", "--config", "configs/lab-example.yaml", "--headless", nullptr);
       _exit(98);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+    // Signalled once it catches the signal (its handler installed, which a loaded machine may delay
+    // past any fixed wait), then a second on, into the session.
+    ASSERT_TRUE(catches_within(pid, sig, std::chrono::seconds(20))) << "run never installed its handler";
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
     kill(pid, sig);
     int status = 0;
     const auto t0 = std::chrono::steady_clock::now();

@@ -4,7 +4,6 @@
 // the spinner's CPU.
 #include <gtest/gtest.h>
 
-#include <dirent.h>
 #include <sched.h>
 #include <unistd.h>
 
@@ -14,35 +13,13 @@
 #include <thread>
 #include <vector>
 
+#include "idle_threads.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/core/idle_spinner.hpp"
 #include "spidar/core/realtime.hpp"
 
 namespace spidar::core {
 namespace {
-
-/// The ids of this process's threads whose policy is SCHED_IDLE.
-std::vector<pid_t> idle_threads() {
-  std::vector<pid_t> out;
-  DIR* d = opendir("/proc/self/task");
-  if (d == nullptr) return out;
-  while (const dirent* e = readdir(d)) {
-    if (e->d_name[0] == '.') continue;
-    const pid_t tid = static_cast<pid_t>(std::stol(e->d_name));
-    if (sched_getscheduler(tid) == SCHED_IDLE) out.push_back(tid);
-  }
-  closedir(d);
-  return out;
-}
-
-/// Whether this process has no SCHED_IDLE thread, waiting up to a second for one that has ended to
-/// leave /proc: pthread_join returns when the kernel clears the thread's id, which it does on its
-/// way out, before the task itself is gone (seen: 1 in 3 runs of the suite listed it just after).
-bool no_idle_thread_within_a_second() {
-  const std::int64_t until = monotonic_ns() + 1'000'000'000;
-  while (!idle_threads().empty() && monotonic_ns() < until) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  return idle_threads().empty();
-}
 
 /// Waits (at most a minute: only a spinner that never runs reaches it) until it has spun.
 bool spun(const IdleSpinner& s) {
@@ -52,7 +29,7 @@ bool spun(const IdleSpinner& s) {
 }
 
 TEST(IdleSpinner, SpinsAtSchedIdlePinnedToItsCpuUntilDestroyed) {
-  ASSERT_TRUE(no_idle_thread_within_a_second());
+  ASSERT_TRUE(test::no_idle_thread_within());
   const long online = sysconf(_SC_NPROCESSORS_ONLN);
   for (const int asked : {-1, 0}) {
     auto started = IdleSpinner::start(asked);
@@ -61,7 +38,7 @@ TEST(IdleSpinner, SpinsAtSchedIdlePinnedToItsCpuUntilDestroyed) {
     const int cpu = asked >= 0 ? asked : static_cast<int>(online - 1);
     EXPECT_EQ(s->cpu(), cpu);
     EXPECT_TRUE(spun(*s));
-    const std::vector<pid_t> idle = idle_threads();
+    const std::vector<pid_t> idle = test::idle_threads();
     ASSERT_EQ(idle.size(), 1u);
     cpu_set_t set;
     CPU_ZERO(&set);
@@ -69,7 +46,7 @@ TEST(IdleSpinner, SpinsAtSchedIdlePinnedToItsCpuUntilDestroyed) {
     EXPECT_EQ(CPU_COUNT(&set), 1);
     EXPECT_TRUE(CPU_ISSET(cpu, &set));
     s.reset();
-    EXPECT_TRUE(no_idle_thread_within_a_second()) << "the spinner's thread outlived it";
+    EXPECT_TRUE(test::no_idle_thread_within()) << "the spinner's thread outlived it";
   }
 }
 
@@ -77,7 +54,7 @@ TEST(IdleSpinner, ACpuThatDoesNotExistIsRefusedWithNothingRunning) {
   const auto s = IdleSpinner::start(4095);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("CPU 4095"), std::string::npos) << s.error().message;
-  EXPECT_TRUE(idle_threads().empty());
+  EXPECT_TRUE(test::no_idle_thread_within());  // an earlier test's spinner may still be leaving
 }
 
 /// Waits (at most a minute) until the spinner has stopped spinning: no round in 30 ms. A spinner
@@ -153,7 +130,7 @@ TEST(IdleSpinner, StopsWhenARealTimeThreadHoldsItsCpu) {
   hog_stop = true;
   hog.join();
   EXPECT_TRUE(hog_on.load());
-  EXPECT_TRUE(no_idle_thread_within_a_second());
+  EXPECT_TRUE(test::no_idle_thread_within());
 }
 
 }  // namespace

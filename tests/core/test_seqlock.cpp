@@ -43,10 +43,15 @@ TEST(Latest, ConcurrentReadsAreNeverTornAndNeverGoBack) {
   Latest<Checked> l;
   std::atomic<bool> done{false};
   std::atomic<std::uint64_t> reads{0}, written{0};
-  // The writer keeps publishing until the reader has read many times while it writes.
+  // The writer keeps publishing until the reader has read many times while it writes. It yields
+  // now and then: back-to-back publishes can keep a reader slowed by a sanitizer from ever
+  // reading between two of them, and the test would then run to the cap and fail.
   std::thread writer([&] {
     std::uint64_t n = 1;
-    for (; reads.load() < 20000 && n < 50'000'000; ++n) l.publish(make(n));
+    for (; reads.load() < 20000 && n < 50'000'000; ++n) {
+      l.publish(make(n));
+      if (n % 256 == 0) std::this_thread::yield();
+    }
     written = n - 1;
     done = true;
   });

@@ -264,7 +264,9 @@ TEST(SerialDevice, SafeStateRequestFromAnotherThreadSendsMinimums) {
 }
 
 TEST(SerialDevice, HeartbeatTimeoutPutsBackendInSafeState) {
-  PtyLink link(4, {0.1});
+  // A timeout well above a loaded machine's pauses between the host's frames below (at 0.1 s a
+  // pause of the test's thread could trip it early, twice).
+  PtyLink link(4, {0.5});
   link.start_emulator();
   SerialDevice dev(link.config(4));
   ASSERT_TRUE(dev.open().ok());
@@ -277,7 +279,7 @@ TEST(SerialDevice, HeartbeatTimeoutPutsBackendInSafeState) {
   EXPECT_FALSE(link.fake.safe());
 
   // The host goes quiet: within the heartbeat timeout (plus scheduling slack) the firmware trips.
-  ASSERT_TRUE(PtyLink::wait_until([&] { return link.fake.safe(); }, 5.0));
+  ASSERT_TRUE(PtyLink::wait_until([&] { return link.fake.safe(); }, 10.0));
   EXPECT_TRUE(link.emulator->watchdog_tripped());
   EXPECT_EQ(link.emulator->counters().watchdog_trips, 1u);
 
@@ -447,7 +449,9 @@ TEST(SerialDevice, SilenceAfterAReadingBecomesAReadTimeout) {
   link.start_emulator();
   SerialDeviceConfig c = link.config(4);
   c.reply_wait_s = 0.0;
-  c.read_timeout_s = 0.05;
+  // Long enough that the first reads after the emulator stops (its join alone takes about 11 ms,
+  // more on a loaded machine or under a sanitizer) still come before the timeout.
+  c.read_timeout_s = 0.5;
   SerialDevice dev(c);
   ASSERT_TRUE(dev.open().ok());
   EncoderReading r;
@@ -456,7 +460,7 @@ TEST(SerialDevice, SilenceAfterAReadingBecomesAReadTimeout) {
   const std::array<std::int32_t, 4> cmd{};
   std::uint32_t repeats = 0;
   Status s = Ok{};
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (std::chrono::steady_clock::now() < end) {
     ASSERT_TRUE(dev.write(cmd).ok());
     s = dev.read(r);

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <optional>
+#include <string>
 
 #include "recording_test_support.hpp"
 #include "spidar/render/context.hpp"
@@ -47,16 +49,19 @@ void record_and_replay(const vision::Camera& camera, const char* folder) {
   sp.servo.force_timeout_s = 0.05;
   sp.pipeline = pipeline_params("configs/vision.yaml", "configs/registration.yaml", false,
                                 render::CompositeMode::kDepth, scene->initial_r_W_hand());
-  sp.seconds = 1.0;
-  // Personalise the hands' sizes often enough that they change within this one second: the
+  // The live run ends after kLiveFrames frames (a slow, loaded or sanitised run takes longer, not
+  // fewer frames); its seconds are only a backstop.
+  constexpr std::size_t kLiveFrames = 20;
+  sp.seconds = 30.0;
+  // Personalise the hands' sizes often enough that they change within these frames: the
   // recording then holds sizes that move, and the replay must reach the same ones frame by frame.
   sp.pipeline.personalise_shape = true;
   sp.pipeline.shape_estimator.min_pose_change = 0.02;
   sp.pipeline.shape_estimator.min_keyframes = 2;
   sp.pipeline.shape_estimator.solve_every = 2;
   sp.pipeline.shape_estimator.shared_hands = true;  // either hand's keyframes move the sizes (few frames under ASan)
-  // Each re-estimate applied where it is made (not 5 frames later on its own thread): under ASan
-  // on a busy machine the second may hold only a handful of frames.
+  // Each re-estimate applied where it is made (not 5 frames later on its own thread), so that the
+  // sizes move within the run's few frames.
   sp.pipeline.shape_estimator.apply_after_frames = 0;
 
   // --- live, recorded ---
@@ -80,7 +85,10 @@ void record_and_replay(const vision::Camera& camera, const char* folder) {
     SessionRecorder recorder(dir.string(), FrameStore::kPng, setup, recording_device, session->servo());
     session->add_sink(live);
     session->add_sink(recorder);
-    session->run();
+    session->run([&]() -> std::optional<std::string> {
+      if (live.q.size() >= kLiveFrames) return std::string("enough frames");
+      return std::nullopt;
+    });
     ASSERT_EQ(recorder.error(), "");
   }
   ASSERT_GT(live.q.size(), 0u) << "the live session processed no frame";

@@ -42,6 +42,7 @@ TEST(Haptic, ScriptedTwoHandScenarioLiftsTurnsAndFeelsContinuous) {
   device::ServoConfig servo;
   servo.force_timeout_s = 0.05;
   servo.deadline_periods = 50;  // this test is about haptics; a busy CI machine may be late
+  servo.stall_limit_s = 1.0;    // a 0.1 s stall would latch the safe state: no force felt after it
   auto bridge = std::make_shared<HapticForces>(world->params().coupling, servo.rate_hz);
   PhysicsThread physics(*world, *bridge);
   std::atomic<double> lift_max{0};
