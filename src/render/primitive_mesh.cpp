@@ -70,13 +70,19 @@ CpuMesh unit_capsule_template(int slices, int stacks_per_cap) {
   for (int i = 0; i <= stacks_per_cap; ++i)
     elevations.push_back((pi / 2) * static_cast<float>(i) / static_cast<float>(stacks_per_cap));
   const std::size_t rows = elevations.size();
+  // The polygon of `slices` sides inscribed in the unit circle is, averaged over the roll about
+  // its axis, N sin(π/N)·2/π as wide as the circle (its mean width is its perimeter over π): the
+  // vertices lie that much further out, so that the outline is as wide as the capsule on average
+  // (within ±(1/cos(π/N) − 1)/2 at any roll).
+  const auto n_slices = static_cast<float>(slices);
+  const float widen = pi / (n_slices * std::sin(pi / n_slices));
   for (std::size_t i = 0; i < rows; ++i) {
     const float t = elevations[i];
     const float z_eps = i <= static_cast<std::size_t>(stacks_per_cap) ? -1e-6f : 1e-6f;
     for (int j = 0; j <= slices; ++j) {
       const float phi = 2 * pi * static_cast<float>(j) / static_cast<float>(slices);
       const Eigen::Vector3f n(std::cos(t) * std::cos(phi), std::cos(t) * std::sin(phi), std::sin(t));
-      Eigen::Vector3f p = n;
+      Eigen::Vector3f p = widen * n;
       if (std::abs(p.z()) < 1e-6f) p.z() = z_eps;
       push_vertex(m, p, n);
     }

@@ -21,8 +21,10 @@ CpuMesh unit_sphere(int slices = 24, int stacks = 16);
 /// A capsule of radius 1 and length 0: a unit sphere split at its equator into two hemispheres
 /// whose equator rows sit at z = ±1e−6. The vertex shader moves each vertex by sign(z) times the
 /// instance's half length (in radii), which stretches the equator band into the cylinder: one
-/// instanced draw per capsule batch instead of a cylinder and two spheres.
-CpuMesh unit_capsule_template(int slices = 16, int stacks_per_cap = 5);
+/// instanced draw per capsule batch instead of a cylinder and two spheres. The vertices lie
+/// π / (slices sin(π/slices)) from the centre instead of 1 (1.012 for 12 slices), so that the
+/// outline of the polygon is as wide as the round capsule's, averaged over its roll.
+CpuMesh unit_capsule_template(int slices = 12, int stacks_per_cap = 4);
 /// Radius 1, z in [−1, 1], with flat caps.
 CpuMesh unit_cylinder(int slices = 24);
 /// The square [−1, 1]² in z = 0, both sides (normals ±z).
