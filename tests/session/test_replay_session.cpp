@@ -5,9 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <map>
-#include <optional>
-#include <string>
 
+#include "after_frames.hpp"
 #include "recording_test_support.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/session/recording_rig.hpp"
@@ -85,10 +84,7 @@ void record_and_replay(const vision::Camera& camera, const char* folder) {
     SessionRecorder recorder(dir.string(), FrameStore::kPng, setup, recording_device, session->servo());
     session->add_sink(live);
     session->add_sink(recorder);
-    session->run([&]() -> std::optional<std::string> {
-      if (live.q.size() >= kLiveFrames) return std::string("enough frames");
-      return std::nullopt;
-    });
+    session->run(after_frames(kLiveFrames, [&] { return live.q.size(); }));
     ASSERT_EQ(recorder.error(), "");
   }
   ASSERT_GT(live.q.size(), 0u) << "the live session processed no frame";

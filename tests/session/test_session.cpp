@@ -18,6 +18,7 @@
 #include "spidar/session/async_sinks.hpp"
 #include "spidar/session/frame_stats.hpp"
 #include "spidar/session/session.hpp"
+#include "after_frames.hpp"
 #include "simulated_setup.hpp"
 
 namespace spidar::session {
@@ -46,16 +47,7 @@ struct TracingSink final : FrameSink {
   SessionSummary summary;
 };
 
-/// run()'s interruption once `count()` has reached `n`: a test that needs a number of frames runs
-/// until it has them (SimulatedSetup's seconds are then only a backstop), not for a time that a
-/// slow, loaded or sanitised run may fill with too few.
-template <class Count>
-std::function<std::optional<std::string>()> after_frames(std::size_t n, Count count) {
-  return [n, count]() -> std::optional<std::string> {
-    if (count() >= n) return std::string("enough frames");
-    return std::nullopt;
-  };
-}
+using testing::after_frames;
 
 /// Generous: only a run that never gets its frames reaches it.
 constexpr double kBackstopS = 30.0;

@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "after_frames.hpp"
 #include "simulated_setup.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/session/async_sinks.hpp"
@@ -68,10 +69,8 @@ TEST(SessionThreads, TheDemosThreadsHandOverEveryFrameAndItsHeldResults) {
   std::atomic<int> frame_thread_frames{0};
   FunctionSink frame_side([&](const FrameEvent&) { frame_thread_frames.fetch_add(1); });
   s.session->add_sink(frame_side);
-  const SessionSummary end = s.session->run([&]() -> std::optional<std::string> {
-    if (frame_thread_frames.load() >= kFrames) return std::string("enough frames");
-    return std::nullopt;
-  });
+  const SessionSummary end =
+      s.session->run(testing::after_frames(static_cast<std::size_t>(kFrames), [&] { return frame_thread_frames.load(); }));
 
   EXPECT_EQ(end.ended_by, "enough frames");
   EXPECT_TRUE(end.camera_error.empty()) << end.camera_error;
