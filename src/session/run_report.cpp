@@ -275,6 +275,28 @@ void write_plots(const fs::path& dir, const MrTrace& t, const MrSummary& summary
   }
 }
 
+/// A silhouette loss pooled over `frames` frames as per-frame means per hand [px], and the IoU of
+/// the pooled counts.
+nlohmann::json silhouette_loss_json(const sim::SilhouetteLoss& sum, std::size_t frames) {
+  const double n = frames > 0 ? static_cast<double>(frames) : 1.0;
+  nlohmann::json j = {{"frames", frames}, {"iou_pooled", sum.iou()}};
+  for (int h = 0; h < 2; ++h)
+    j[h == 0 ? "left" : "right"] = {{"missed_px", static_cast<double>(sum.missed[h]) / n},
+                                    {"spill_palm_px", static_cast<double>(sum.spill_palm[h]) / n},
+                                    {"spill_digits_px", static_cast<double>(sum.spill_digits[h]) / n}};
+  return j;
+}
+
+/// "missed L/R, palm spill L/R, digit spill L/R" of a per-frame loss (silhouette_loss_json).
+std::string silhouette_loss_line(const nlohmann::json& j) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(0);
+  for (const char* k : {"missed_px", "spill_palm_px", "spill_digits_px"})
+    o << (k[0] == 'm' ? "missed " : k[6] == 'p' ? ", palm spill " : ", digit spill ") << j["left"][k].get<double>()
+      << "/" << j["right"][k].get<double>();
+  return o.str();
+}
+
 }  // namespace
 
 int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s, std::ostream& os) {
@@ -303,6 +325,20 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   std::vector<double> ceiling;
   for (const MrFrame& m : t.frames)
     if (m.ceiling_measured && m.truth[0].real_hand_pixels > 0) ceiling.push_back(m.ceiling_iou);
+  // Where the IoU is lost: the fit over its scored frames, and the fit and the ceiling over the
+  // ceiling's frames (like for like).
+  sim::SilhouetteLoss loss_fit, loss_fit_ceiling_frames, loss_ceiling;
+  std::size_t scored = 0;
+  for (const MrFrame& m : t.frames) {
+    if (m.truth[0].scored_in_image()) {
+      loss_fit += m.truth[0].loss;
+      ++scored;
+    }
+    if (m.ceiling_measured && m.truth[0].real_hand_pixels > 0) {
+      loss_fit_ceiling_frames += m.truth[0].loss;
+      loss_ceiling += m.ceiling_loss;
+    }
+  }
   const auto joint_floor = column(t, [](const MrFrame& m) { return 0.5 * (m.truth[0].joint_px_floor[0] + m.truth[0].joint_px_floor[1]); });
   const auto cap_res = column(t, [](const MrFrame& m) { return std::max(m.truth_cap_residual_mm[0], m.truth_cap_residual_mm[1]); });
   // Frames delivered per second of the run: processed frames over the span of their exposures
@@ -321,6 +357,9 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   nlohmann::json other = registration_json(t, 1);
   other["method"] = s.main_silhouette ? "joint-balls (paper)" : "joint-balls + silhouette";
   reg["comparison"] = other;
+  reg["silhouette_loss"] = silhouette_loss_json(loss_fit, scored);
+  reg["silhouette_loss_on_ceiling_frames"] = silhouette_loss_json(loss_fit_ceiling_frames, ceiling.size());
+  const nlohmann::json ceiling_loss = silhouette_loss_json(loss_ceiling, ceiling.size());
   // The hands' sizes as the registration estimated them (its starting profile when not
   // personalised), beside ground_truth.hand_shape.
   if (!t.frames.empty()) {
@@ -436,6 +475,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                         {"model_ceiling_iou", mean(ceiling)},
                         {"model_ceiling_iou_p5", quantile(ceiling, 0.05)},
                         {"model_ceiling_frames", ceiling.size()},
+                        {"model_ceiling_loss", ceiling_loss},
                         {"joint_px_floor", mean(joint_floor)},
                         {"hand_shape", {{"length_m", s.user_length_m}, {"width_m", s.user_width_m}}}}},
       {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
@@ -474,6 +514,10 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << reg["iterations_mean"].get<double>() << " iterations\n"
      << "  model ceiling  IoU " << std::setprecision(3) << mean(ceiling)
      << " (the model's skin at the true pose with the user's sizes)\n"
+     << (ceiling.empty() ? std::string()
+                         : "  IoU lost       px per frame, left/right, on the ceiling's frames: fit " +
+                               silhouette_loss_line(reg["silhouette_loss_on_ceiling_frames"]) + "; ceiling " +
+                               silhouette_loss_line(ceiling_loss) + "\n")
      << by_phase_line(by_phase)
      << "  comparison     " << other["method"].get<std::string>() << ": IoU "
      << std::setprecision(3) << other["iou_mean"].get<double>() << ", fingertip "

@@ -42,11 +42,12 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     const std::uint8_t* id = result.virt.hand_id.ptr<std::uint8_t>(y);
     std::uint8_t* o = ws->model_mask.ptr<std::uint8_t>(y);
     for (int x = 0; x < ws->model_mask.cols; ++x) {
-      const render::HandId d = render::decode_hand_id(id[x]);
-      o[x] = id[x] != 0 && d.finger != render::kForearmPart && d.finger != render::kBraceletPart ? 255 : 0;
+      o[x] = is_hand_pixel(id[x]) ? 255 : 0;
     }
   }
   m.iou = registration::mask_iou(ws->model_mask, frame.hand_only);
+  if (auto st = silhouette_loss(result.virt.hand_id, frame.hand_only, frame.hand_index, &m.loss); !st)
+    return st.error();
   m.real_hand_pixels = cv::countNonZero(frame.hand_only);
   m.fitted_hand_pixels = cv::countNonZero(ws->model_mask);
 

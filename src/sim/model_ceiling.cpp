@@ -44,7 +44,8 @@ Result<std::unique_ptr<ModelCeiling>> ModelCeiling::create(render::Context& cont
 
 Result<double> ModelCeiling::iou(const std::array<hand::HandParams, 2>& truth,
                                  const cv::Mat& real_hand_only,
-                                 const std::array<std::optional<Vec3>, 2>& toward_elbow_W) {
+                                 const std::array<std::optional<Vec3>, 2>& toward_elbow_W,
+                                 const cv::Mat& real_hand_index, SilhouetteLoss* loss) {
   Impl& s = *impl_;
   if (real_hand_only.type() != CV_8UC1 || real_hand_only.cols != s.camera.width() ||
       real_hand_only.rows != s.camera.height())
@@ -68,10 +69,12 @@ Result<double> ModelCeiling::iou(const std::array<hand::HandParams, 2>& truth,
     const std::uint8_t* id = s.targets.hand_id.ptr<std::uint8_t>(y);
     std::uint8_t* o = s.model_mask.ptr<std::uint8_t>(y);
     for (int x = 0; x < s.model_mask.cols; ++x) {
-      const render::HandId d = render::decode_hand_id(id[x]);
-      o[x] = id[x] != 0 && d.finger != render::kForearmPart && d.finger != render::kBraceletPart ? 255 : 0;
+      o[x] = is_hand_pixel(id[x]) ? 255 : 0;
     }
   }
+  if (loss != nullptr)
+    if (auto st = silhouette_loss(s.targets.hand_id, real_hand_only, real_hand_index, loss); !st)
+      return Error{"model ceiling: " + st.error().message};
   return registration::mask_iou(s.model_mask, real_hand_only);
 }
 

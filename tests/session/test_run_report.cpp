@@ -64,5 +64,54 @@ TEST(RunReport, FramesWithoutAHandInViewAreLeftOutOfTheImagesFigures) {
   fs::remove_all(dir);
 }
 
+// Where the IoU is lost: per-frame means per hand over the scored frames, and like for like (the
+// fit and the ceiling) over the frames where the ceiling was measured.
+TEST(RunReport, TheIousLossIsAveragedPerHandAndPartBesideTheCeilings) {
+  MrTrace t;
+  auto loss = [](long missed_left, long spill_palm_right, long both) {
+    sim::SilhouetteLoss l;
+    l.missed = {missed_left, 0};
+    l.spill_palm = {0, spill_palm_right};
+    l.spill_digits = {5, 7};
+    l.both = both;
+    return l;
+  };
+  t.frames.push_back(frame(0.0, 0.8, 4.0, 900, 800, true, 0.9));
+  t.frames.back().truth[0].loss = loss(100, 40, 800);
+  t.frames.back().ceiling_loss = loss(60, 10, 850);
+  t.frames.push_back(frame(0.1, 0.7, 5.0, 900, 800, false, 0));
+  t.frames.back().truth[0].loss = loss(300, 80, 700);
+  t.frames.push_back(frame(0.2, 1.0, 0.0, 0, 0, true, 1.0));  // out of view: not scored
+  t.frames.back().truth[0].loss = loss(9999, 9999, 0);
+  MrSummary s;
+  s.seconds = s.wall_s = 0.3;
+  const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_loss_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ostringstream out;
+  write_mr_report(dir.string(), t, s, out);
+  std::ifstream in(dir / "report.json");
+  ASSERT_TRUE(in.good()) << out.str();
+  const auto j = nlohmann::json::parse(in);
+  const auto& all = j["registration"]["silhouette_loss"];
+  EXPECT_EQ(all["frames"].get<int>(), 2);
+  EXPECT_DOUBLE_EQ(all["left"]["missed_px"].get<double>(), 200.0);
+  EXPECT_DOUBLE_EQ(all["right"]["spill_palm_px"].get<double>(), 60.0);
+  EXPECT_DOUBLE_EQ(all["right"]["spill_digits_px"].get<double>(), 7.0);
+  EXPECT_DOUBLE_EQ(all["right"]["missed_px"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(all["iou_pooled"].get<double>(), 1500.0 / (1500.0 + 400 + 120 + 24));
+  const auto& same = j["registration"]["silhouette_loss_on_ceiling_frames"];
+  EXPECT_EQ(same["frames"].get<int>(), 1);
+  EXPECT_DOUBLE_EQ(same["left"]["missed_px"].get<double>(), 100.0);
+  const auto& ceiling = j["ground_truth"]["model_ceiling_loss"];
+  EXPECT_EQ(ceiling["frames"].get<int>(), 1);
+  EXPECT_DOUBLE_EQ(ceiling["left"]["missed_px"].get<double>(), 60.0);
+  EXPECT_DOUBLE_EQ(ceiling["right"]["spill_palm_px"].get<double>(), 10.0);
+  EXPECT_NE(out.str().find("fit missed 100/0, palm spill 0/40, digit spill 5/7; ceiling missed 60/0"),
+            std::string::npos)
+      << out.str();
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace spidar::session

@@ -38,6 +38,7 @@ struct TruthFrame {
   /// The model's skin at the true pose with the user's sizes vs the real silhouette
   /// (sim::ModelCeiling); measured on compared frames (ceiling_measured).
   double ceiling_iou = 0;
+  sim::SilhouetteLoss ceiling_loss;  ///< where the ceiling's skin and the real hands differ
   bool ceiling_measured = false;
   std::array<int, 2> iterations{};
   /// The registration's size estimates after this frame (left, right).

@@ -8,6 +8,7 @@
 #include "spidar/core/result.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
+#include "spidar/sim/silhouette_loss.hpp"
 #include "spidar/sim/synthetic_camera.hpp"
 #include "spidar/vision/camera.hpp"
 
@@ -22,6 +23,8 @@ struct FrameTruthMetrics {
   long real_hand_pixels = 0;
   long fitted_hand_pixels = 0;
   bool scored_in_image() const { return real_hand_pixels > 0 || fitted_hand_pixels > 0; }
+  /// Where the fitted hands' pixels and the real hands' differ, per hand and part (iou's loss).
+  SilhouetteLoss loss;
   std::array<double, 2> fingertip_mm{};  ///< mean fingertip cap error per hand [mm]
   std::array<double, 2> joint_px{};      ///< mean projected joint error per hand [px]
   /// The fitted wrist's depth (along the camera's optical axis) minus the true one per hand [mm]:

@@ -14,6 +14,7 @@
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/render/context.hpp"
 #include "spidar/render/hand_skin.hpp"
+#include "spidar/sim/silhouette_loss.hpp"
 #include "spidar/vision/camera.hpp"
 
 namespace spidar::sim {
@@ -32,8 +33,11 @@ class ModelCeiling {
   /// real palms and digits, no forearm or bracelet: SyntheticFrame::hand_only).
   /// `toward_elbow_W`: where the real forearms pointed (SyntheticFrame::toward_elbow_W); the
   /// model's forearms point there too (the elbow is part of the true pose).
+  /// With `loss`, also where the skin and the real hands differ, per hand and part, which needs
+  /// `real_hand_index` (SyntheticFrame::hand_index).
   Result<double> iou(const std::array<hand::HandParams, 2>& truth, const cv::Mat& real_hand_only,
-                     const std::array<std::optional<Vec3>, 2>& toward_elbow_W);
+                     const std::array<std::optional<Vec3>, 2>& toward_elbow_W,
+                     const cv::Mat& real_hand_index = cv::Mat(), SilhouetteLoss* loss = nullptr);
 
  private:
   struct Impl;

@@ -1,0 +1,38 @@
+#pragma once
+/// Where a drawn hand model's silhouette and the real hands' differ, per hand and per part: the
+/// IoU's loss taken apart, so that a run says which part of the gap to the ceiling is the palm's
+/// and which the digits', and which hand's (docs/measurements.md, 2026-11-28: the fit doubles the
+/// ceiling's palm spill while its digits spill no more than the ceiling's).
+#include <array>
+#include <cstdint>
+#include <opencv2/core/mat.hpp>
+
+#include "spidar/core/result.hpp"
+
+namespace spidar::sim {
+
+/// Whether a hand id (render::encode_hand_id) is a hand's palm or digit: not empty, not its
+/// forearm or bracelet (which the real hands' hand_only leaves out too).
+bool is_hand_pixel(std::uint8_t hand_id);
+
+/// Pixel counts of one frame [px]. With n_both the pixels both masks hold,
+/// IoU = n_both / (n_both + Σ missed + Σ spill_palm + Σ spill_digits).
+struct SilhouetteLoss {
+  std::array<long, 2> missed{};        ///< real hand h's palm and digits that no model hand covers
+  std::array<long, 2> spill_palm{};    ///< model hand h's palm off the real hands
+  std::array<long, 2> spill_digits{};  ///< model hand h's digits off the real hands
+  long both = 0;                       ///< real and model hand alike (either hand)
+  /// The frame's IoU from these counts (1 when neither mask holds a pixel, as mask_iou).
+  double iou() const;
+  SilhouetteLoss& operator+=(const SilhouetteLoss& o);
+};
+
+/// Counts the loss of a model drawn into `model_hand_id` (CV_8UC1, render::RenderTargets::hand_id:
+/// its forearm and bracelet parts are not the hand) against the real hands: `real_hand_only`
+/// (CV_8UC1, non-zero on the real palms and digits: SyntheticFrame::hand_only) and
+/// `real_hand_index` (CV_8UC1, 1 left, 2 right: SyntheticFrame::hand_index). Error naming the
+/// image if a type or size differs.
+Status silhouette_loss(const cv::Mat& model_hand_id, const cv::Mat& real_hand_only,
+                       const cv::Mat& real_hand_index, SilhouetteLoss* out);
+
+}  // namespace spidar::sim
