@@ -281,19 +281,27 @@ nlohmann::json silhouette_loss_json(const sim::SilhouetteLoss& sum, std::size_t 
   const double n = frames > 0 ? static_cast<double>(frames) : 1.0;
   nlohmann::json j = {{"frames", frames}, {"iou_pooled", sum.iou()}};
   for (int h = 0; h < 2; ++h)
-    j[h == 0 ? "left" : "right"] = {{"missed_px", static_cast<double>(sum.missed[h]) / n},
+    j[h == 0 ? "left" : "right"] = {{"missed_palm_px", static_cast<double>(sum.missed_palm[h]) / n},
+                                    {"missed_digits_px", static_cast<double>(sum.missed_digits[h]) / n},
                                     {"spill_palm_px", static_cast<double>(sum.spill_palm[h]) / n},
                                     {"spill_digits_px", static_cast<double>(sum.spill_digits[h]) / n}};
   return j;
 }
 
-/// "missed L/R, palm spill L/R, digit spill L/R" of a per-frame loss (silhouette_loss_json).
+/// "palm missed L/R, spilled L/R; digits missed L/R, spilled L/R" of a per-frame loss
+/// (silhouette_loss_json).
 std::string silhouette_loss_line(const nlohmann::json& j) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(0);
-  for (const char* k : {"missed_px", "spill_palm_px", "spill_digits_px"})
-    o << (k[0] == 'm' ? "missed " : k[6] == 'p' ? ", palm spill " : ", digit spill ") << j["left"][k].get<double>()
-      << "/" << j["right"][k].get<double>();
+  const auto pair = [&](const char* k) { o << j["left"][k].get<double>() << "/" << j["right"][k].get<double>(); };
+  o << "palm missed ";
+  pair("missed_palm_px");
+  o << ", spilled ";
+  pair("spill_palm_px");
+  o << "; digits missed ";
+  pair("missed_digits_px");
+  o << ", spilled ";
+  pair("spill_digits_px");
   return o.str();
 }
 
@@ -515,9 +523,9 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << "  model ceiling  IoU " << std::setprecision(3) << mean(ceiling)
      << " (the model's skin at the true pose with the user's sizes)\n"
      << (ceiling.empty() ? std::string()
-                         : "  IoU lost       px per frame, left/right, on the ceiling's frames: fit " +
-                               silhouette_loss_line(reg["silhouette_loss_on_ceiling_frames"]) + "; ceiling " +
-                               silhouette_loss_line(ceiling_loss) + "\n")
+                         : "  IoU lost       px per frame, left/right, on the ceiling's frames:\n"
+                           "                   fit      " + silhouette_loss_line(reg["silhouette_loss_on_ceiling_frames"]) +
+                           "\n                   ceiling  " + silhouette_loss_line(ceiling_loss) + "\n")
      << by_phase_line(by_phase)
      << "  comparison     " << other["method"].get<std::string>() << ": IoU "
      << std::setprecision(3) << other["iou_mean"].get<double>() << ", fingertip "

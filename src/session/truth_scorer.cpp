@@ -71,7 +71,7 @@ void TruthScorer::on_frame(const FrameEvent& e) {
     // Its own context, current here whatever else this thread renders (Session::step makes the
     // frame thread's current again before the next frame).
     if (auto st = context_->make_current(); !st) throw SpidarError("ground truth: " + st.error().message);
-    auto c = ceiling_->iou(filmed.truth, images.hand_only, images.toward_elbow_W, images.hand_index, &m.ceiling_loss);
+    auto c = ceiling_->iou(filmed.truth, images.hand_only, images.toward_elbow_W, images.hand_id, &m.ceiling_loss);
     if (!c) throw SpidarError(c.error().message);
     m.ceiling_iou = *c;
     m.ceiling_measured = true;

@@ -21,7 +21,8 @@ void copy_filmed_frame(const FilmedFrame& from, FilmedFrame* to) {
   to->t_script_s = from.t_script_s;
   for (auto [a, b] : {std::pair{&from.frame.bgr, &to->frame.bgr}, {&from.frame.mask, &to->frame.mask},
                       {&from.frame.hand_index, &to->frame.hand_index},
-                      {&from.frame.hand_only, &to->frame.hand_only}, {&from.frame.depth, &to->frame.depth}}) {
+                      {&from.frame.hand_only, &to->frame.hand_only}, {&from.frame.depth, &to->frame.depth},
+                      {&from.frame.hand_id, &to->frame.hand_id}}) {
     if (a->empty()) b->release();
     else a->copyTo(*b);
   }
@@ -205,7 +206,7 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
       writing->truth_images_ms = core::ns_to_s(core::monotonic_ns() - t_truth) * 1e3;
       if (!truth_status) {
         SyntheticFrame& f = writing->frame;
-        for (cv::Mat* m : {&f.mask, &f.hand_index, &f.hand_only, &f.depth}) m->release();
+        for (cv::Mat* m : {&f.mask, &f.hand_index, &f.hand_only, &f.depth, &f.hand_id}) m->release();
         error_ = truth_status.error().message;
       }
       writing->truth_images.set();

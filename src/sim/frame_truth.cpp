@@ -46,7 +46,7 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     }
   }
   m.iou = registration::mask_iou(ws->model_mask, frame.hand_only);
-  if (auto st = silhouette_loss(result.virt.hand_id, frame.hand_only, frame.hand_index, &m.loss); !st)
+  if (auto st = silhouette_loss(result.virt.hand_id, frame.hand_id, &m.loss); !st)
     return st.error();
   m.real_hand_pixels = cv::countNonZero(frame.hand_only);
   m.fitted_hand_pixels = cv::countNonZero(ws->model_mask);

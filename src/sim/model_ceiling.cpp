@@ -45,7 +45,7 @@ Result<std::unique_ptr<ModelCeiling>> ModelCeiling::create(render::Context& cont
 Result<double> ModelCeiling::iou(const std::array<hand::HandParams, 2>& truth,
                                  const cv::Mat& real_hand_only,
                                  const std::array<std::optional<Vec3>, 2>& toward_elbow_W,
-                                 const cv::Mat& real_hand_index, SilhouetteLoss* loss) {
+                                 const cv::Mat& real_hand_id, SilhouetteLoss* loss) {
   Impl& s = *impl_;
   if (real_hand_only.type() != CV_8UC1 || real_hand_only.cols != s.camera.width() ||
       real_hand_only.rows != s.camera.height())
@@ -73,7 +73,7 @@ Result<double> ModelCeiling::iou(const std::array<hand::HandParams, 2>& truth,
     }
   }
   if (loss != nullptr)
-    if (auto st = silhouette_loss(s.targets.hand_id, real_hand_only, real_hand_index, loss); !st)
+    if (auto st = silhouette_loss(s.targets.hand_id, real_hand_id, loss); !st)
       return Error{"model ceiling: " + st.error().message};
   return registration::mask_iou(s.model_mask, real_hand_only);
 }

@@ -254,6 +254,7 @@ Status SyntheticCamera::film_truth(SyntheticFrame* out) {
   cv::LUT(s.targets.hand_id, s.lut_index, out->hand_index);
   cv::LUT(s.targets.hand_id, s.lut_only, out->hand_only);
   s.targets.hand_depth.copyTo(out->depth);
+  s.targets.hand_id.copyTo(out->hand_id);
   return Ok{};
 }
 

@@ -53,6 +53,23 @@ TEST(SyntheticCamera, ChromaKeyRecoversTheGroundTruthMask) {
   EXPECT_EQ(cv::countNonZero(finite != frame.mask), 0);
   EXPECT_GT(cv::countNonZero(frame.hand_index == 1), 5000);
   EXPECT_GT(cv::countNonZero(frame.hand_index == 2), 5000);
+  // The part ids say the same: some palm and some digit of each hand, and hand_only is their palms
+  // and digits.
+  ASSERT_EQ(frame.hand_id.size(), frame.mask.size());
+  std::array<std::array<int, 2>, 2> palm_digit{};
+  for (int y = 0; y < frame.hand_id.rows; ++y)
+    for (int x = 0; x < frame.hand_id.cols; ++x) {
+      const std::uint8_t id = frame.hand_id.at<std::uint8_t>(y, x);
+      ASSERT_EQ(id != 0, frame.mask.at<std::uint8_t>(y, x) != 0) << x << "," << y;
+      const render::HandId d = render::decode_hand_id(id);
+      const bool own = id != 0 && d.finger != render::kForearmPart && d.finger != render::kBraceletPart;
+      ASSERT_EQ(own, frame.hand_only.at<std::uint8_t>(y, x) != 0) << x << "," << y;
+      if (own) ++palm_digit[static_cast<std::size_t>(d.hand)][d.finger == render::kPalmPart ? 0 : 1];
+    }
+  for (const auto& h : palm_digit) {
+    EXPECT_GT(h[0], 1000);
+    EXPECT_GT(h[1], 1000);
+  }
 }
 
 // A camera with a webcam's barrel lens films through it: its raw frame's key misses the ground
@@ -302,7 +319,8 @@ TEST(SyntheticCamera, TheImageAndItsGroundTruthCanBeFilmedApart) {
   EXPECT_TRUE(b.mask.empty());  // the image only
   EXPECT_EQ(cv::norm(a.bgr, b.bgr, cv::NORM_INF), 0.0);  // the same seed: the same noise
   ASSERT_TRUE(apart->film_truth(&b).ok());
-  for (auto [x, y] : {std::pair{&a.mask, &b.mask}, {&a.hand_index, &b.hand_index}, {&a.hand_only, &b.hand_only}}) {
+  for (auto [x, y] : {std::pair{&a.mask, &b.mask}, {&a.hand_index, &b.hand_index}, {&a.hand_only, &b.hand_only},
+                        {&a.hand_id, &b.hand_id}}) {
     ASSERT_EQ(x->size(), y->size());
     EXPECT_EQ(cv::countNonZero(*x != *y), 0);
   }

@@ -70,7 +70,8 @@ TEST(RunReport, TheIousLossIsAveragedPerHandAndPartBesideTheCeilings) {
   MrTrace t;
   auto loss = [](long missed_left, long spill_palm_right, long both) {
     sim::SilhouetteLoss l;
-    l.missed = {missed_left, 0};
+    l.missed_palm = {missed_left, 0};
+    l.missed_digits = {0, 3};
     l.spill_palm = {0, spill_palm_right};
     l.spill_digits = {5, 7};
     l.both = both;
@@ -95,19 +96,21 @@ TEST(RunReport, TheIousLossIsAveragedPerHandAndPartBesideTheCeilings) {
   const auto j = nlohmann::json::parse(in);
   const auto& all = j["registration"]["silhouette_loss"];
   EXPECT_EQ(all["frames"].get<int>(), 2);
-  EXPECT_DOUBLE_EQ(all["left"]["missed_px"].get<double>(), 200.0);
+  EXPECT_DOUBLE_EQ(all["left"]["missed_palm_px"].get<double>(), 200.0);
+  EXPECT_DOUBLE_EQ(all["right"]["missed_digits_px"].get<double>(), 3.0);
   EXPECT_DOUBLE_EQ(all["right"]["spill_palm_px"].get<double>(), 60.0);
   EXPECT_DOUBLE_EQ(all["right"]["spill_digits_px"].get<double>(), 7.0);
-  EXPECT_DOUBLE_EQ(all["right"]["missed_px"].get<double>(), 0.0);
-  EXPECT_DOUBLE_EQ(all["iou_pooled"].get<double>(), 1500.0 / (1500.0 + 400 + 120 + 24));
+  EXPECT_DOUBLE_EQ(all["right"]["missed_palm_px"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(all["iou_pooled"].get<double>(), 1500.0 / (1500.0 + 400 + 6 + 120 + 24));
   const auto& same = j["registration"]["silhouette_loss_on_ceiling_frames"];
   EXPECT_EQ(same["frames"].get<int>(), 1);
-  EXPECT_DOUBLE_EQ(same["left"]["missed_px"].get<double>(), 100.0);
+  EXPECT_DOUBLE_EQ(same["left"]["missed_palm_px"].get<double>(), 100.0);
   const auto& ceiling = j["ground_truth"]["model_ceiling_loss"];
   EXPECT_EQ(ceiling["frames"].get<int>(), 1);
-  EXPECT_DOUBLE_EQ(ceiling["left"]["missed_px"].get<double>(), 60.0);
+  EXPECT_DOUBLE_EQ(ceiling["left"]["missed_palm_px"].get<double>(), 60.0);
   EXPECT_DOUBLE_EQ(ceiling["right"]["spill_palm_px"].get<double>(), 10.0);
-  EXPECT_NE(out.str().find("fit missed 100/0, palm spill 0/40, digit spill 5/7; ceiling missed 60/0"),
+  EXPECT_NE(out.str().find("fit      palm missed 100/0, spilled 0/40; digits missed 0/3, spilled 5/7\n"
+                           "                   ceiling  palm missed 60/0, spilled 0/10"),
             std::string::npos)
       << out.str();
   fs::remove_all(dir);

@@ -32,7 +32,7 @@ struct FilmedFrame {
   std::int64_t t_exposure_ns = 0;  ///< host monotonic time of the exposure [ns]
   double t_script_s = 0;           ///< the scenario's time at the exposure [s]
   /// The image (frame.bgr, frame.toward_elbow_W) is complete when the frame is published; its
-  /// ground-truth images (frame.mask, hand_index, hand_only, depth) only once truth_images is
+  /// ground-truth images (frame.mask, hand_index, hand_only, depth, hand_id) only once truth_images is
   /// done: the camera thread reads them after publishing, off the frame's latency. Their readers
   /// wait first (wait_for_truth_images). Done by default: a frame made otherwise is complete.
   SyntheticFrame frame;

@@ -34,10 +34,10 @@ class ModelCeiling {
   /// `toward_elbow_W`: where the real forearms pointed (SyntheticFrame::toward_elbow_W); the
   /// model's forearms point there too (the elbow is part of the true pose).
   /// With `loss`, also where the skin and the real hands differ, per hand and part, which needs
-  /// `real_hand_index` (SyntheticFrame::hand_index).
+  /// `real_hand_id` (SyntheticFrame::hand_id).
   Result<double> iou(const std::array<hand::HandParams, 2>& truth, const cv::Mat& real_hand_only,
                      const std::array<std::optional<Vec3>, 2>& toward_elbow_W,
-                     const cv::Mat& real_hand_index = cv::Mat(), SilhouetteLoss* loss = nullptr);
+                     const cv::Mat& real_hand_id = cv::Mat(), SilhouetteLoss* loss = nullptr);
 
  private:
   struct Impl;

@@ -16,9 +16,10 @@ namespace spidar::sim {
 bool is_hand_pixel(std::uint8_t hand_id);
 
 /// Pixel counts of one frame [px]. With n_both the pixels both masks hold,
-/// IoU = n_both / (n_both + Σ missed + Σ spill_palm + Σ spill_digits).
+/// IoU = n_both / (n_both + Σ missed_palm + Σ missed_digits + Σ spill_palm + Σ spill_digits).
 struct SilhouetteLoss {
-  std::array<long, 2> missed{};        ///< real hand h's palm and digits that no model hand covers
+  std::array<long, 2> missed_palm{};    ///< real hand h's palm that no model hand covers
+  std::array<long, 2> missed_digits{};  ///< real hand h's digits (and nails) no model hand covers
   std::array<long, 2> spill_palm{};    ///< model hand h's palm off the real hands
   std::array<long, 2> spill_digits{};  ///< model hand h's digits off the real hands
   long both = 0;                       ///< real and model hand alike (either hand)
@@ -27,12 +28,10 @@ struct SilhouetteLoss {
   SilhouetteLoss& operator+=(const SilhouetteLoss& o);
 };
 
-/// Counts the loss of a model drawn into `model_hand_id` (CV_8UC1, render::RenderTargets::hand_id:
-/// its forearm and bracelet parts are not the hand) against the real hands: `real_hand_only`
-/// (CV_8UC1, non-zero on the real palms and digits: SyntheticFrame::hand_only) and
-/// `real_hand_index` (CV_8UC1, 1 left, 2 right: SyntheticFrame::hand_index). Error naming the
-/// image if a type or size differs.
-Status silhouette_loss(const cv::Mat& model_hand_id, const cv::Mat& real_hand_only,
-                       const cv::Mat& real_hand_index, SilhouetteLoss* out);
+/// Counts the loss of a model drawn into `model_hand_id` (CV_8UC1, render::RenderTargets::hand_id)
+/// against the real hands filmed into `real_hand_id` (CV_8UC1, SyntheticFrame::hand_id). On both,
+/// only palms and digits are the hand (is_hand_pixel). Error naming the image if a type or size
+/// differs.
+Status silhouette_loss(const cv::Mat& model_hand_id, const cv::Mat& real_hand_id, SilhouetteLoss* out);
 
 }  // namespace spidar::sim

@@ -56,6 +56,10 @@ struct SyntheticFrame {
   cv::Mat hand_only;   ///< CV_8UC1, 255 where the hand itself (palm, digits) is in front: no
                        ///< bracelet, no forearm (what a hand model should cover)
   cv::Mat depth;       ///< CV_32FC1 z_C [m] of the ground-truth surface; +inf on the screen
+  /// CV_8UC1, render::encode_hand_id of the part in front: the hand and its palm, digit (nails
+  /// count as their digit), bracelet or forearm; 0 on the screen (hand_index and hand_only are
+  /// made from it)
+  cv::Mat hand_id;
   /// Where each forearm (left, right) pointed, from the wrist toward the elbow (unit, world);
   /// unset where it was in line with the hand (no elbows given) or the hand was not filmed.
   std::array<std::optional<Vec3>, 2> toward_elbow_W;
@@ -88,7 +92,7 @@ class SyntheticCamera {
   /// left as they were). The ground truth of this film stays in the renderer for film_truth: a
   /// camera can hand the image over first and read its truth after (sim::CameraThread).
   Status film_image(const HandPoses& poses, SyntheticFrame* out, const HandPoses* previous = nullptr);
-  /// The ground-truth images of the last film_image (out->mask, hand_index, hand_only, depth).
+  /// The ground-truth images of the last film_image (out->mask, hand_index, hand_only, depth, hand_id).
   /// Error if there was none since the last film_truth, or the last film_image failed.
   Status film_truth(SyntheticFrame* out);
 
