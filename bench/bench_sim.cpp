@@ -1,4 +1,6 @@
-// The simulated user's per-frame cost: UserHands::update, the inverse kinematics that poses the
+// The simulated rig's per-frame costs. SilhouetteLoss640x480: the IoU's loss split by hand and
+// part, which the truth scorer counts two or three times a frame (the fit, the comparison and the
+// ceiling), on two hands' worth of pixels. UserHandsUpdate30fps: the simulated user's per-frame cost: UserHands::update, the inverse kinematics that poses the
 // truth hands on the device's caps before the synthetic camera films them (run on the camera
 // thread for every exposure, so it adds to the demo's latency). Measured over the whole script at
 // the camera's 30 fps, caps at the script's goals, as the camera thread calls it.
@@ -7,7 +9,12 @@
 #include <algorithm>
 #include <array>
 
+#include <opencv2/imgproc.hpp>
+
 #include "spidar/hand/hand_config.hpp"
+#include "spidar/render/hand_skin.hpp"
+#include "spidar/render/renderer.hpp"
+#include "spidar/sim/silhouette_loss.hpp"
 #include "spidar/sim/rubiks_task.hpp"
 #include "spidar/sim/user_hands.hpp"
 
@@ -52,6 +59,27 @@ void UserHandsUpdate30fps(benchmark::State& state) {
   state.counters["cap_residual_mm_max"] = residual_max;
 }
 BENCHMARK(UserHandsUpdate30fps)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+/// One iteration: one frame's loss, two hands (palm discs and digit bars) drawn a few pixels apart
+/// in the model's and the real image.
+void SilhouetteLoss640x480(benchmark::State& state) {
+  cv::Mat model(480, 640, CV_8UC1, cv::Scalar(0)), real(480, 640, CV_8UC1, cv::Scalar(0));
+  for (int h = 0; h < 2; ++h) {
+    const int x0 = 180 + 280 * h;
+    const auto palm = render::encode_hand_id(h, render::kPalmPart), digit = render::encode_hand_id(h, 1);
+    cv::circle(real, {x0, 300}, 70, palm, cv::FILLED);
+    cv::rectangle(real, cv::Rect(x0 - 60, 150, 120, 90), digit, cv::FILLED);
+    cv::circle(model, {x0 + 4, 303}, 72, palm, cv::FILLED);
+    cv::rectangle(model, cv::Rect(x0 - 55, 148, 112, 92), digit, cv::FILLED);
+  }
+  sim::SilhouetteLoss loss;
+  for (auto _ : state) {
+    if (!sim::silhouette_loss(model, real, &loss).ok()) state.SkipWithError("silhouette_loss failed");
+    benchmark::DoNotOptimize(loss);
+  }
+  state.counters["iou"] = loss.iou();
+}
+BENCHMARK(SilhouetteLoss640x480)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
