@@ -1,5 +1,6 @@
 #include "spidar/registration/metrics.hpp"
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -47,6 +48,16 @@ double fingertip_error_m(const hand::HandPoints& fitted, const hand::HandPoints&
     sum += (fitted.p_W_fingertip[i] - truth.p_W_fingertip[i]).norm();
   }
   return sum / hand::kFingertipCount;
+}
+
+Vec3 palm_rotation_error_rad(const hand::HandParams& fitted, const hand::HandParams& truth,
+                             hand::Side side) {
+  const Eigen::AngleAxisd aa(hand::hand_pose(truth).R.conjugate() * hand::hand_pose(fitted).R);
+  Vec3 w = aa.angle() * aa.axis();
+  // The left hand's body is mirrored in x (hand_pose): a rotation vector, a pseudovector, maps
+  // under that mirror M as w → det(M) M w = (w_x, −w_y, −w_z).
+  if (side == hand::Side::kLeft) w = Vec3(w.x(), -w.y(), -w.z());
+  return w;
 }
 
 }  // namespace spidar::registration

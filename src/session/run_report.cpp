@@ -65,8 +65,23 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
   std::vector<double> depth;  // both hands' wrists, |fit − truth| along the optical axis
   for (const MrFrame& m : t.frames)
     for (double d : m.truth[k].wrist_depth_mm) depth.push_back(std::abs(d));
+  // How each fitted palm is turned against the true one [deg] (FrameTruthMetrics::palm_rotation_deg):
+  // the angle, and the signed means of its three parts (a bias shows there).
+  nlohmann::json palm;
+  for (int h = 0; h < 2; ++h) {
+    const auto part = [&](int c) {
+      return mean(column(t, [k, h, c](const MrFrame& m) { return m.truth[k].palm_rotation_deg[h][c]; }));
+    };
+    const auto angle = column(t, [k, h](const MrFrame& m) { return m.truth[k].palm_rotation_deg[h].norm(); });
+    palm[h == 0 ? "left" : "right"] = {{"angle_mean", mean(angle)},
+                                       {"angle_p95", quantile(angle, 0.95)},
+                                       {"pitch_mean", part(0)},
+                                       {"roll_mean", part(1)},
+                                       {"turn_mean", part(2)}};
+  }
   return {{"iou_mean", mean(iou)},
           {"iou_p5", quantile(iou, 0.05)},
+          {"palm_rotation_deg", palm},
           {"joint_px_mean", mean(jp)},
           {"wrist_depth_mm_mean", mean(depth)},
           {"wrist_depth_mm_p95", quantile(depth, 0.95)},
@@ -140,7 +155,8 @@ void write_frames_csv(const std::string& path, const MrTrace& t, const std::vect
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
        "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou,"
        "length_mm_left,width_mm_left,length_mm_right,width_mm_right,dropped_before,joint_px_floor,"
-       "wrist_depth_mm_left,wrist_depth_mm_right,phase\n";
+       "wrist_depth_mm_left,wrist_depth_mm_right,palm_angle_deg_left,palm_roll_deg_left,"
+       "palm_angle_deg_right,palm_roll_deg_right,phase\n";
   f << std::setprecision(6);
   for (std::size_t i = 0; i < t.frames.size(); ++i) {
     const MrFrame& m = t.frames[i];
@@ -158,7 +174,9 @@ void write_frames_csv(const std::string& path, const MrTrace& t, const std::vect
     if (m.ceiling_measured) f << m.ceiling_iou;
     for (int h = 0; h < 2; ++h) f << ',' << 1e3 * m.shape[h].length_m << ',' << 1e3 * m.shape[h].width_m;
     f << ',' << m.dropped_before << ',' << 0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1]) << ','
-      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << ',' << (i < phases.size() ? phases[i] : "")
+      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << ',' << a.palm_rotation_deg[0].norm() << ','
+      << a.palm_rotation_deg[0].y() << ',' << a.palm_rotation_deg[1].norm() << ',' << a.palm_rotation_deg[1].y()
+      << ',' << (i < phases.size() ? phases[i] : "")
       << '\n';
   }
   core::write_file_atomic(path, f.str());

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "spidar/core/units.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/render_geometry.hpp"
 #include "spidar/registration/metrics.hpp"
@@ -30,6 +31,8 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     m.joint_px[h] = registration::joint_px_error(f, t, camera);
     m.wrist_depth_mm[h] = 1e3 * (camera.depth(hand::hand_pose(result.hands[h]).p) -
                                  camera.depth(hand::hand_pose(truth[h]).p));
+    m.palm_rotation_deg[h] =
+        registration::palm_rotation_error_rad(result.hands[h], truth[h], truth_models[h].side) * (180.0 / units::kPi);
     hand::HandParams coupled = truth[h];
     coupled.little_independent = false;
     m.joint_px_floor[h] =

@@ -30,6 +30,9 @@ struct FrameTruthMetrics {
   /// The fitted wrist's depth (along the camera's optical axis) minus the true one per hand [mm]:
   /// the direction the image and the bracelet's midpoint observe least; it decides occlusion.
   std::array<double, 2> wrist_depth_mm{};
+  /// How each fitted palm is turned against the true one [deg]: registration::palm_rotation_error_rad
+  /// (x pitched, y rolled, z turned in the palm's plane, in the hand's own axes).
+  std::array<Vec3, 2> palm_rotation_deg{};
   /// The paper's model's joint error floor per hand [px]: its skeleton with the user's true sizes
   /// at the true pose, with the little finger following the ring finger's (the paper's model has
   /// no parameters of their own for it; registration's little_free fits them, and can go below
