@@ -1,6 +1,7 @@
 #include "spidar/session/run_report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -65,6 +66,10 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
   std::vector<double> depth;  // both hands' wrists, |fit − truth| along the optical axis
   for (const MrFrame& m : t.frames)
     for (double d : m.truth[k].wrist_depth_mm) depth.push_back(std::abs(d));
+  std::vector<double> wrist_px;  // both hands' wrists in the image, where both are in front
+  for (const MrFrame& m : seen.frames)
+    for (double d : m.truth[k].wrist_px)
+      if (std::isfinite(d)) wrist_px.push_back(d);
   // How each fitted palm is turned against the true one [deg] (FrameTruthMetrics::palm_rotation_deg):
   // the angle, and the signed means of its three parts (a bias shows there).
   nlohmann::json palm;
@@ -84,6 +89,7 @@ nlohmann::json registration_json(const MrTrace& all, int k) {
           {"palm_rotation_deg", palm},
           {"joint_px_mean", mean(jp)},
           {"wrist_depth_mm_mean", mean(depth)},
+          {"wrist_px_mean", mean(wrist_px)},
           {"wrist_depth_mm_p95", quantile(depth, 0.95)},
           {"fingertip_mm_mean", mean(tip)},
           {"fingertip_mm_p95", quantile(tip, 0.95)},
@@ -155,7 +161,7 @@ void write_frames_csv(const std::string& path, const MrTrace& t, const std::vect
        "iterations_right,compared,iou_comparison,lift_mm,u_angle_deg,turns,servo_rate_hz,"
        "servo_jitter_max_us,cap_residual_mm_left,cap_residual_mm_right,model_ceiling_iou,"
        "length_mm_left,width_mm_left,length_mm_right,width_mm_right,dropped_before,joint_px_floor,"
-       "wrist_depth_mm_left,wrist_depth_mm_right,palm_angle_deg_left,palm_roll_deg_left,"
+       "wrist_depth_mm_left,wrist_depth_mm_right,wrist_px_left,wrist_px_right,palm_angle_deg_left,palm_roll_deg_left,"
        "palm_angle_deg_right,palm_roll_deg_right,phase\n";
   f << std::setprecision(6);
   for (std::size_t i = 0; i < t.frames.size(); ++i) {
@@ -174,7 +180,8 @@ void write_frames_csv(const std::string& path, const MrTrace& t, const std::vect
     if (m.ceiling_measured) f << m.ceiling_iou;
     for (int h = 0; h < 2; ++h) f << ',' << 1e3 * m.shape[h].length_m << ',' << 1e3 * m.shape[h].width_m;
     f << ',' << m.dropped_before << ',' << 0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1]) << ','
-      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << ',' << a.palm_rotation_deg[0].norm() << ','
+      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << ',' << a.wrist_px[0] << ',' << a.wrist_px[1] << ','
+      << a.palm_rotation_deg[0].norm() << ','
       << a.palm_rotation_deg[0].y() << ',' << a.palm_rotation_deg[1].norm() << ',' << a.palm_rotation_deg[1].y()
       << ',' << (i < phases.size() ? phases[i] : "")
       << '\n';

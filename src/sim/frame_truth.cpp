@@ -31,6 +31,12 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
     m.joint_px[h] = registration::joint_px_error(f, t, camera);
     m.wrist_depth_mm[h] = 1e3 * (camera.depth(hand::hand_pose(result.hands[h]).p) -
                                  camera.depth(hand::hand_pose(truth[h]).p));
+    {
+      const Vec3 w_f = hand::hand_pose(result.hands[h]).p, w_t = hand::hand_pose(truth[h]).p;
+      m.wrist_px[h] = camera.depth(w_f) > 0 && camera.depth(w_t) > 0
+                          ? (camera.project(w_f) - camera.project(w_t)).norm()
+                          : std::numeric_limits<double>::quiet_NaN();
+    }
     m.palm_rotation_deg[h] =
         registration::palm_rotation_error_rad(result.hands[h], truth[h], truth_models[h].side) * (180.0 / units::kPi);
     hand::HandParams coupled = truth[h];

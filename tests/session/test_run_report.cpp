@@ -3,6 +3,7 @@
 // out of the image's figures, said so, and counted.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -113,6 +114,29 @@ TEST(RunReport, TheIousLossIsAveragedPerHandAndPartBesideTheCeilings) {
                            "                   ceiling  palm missed 60/0, spilled 0/10"),
             std::string::npos)
       << out.str();
+  fs::remove_all(dir);
+}
+
+// The wrists' image error: both hands of the scored frames, a wrist behind the camera (NaN) left out.
+TEST(RunReport, TheWristsImageErrorIsAveragedOverTheWristsInView) {
+  MrTrace t;
+  t.frames.push_back(frame(0.0, 0.8, 4.0, 900, 800, false, 0));
+  t.frames.back().truth[0].wrist_px = {2.0, 4.0};
+  t.frames.push_back(frame(0.1, 0.8, 4.0, 900, 800, false, 0));
+  t.frames.back().truth[0].wrist_px = {std::nan(""), 9.0};
+  t.frames.push_back(frame(0.2, 1.0, 0.0, 0, 0, false, 0));  // out of view: not scored
+  t.frames.back().truth[0].wrist_px = {100.0, 100.0};
+  MrSummary s;
+  s.seconds = s.wall_s = 0.3;
+  const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_wrist_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ostringstream out;
+  write_mr_report(dir.string(), t, s, out);
+  std::ifstream in(dir / "report.json");
+  ASSERT_TRUE(in.good()) << out.str();
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_DOUBLE_EQ(j["registration"]["wrist_px_mean"].get<double>(), 5.0);
   fs::remove_all(dir);
 }
 

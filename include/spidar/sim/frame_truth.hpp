@@ -30,6 +30,9 @@ struct FrameTruthMetrics {
   /// The fitted wrist's depth (along the camera's optical axis) minus the true one per hand [mm]:
   /// the direction the image and the bracelet's midpoint observe least; it decides occlusion.
   std::array<double, 2> wrist_depth_mm{};
+  /// The fitted wrist's distance from the true one in the image, per hand [px] (NaN when either
+  /// is behind the camera): with wrist_depth_mm, where the wrist is wrong.
+  std::array<double, 2> wrist_px{};
   /// How each fitted palm is turned against the true one [deg]: registration::palm_rotation_error_rad
   /// (x pitched, y rolled, z turned in the palm's plane, in the hand's own axes).
   std::array<Vec3, 2> palm_rotation_deg{};
