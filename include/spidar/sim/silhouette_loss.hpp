@@ -1,8 +1,8 @@
 #pragma once
 /// Where a drawn hand model's silhouette and the real hands' differ, per hand and per part: the
 /// IoU's loss taken apart, so that a run says which part of the gap to the ceiling is the palm's
-/// and which the digits', and which hand's (docs/measurements.md, 2026-11-28: the fit doubles the
-/// ceiling's palm spill while its digits spill no more than the ceiling's).
+/// and which the digits', and which hand's (docs/measurements.md, 2026-11-28: with the true sizes
+/// the fitted palms' spill is the largest part of the fit's loss above the ceiling's).
 #include <array>
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
