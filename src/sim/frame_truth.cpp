@@ -45,7 +45,8 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
         registration::joint_px_error(hand::forward_kinematics(truth_models[h], coupled), t, camera);
   }
   // The fitted hands' own pixels, where no forearm of theirs is in front (the truth's hand_only
-  // mask is filmed without a scene, so scene occlusion does not enter either).
+  // mask is filmed without a scene, so scene occlusion does not enter either); the mask for
+  // callers that draw it (the registration study), the IoU and the pixel counts from the loss.
   ws->model_mask.create(result.virt.hand_id.size(), CV_8UC1);
   for (int y = 0; y < ws->model_mask.rows; ++y) {
     const std::uint8_t* id = result.virt.hand_id.ptr<std::uint8_t>(y);
@@ -54,11 +55,11 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
       o[x] = is_hand_pixel(id[x]) ? 255 : 0;
     }
   }
-  m.iou = registration::mask_iou(ws->model_mask, frame.hand_only);
   if (auto st = silhouette_loss(result.virt.hand_id, frame.hand_id, &m.loss); !st)
     return st.error();
-  m.real_hand_pixels = cv::countNonZero(frame.hand_only);
-  m.fitted_hand_pixels = cv::countNonZero(ws->model_mask);
+  m.iou = m.loss.iou();
+  m.real_hand_pixels = m.loss.real_pixels();
+  m.fitted_hand_pixels = m.loss.model_pixels();
 
   if (auto st = render::truth_composite_mask(frame.mask, frame.depth, result.virt.depth,
                                              &ws->truth_alpha);

@@ -21,6 +21,14 @@ double SilhouetteLoss::iou() const {
   return all > 0 ? static_cast<double>(both) / static_cast<double>(all) : 1.0;
 }
 
+long SilhouetteLoss::real_pixels() const {
+  return both + missed_palm[0] + missed_palm[1] + missed_digits[0] + missed_digits[1];
+}
+
+long SilhouetteLoss::model_pixels() const {
+  return both + spill_palm[0] + spill_palm[1] + spill_digits[0] + spill_digits[1];
+}
+
 SilhouetteLoss& SilhouetteLoss::operator+=(const SilhouetteLoss& o) {
   for (int h = 0; h < 2; ++h) {
     missed_palm[h] += o.missed_palm[h];

@@ -34,6 +34,23 @@ MrFrame frame(double t, double iou, double joints_px, long real_px, long fitted_
   return m;
 }
 
+/// Writes the report of `t` into a fresh directory named for `tag`, and returns its report.json
+/// (null if none was written) and the summary printed (into `*printed`).
+nlohmann::json report_of(const MrTrace& t, double seconds, const std::string& tag, std::string* printed) {
+  MrSummary s;
+  s.seconds = s.wall_s = seconds;
+  const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ostringstream out;
+  write_mr_report(dir.string(), t, s, out);
+  *printed = out.str();
+  std::ifstream in(dir / "report.json");
+  nlohmann::json j = in.good() ? nlohmann::json::parse(in) : nlohmann::json();
+  fs::remove_all(dir);
+  return j;
+}
+
 TEST(RunReport, FramesWithoutAHandInViewAreLeftOutOfTheImagesFigures) {
   MrTrace t;
   t.frames.push_back(frame(0.0, 0.8, 4.0, 900, 800, true, 0.9));
@@ -43,16 +60,9 @@ TEST(RunReport, FramesWithoutAHandInViewAreLeftOutOfTheImagesFigures) {
   // A fit drawn where no real hand is: a real failure, scored (IoU 0); the ceiling, whose model is
   // at the true pose, has nothing to cover and is left out.
   t.frames.push_back(frame(0.3, 0.0, 30.0, 0, 500, true, 1.0));
-  MrSummary s;
-  s.seconds = s.wall_s = 0.4;
-  const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ostringstream out;
-  write_mr_report(dir.string(), t, s, out);
-  std::ifstream in(dir / "report.json");
-  ASSERT_TRUE(in.good()) << out.str();
-  const auto j = nlohmann::json::parse(in);
+  std::string printed;
+  const auto j = report_of(t, 0.4, "images", &printed);
+  ASSERT_FALSE(j.is_null()) << printed;
   const auto& reg = j["registration"];
   EXPECT_EQ(reg["frames"].get<int>(), 4);
   EXPECT_EQ(reg["frames_scored_in_image"].get<int>(), 3);
@@ -61,8 +71,7 @@ TEST(RunReport, FramesWithoutAHandInViewAreLeftOutOfTheImagesFigures) {
   EXPECT_NEAR(reg["fingertip_mm_mean"].get<double>(), 0.5, 1e-12);  // the strings see every frame
   EXPECT_NEAR(j["ground_truth"]["model_ceiling_iou"].get<double>(), 0.9, 1e-12);
   EXPECT_EQ(j["ground_truth"]["model_ceiling_frames"].get<int>(), 1);
-  EXPECT_NE(out.str().find("out of the camera's view in 1 frames"), std::string::npos) << out.str();
-  fs::remove_all(dir);
+  EXPECT_NE(printed.find("out of the camera's view in 1 frames"), std::string::npos) << printed;
 }
 
 // Where the IoU is lost: per-frame means per hand over the scored frames, and like for like (the
@@ -85,16 +94,9 @@ TEST(RunReport, TheIousLossIsAveragedPerHandAndPartBesideTheCeilings) {
   t.frames.back().truth[0].loss = loss(300, 80, 700);
   t.frames.push_back(frame(0.2, 1.0, 0.0, 0, 0, true, 1.0));  // out of view: not scored
   t.frames.back().truth[0].loss = loss(9999, 9999, 0);
-  MrSummary s;
-  s.seconds = s.wall_s = 0.3;
-  const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_loss_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ostringstream out;
-  write_mr_report(dir.string(), t, s, out);
-  std::ifstream in(dir / "report.json");
-  ASSERT_TRUE(in.good()) << out.str();
-  const auto j = nlohmann::json::parse(in);
+  std::string printed;
+  const auto j = report_of(t, 0.3, "loss", &printed);
+  ASSERT_FALSE(j.is_null()) << printed;
   const auto& all = j["registration"]["silhouette_loss"];
   EXPECT_EQ(all["frames"].get<int>(), 2);
   EXPECT_DOUBLE_EQ(all["left"]["missed_palm_px"].get<double>(), 200.0);
@@ -110,11 +112,10 @@ TEST(RunReport, TheIousLossIsAveragedPerHandAndPartBesideTheCeilings) {
   EXPECT_EQ(ceiling["frames"].get<int>(), 1);
   EXPECT_DOUBLE_EQ(ceiling["left"]["missed_palm_px"].get<double>(), 60.0);
   EXPECT_DOUBLE_EQ(ceiling["right"]["spill_palm_px"].get<double>(), 10.0);
-  EXPECT_NE(out.str().find("fit      palm missed 100/0, spilled 0/40; digits missed 0/3, spilled 5/7\n"
+  EXPECT_NE(printed.find("fit      palm missed 100/0, spilled 0/40; digits missed 0/3, spilled 5/7\n"
                            "                   ceiling  palm missed 60/0, spilled 0/10"),
             std::string::npos)
-      << out.str();
-  fs::remove_all(dir);
+      << printed;
 }
 
 // The wrists' image error: both hands of the scored frames, a wrist behind the camera (NaN) left out.
@@ -126,18 +127,10 @@ TEST(RunReport, TheWristsImageErrorIsAveragedOverTheWristsInView) {
   t.frames.back().truth[0].wrist_px = {std::nan(""), 9.0};
   t.frames.push_back(frame(0.2, 1.0, 0.0, 0, 0, false, 0));  // out of view: not scored
   t.frames.back().truth[0].wrist_px = {100.0, 100.0};
-  MrSummary s;
-  s.seconds = s.wall_s = 0.3;
-  const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_wrist_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ostringstream out;
-  write_mr_report(dir.string(), t, s, out);
-  std::ifstream in(dir / "report.json");
-  ASSERT_TRUE(in.good()) << out.str();
-  const auto j = nlohmann::json::parse(in);
+  std::string printed;
+  const auto j = report_of(t, 0.3, "wrist", &printed);
+  ASSERT_FALSE(j.is_null()) << printed;
   EXPECT_DOUBLE_EQ(j["registration"]["wrist_px_mean"].get<double>(), 5.0);
-  fs::remove_all(dir);
 }
 
 }  // namespace

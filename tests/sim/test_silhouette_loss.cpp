@@ -86,6 +86,8 @@ TEST(SilhouetteLoss, ItsIouIsMaskIousOnRandomHands) {
     cv::Mat uncovered;
     cv::bitwise_and(hand_mask(real), ~hand_mask(model), uncovered);
     EXPECT_EQ(missed, cv::countNonZero(uncovered)) << "trial " << trial;
+    EXPECT_EQ(l.real_pixels(), cv::countNonZero(hand_mask(real))) << "trial " << trial;
+    EXPECT_EQ(l.model_pixels(), cv::countNonZero(hand_mask(model))) << "trial " << trial;
   }
 }
 

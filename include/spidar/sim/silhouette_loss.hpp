@@ -25,6 +25,8 @@ struct SilhouetteLoss {
   long both = 0;                       ///< real and model hand alike (either hand)
   /// The frame's IoU from these counts (1 when neither mask holds a pixel, as mask_iou).
   double iou() const;
+  long real_pixels() const;   ///< the real hands' palms and digits
+  long model_pixels() const;  ///< the model hands' palms and digits
   SilhouetteLoss& operator+=(const SilhouetteLoss& o);
 };
 
