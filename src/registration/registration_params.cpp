@@ -115,7 +115,7 @@ Status validate(const RegistrationParams& p) {
 RegistrationParams parse_registration_params(const core::ConfigNode& node) {
   if (!node.is_map()) node.fail("expected a map of registration settings");
   node.expect_keys({"fingertip_sigma_m", "wrist_sigma_px", "bracelet_offset_m",
-                    "bracelet_surface_shift", "bracelet_radius_per_width", "bracelet_standoff_m",
+                    "bracelet_surface_shift", "bracelet_detector_midpoint", "bracelet_radius_per_width", "bracelet_standoff_m",
                     "bracelet_depth_ratio", "bracelet_length_sigma", "bracelet_length_min_fill",
                     "bracelet_length_gate", "bracelet_length_tolerance", "bracelet_width_m",
                     "bracelet_thickness_sigma", "bracelet_thickness_tolerance",
@@ -147,6 +147,7 @@ RegistrationParams parse_registration_params(const core::ConfigNode& node) {
   if (auto b = node.find("silhouette_inward")) p.silhouette_inward = b->as_bool();
   if (auto b = node.find("little_free")) p.little_free = b->as_bool();
   if (auto b = node.find("forearm_from_band")) p.forearm_from_band = b->as_bool();
+  if (auto b = node.find("bracelet_detector_midpoint")) p.bracelet_detector_midpoint = b->as_bool();
   // Every field was range-checked at its key; this only guards against the table and the
   // struct drifting apart.
   if (auto s = validate(p); !s.ok()) node.fail(s.error().message);

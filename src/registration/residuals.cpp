@@ -1,6 +1,7 @@
 #include "spidar/registration/residuals.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "spidar/core/units.hpp"
+#include "spidar/hand/forearm.hpp"
 #include "spidar/registration/coverage.hpp"
 
 #include "residual_terms.hpp"
@@ -246,55 +248,127 @@ double bracelet_length_px(const Pose& X_WH, double hand_width_m, const vision::C
   return (camera.project(ends[1]) - camera.project(ends[0])).norm();
 }
 
-BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
-                                  const RegistrationParams& params, const Vec2& across_px, int samples_per_rim) {
+namespace {
+
+/// The band's near side sampled: both rims (bracelet_width_m apart along the forearm −y of
+/// X_WH, around bracelet_offset_m), `samples` points each, the section as in bracelet_band_ends;
+/// which face the camera (outward normal toward it) and their projections. false when a near
+/// point is behind the camera.
+struct BandNearSide {
+  static constexpr int kMaxSamples = 96;
+  int samples = 0;
+  std::array<std::array<Vec2, kMaxSamples>, 2> image{};
+  std::array<std::array<Vec3, kMaxSamples>, 2> point{};
+  std::array<std::array<bool, kMaxSamples>, 2> near{};
+  /// Whether the quad between samples k and k+1 of both rims is wholly on the near side.
+  bool quad(int k) const {
+    const int k1 = (k + 1) % samples;
+    return near[0][k] && near[0][k1] && near[1][k] && near[1][k1];
+  }
+};
+
+bool band_near_side(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                    const RegistrationParams& params, int samples_per_rim, BandNearSide* out) {
   const Mat3 R = X_WH.R.toRotationMatrix();
   const Vec3 x = R.col(0), z = R.col(2);  // across the forearm; y_H runs along it
   const auto [a, b] = band_section(params, hand_width_m);
   const Vec3 p_W_camera = camera.X_WC().p;
-  constexpr int kMaxSamples = 96;
-  const int samples = std::clamp(samples_per_rim, 8, kMaxSamples);
-  std::array<std::array<Vec2, kMaxSamples>, 2> image{};
-  std::array<std::array<bool, kMaxSamples>, 2> near{};
-  BandProfile out;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  out->samples = std::clamp(samples_per_rim, 8, BandNearSide::kMaxSamples);
   for (int r = 0; r < 2; ++r) {
     const double along = params.bracelet_offset_m + (r == 0 ? -0.5 : 0.5) * params.bracelet_width_m;
     const Vec3 rim_centre = X_WH * Vec3(0.0, -along, 0.0);
-    for (int k = 0; k < samples; ++k) {
-      const double phi = 2.0 * units::kPi * k / samples;
+    for (int k = 0; k < out->samples; ++k) {
+      const double phi = 2.0 * units::kPi * k / out->samples;
       const double c = std::cos(phi), sn = std::sin(phi);
       const Vec3 p = rim_centre + a * c * x + b * sn * z;
       const Vec3 outward = (c / a) * x + (sn / b) * z;  // the ellipse's normal (unnormalised)
-      near[r][k] = outward.dot(p_W_camera - p) > 0.0;  // else the far side
-      if (!near[r][k]) continue;
-      if (camera.depth(p) < detail::kMinImageDepth) return BandProfile{};
-      image[r][k] = camera.project(p);
-      const double u = image[r][k].dot(across_px);
-      if (u < lo) lo = u, out.ends[0] = p;
-      if (u > hi) hi = u, out.ends[1] = p;
+      out->near[r][k] = outward.dot(p_W_camera - p) > 0.0;  // else the far side
+      if (!out->near[r][k]) continue;
+      if (camera.depth(p) < detail::kMinImageDepth) return false;
+      out->point[r][k] = p;
+      out->image[r][k] = camera.project(p);
     }
   }
+  return true;
+}
+
+/// Calls f(p0, p1, p2) for the near side's triangles in the image (each patch between the rims
+/// seen once: the band is convex).
+template <class F>
+void for_each_near_triangle(const BandNearSide& n, F&& f) {
+  for (int k = 0; k < n.samples; ++k) {
+    if (!n.quad(k)) continue;
+    const int k1 = (k + 1) % n.samples;
+    f(n.image[0][k], n.image[0][k1], n.image[1][k1]);
+    f(n.image[0][k], n.image[1][k1], n.image[1][k]);
+  }
+}
+
+}  // namespace
+
+BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
+                                  const RegistrationParams& params, const Vec2& across_px, int samples_per_rim) {
+  BandNearSide n;
+  if (!band_near_side(X_WH, hand_width_m, camera, params, samples_per_rim, &n)) return BandProfile{};
+  BandProfile out;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int r = 0; r < 2; ++r)
+    for (int k = 0; k < n.samples; ++k) {
+      if (!n.near[r][k]) continue;
+      const double u = n.image[r][k].dot(across_px);
+      if (u < lo) lo = u, out.ends[0] = n.point[r][k];
+      if (u > hi) hi = u, out.ends[1] = n.point[r][k];
+    }
   if (!(hi > lo)) return BandProfile{};
-  // The near side's patches between the rims (each seen once: the band is convex), split into
-  // triangles: their areas and centroids along across_px.
+  // The near side's triangles: their areas and centroids along across_px.
   double area = 0, moment = 0;
-  auto triangle = [&](const Vec2& p0, const Vec2& p1, const Vec2& p2) {
+  for_each_near_triangle(n, [&](const Vec2& p0, const Vec2& p1, const Vec2& p2) {
     const Vec2 e1 = p1 - p0, e2 = p2 - p0;
     const double t = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
     area += t;
     moment += t * (p0 + p1 + p2).dot(across_px) / 3.0;
-  };
-  for (int k = 0; k < samples; ++k) {
-    const int k1 = (k + 1) % samples;
-    if (!(near[0][k] && near[0][k1] && near[1][k] && near[1][k1])) continue;
-    triangle(image[0][k], image[0][k1], image[1][k1]);
-    triangle(image[0][k], image[1][k1], image[1][k]);
-  }
+  });
   out.lo_px = lo;
   out.hi_px = hi;
   out.area_px = area;
   out.centroid_px = area > 0 ? moment / area : 0.5 * (lo + hi);
+  return out;
+}
+
+std::optional<Vec2> bracelet_midpoint_px(const Pose& X_WF, double hand_width_m, const vision::Camera& camera,
+                                         const RegistrationParams& params, int samples_per_rim) {
+  BandNearSide n;
+  if (!band_near_side(X_WF, hand_width_m, camera, params, samples_per_rim, &n)) return std::nullopt;
+  // The near side's area, centroid and second moments about the origin (a triangle's:
+  // A/12 (Σ vᵢvᵢᵀ + (Σ vᵢ)(Σ vᵢ)ᵀ)).
+  double area = 0;
+  Vec2 first = Vec2::Zero();
+  Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
+  for_each_near_triangle(n, [&](const Vec2& p0, const Vec2& p1, const Vec2& p2) {
+    const Vec2 e1 = p1 - p0, e2 = p2 - p0;
+    const double t = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    const Vec2 sum = p0 + p1 + p2;
+    area += t;
+    first += t * sum / 3.0;
+    second += (t / 12.0) * (p0 * p0.transpose() + p1 * p1.transpose() + p2 * p2.transpose() + sum * sum.transpose());
+  });
+  if (!(area > 1e-9)) return std::nullopt;
+  const Vec2 c = first / area;
+  const Eigen::Matrix2d cov = second / area - c * c.transpose();
+  // The major axis, as vision/bracelet.cpp takes it from the red pixels' moments.
+  const double angle = 0.5 * std::atan2(2.0 * cov(0, 1), cov(0, 0) - cov(1, 1));
+  const Vec2 axis(std::cos(angle), std::sin(angle));
+  double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
+  for (int r = 0; r < 2; ++r)
+    for (int k = 0; k < n.samples; ++k) {
+      if (!n.near[r][k]) continue;
+      const double t = (n.image[r][k] - c).dot(axis);
+      t_min = std::min(t_min, t);
+      t_max = std::max(t_max, t);
+    }
+  if (!(t_max > t_min)) return std::nullopt;
+  const Vec2 out = c + 0.5 * (t_min + t_max) * axis;
+  if (!out.allFinite()) return std::nullopt;
   return out;
 }
 
@@ -322,10 +396,22 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   detail::pose_state(*pr.model, q, false, &s);
   tg->bracelet_shift_W = Vec3::Zero();
   if (detail::wrist_observed(*pr.observation)) {
-    const Vec3 p = bracelet_visible_point(hand::hand_pose(q), pr.model->shape.dimensions.width,
-                                          camera.X_WC().p, *pr.params, &tg->bracelet_shift_W,
-                                          pr.observation->forearm_H);
+    const Pose X_WH = hand::hand_pose(q);
+    const double width = pr.model->shape.dimensions.width;
+    Vec3 p = bracelet_visible_point(X_WH, width, camera.X_WC().p, *pr.params, &tg->bracelet_shift_W,
+                                    pr.observation->forearm_H);
     tg->wrist_active = camera.depth(p) >= detail::kMinImageDepth;
+    if (tg->wrist_active && pr.params->bracelet_detector_midpoint) {
+      // The point at the visible point's depth that projects where the detector would put the
+      // band's midpoint: the shift, frozen, moves it with the band's centre.
+      const Mat3 R = X_WH.R.toRotationMatrix();
+      const Pose X_WF{Quat(hand::wrist_bend(R, R * pr.observation->forearm_H) * R).normalized(), X_WH.p};
+      if (const auto m = bracelet_midpoint_px(X_WF, width, camera, *pr.params)) {
+        const Vec3 centre = p - tg->bracelet_shift_W;
+        p = camera.unproject(*m, camera.depth(p));
+        tg->bracelet_shift_W = p - centre;
+      }
+    }
     const HandObservation& obs = *pr.observation;
     if (tg->wrist_active && pr.params->bracelet_length_sigma > 0 && std::isfinite(obs.wrist_length_px) &&
         obs.wrist_length_px > 0) {

@@ -38,6 +38,7 @@
 #include "source_path.hpp"
 #include "spidar/core/config.hpp"
 #include "spidar/hand/hand_config.hpp"
+#include "spidar/hand/forearm.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/pipeline/frame_pipeline.hpp"
 #include "spidar/registration/palm_breadth.hpp"
@@ -75,6 +76,7 @@ struct Args {
   bool section_widths = false;  ///< --section-widths: the digits' sections against the model's, at the truth
   double forearm_cap = 0;  ///< --forearm-cap D: the model skin's forearm_cap_depth (0..1]
   double forearm_breadth = 0;  ///< --forearm-breadth B: the model skin's forearm_breadth
+  bool model_bracelet = false;  ///< --model-bracelet: the model skin draws its bracelet
   std::vector<std::string> sets;  ///< --set key=value: a registration setting (registration.yaml)
   std::string dump_dir;  ///< --dump DIR: overlays of the frames whose IoU is below --dump-below
   double dump_below = 0.5;
@@ -133,6 +135,7 @@ int main(int argc, char** argv) {
     else if (k == "--section-widths") a.section_widths = true;
     else if (k == "--forearm-cap") a.forearm_cap = std::atof(next().c_str());
     else if (k == "--forearm-breadth") a.forearm_breadth = std::atof(next().c_str());
+    else if (k == "--model-bracelet") a.model_bracelet = true;
     else if (k == "--dump") a.dump_dir = next();
     else if (k == "--bending-wrists") a.bending_wrists = true;
     else if (k == "--oracle-forearm") a.oracle_forearm = true;
@@ -184,6 +187,7 @@ int main(int argc, char** argv) {
   render::HandSkinParams model_skin = pipeline::FramePipelineParams{}.model_skin;
   if (a.forearm_cap > 0) model_skin.forearm_cap_depth = a.forearm_cap;
   if (a.forearm_breadth > 0) model_skin.forearm_breadth = a.forearm_breadth;
+  if (a.model_bracelet) model_skin.bracelet = true;
   auto ceiling = sim::ModelCeiling::create(context, camera, truth_models, model_skin).value();
 
   // The ceiling's variants (--ceiling-scan): digit radii scaled, then the palm's fullness.
@@ -337,6 +341,7 @@ int main(int argc, char** argv) {
   sim::FrameTruthWorkspace ws;
   std::array<double, 6> brace_k{};
   std::vector<double> brace_term;
+  std::vector<double> brace_pred;  // the detector's midpoint predicted from the true band (bracelet_midpoint_px)
   std::array<double, 6> joint_part_sum{}, joint_floor_sum{}, joint_part_n{};  // wrist, thumb … little
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
@@ -582,6 +587,13 @@ int main(int argc, char** argv) {
       brace_term.push_back((det - camera.project(registration::bracelet_visible_point(
                                       X_WH, truth_models[h].shape.dimensions.width, camera.X_WC().p,
                                       p.registration, nullptr))).norm());
+      {
+        const Pose X_WF{Quat(hand::wrist_bend(X_WH.R.toRotationMatrix(), -axis) * X_WH.R.toRotationMatrix()).normalized(),
+                        X_WH.p};
+        if (const auto m = registration::bracelet_midpoint_px(X_WF, truth_models[h].shape.dimensions.width, camera,
+                                                              p.registration))
+          brace_pred.push_back((det - *m).norm());
+      }
       for (int k = 0; k < 6; ++k)
         brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
       ++brace_n;
@@ -842,6 +854,8 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 6; ++k) std::printf("  shift %.1f r: %.2f px\n", 0.2 * k, brace_k[k] / std::max(brace_n, 1));
   std::printf("  the wrist term's point at the true pose: %.2f px (p95 %.2f)\n", mean(brace_term),
               quantile(brace_term, 0.95));
+  std::printf("  the detector's midpoint predicted from the true band: %.2f px (p95 %.2f)\n", mean(brace_pred),
+              quantile(brace_pred, 0.95));
   if (!chord_ratio.empty()) {
     std::sort(chord_ratio.begin(), chord_ratio.end());
     auto q = [&](double f) { return chord_ratio[static_cast<std::size_t>(f * static_cast<double>(chord_ratio.size() - 1))]; };

@@ -53,6 +53,7 @@ TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
   EXPECT_EQ(p.fingertip_sigma_m, d.fingertip_sigma_m);
   EXPECT_EQ(p.wrist_sigma_px, d.wrist_sigma_px);
   EXPECT_EQ(p.bracelet_offset_m, d.bracelet_offset_m);
+  EXPECT_EQ(p.bracelet_detector_midpoint, d.bracelet_detector_midpoint);
   EXPECT_EQ(p.joint_ball_sigma_px, d.joint_ball_sigma_px);
   EXPECT_EQ(p.joint_ball_alpha, d.joint_ball_alpha);
   EXPECT_EQ(p.ball_radius_scale, d.ball_radius_scale);

@@ -31,6 +31,16 @@ struct RegistrationParams {
   /// the centre's projection, 3.8–3.9 px from the shifted point's at 0.4–0.6 r (2/π ≈ 0.64 would
   /// be a uniformly seen half ring's centroid; the detector takes the middle of the band's extent).
   double bracelet_surface_shift = 0.5;
+  /// The wrist term's expected midpoint from the detector's own rule instead of the shift above:
+  /// the band's near side projected (an ellipse section, bracelet_midpoint_px), the middle of its
+  /// extent along its major axis, its area's centroid across it, as vision/bracelet.cpp takes them
+  /// from the red pixels. With the simulated users' bending wrists (registration_study, default
+  /// user, true sizes, at the true pose): 3.8 px from the detected midpoint (p95 6.3), against
+  /// 6.5–7.0 px for the best constant shift (0.4–0.6 r) along the true forearm. Off: in the demo
+  /// (seeds 1–2) the fitted wrists came nearer the true ones in the image (5.8 / 5.6 → 4.3 / 4.2 px)
+  /// and the left palm's roll bias fell (+4.5 → +1.3°), but the palms' spill rose and the IoU fell
+  /// (0.872 / 0.873 → 0.863 / 0.870; docs/measurements.md, session 43).
+  bool bracelet_detector_midpoint = false;
   double bracelet_radius_per_width = 0.31;  ///< forearm radius at the band / palm width
   double bracelet_standoff_m = 0.002;        ///< how far the band stands off the skin [m]
   /// The forearm at the band is an ellipse, not a circle: its depth (back of the wrist to its

@@ -36,6 +36,7 @@
 /// visible-surface shift and the band's two ends, and each digit axis section's midpoint.
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "spidar/core/types.hpp"
@@ -185,6 +186,15 @@ struct BandProfile {
 BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
                                   const RegistrationParams& params, const Vec2& across_px,
                                   int samples_per_rim = 48);
+
+/// Where vision/bracelet.cpp's detector would put the band's midpoint (its projected wrist) [px]:
+/// the band's near side (as in bracelet_band_profile) for a forearm at pose `X_WF` (the forearm's
+/// frame: hand::wrist_bend applied to the hand's rotation, the band around its −y axis), its
+/// area's centroid and major axis in the image, and the midpoint of its extent along that axis,
+/// the centroid's place across it, as the detector takes them from the red pixels. nullopt when
+/// a near point is behind the camera or the near side has no area.
+std::optional<Vec2> bracelet_midpoint_px(const Pose& X_WF, double hand_width_m, const vision::Camera& camera,
+                                         const RegistrationParams& params, int samples_per_rim = 32);
 
 /// The band's thickness in the image for a hand at pose `X_WH`: the extent of its near side
 /// (bracelet_band_profile) along `across_px` (unit, image). `ends` (optional) receives the two points giving the extent (world).
