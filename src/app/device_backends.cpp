@@ -14,6 +14,11 @@ void add_backend_options(CLI::App& cmd, BackendArgs& a) {
   cmd.add_flag("!--no-link-check", a.check_link_budget,
                "serial: do not refuse a rate whose frames exceed the baud rate (a pseudo-terminal, "
                "or a transport faster than its baud setting)");
+  cmd.add_option("--read-timeout", a.read_timeout_s,
+                 "serial: seconds without a reading after which the device counts as lost (a read "
+                 "timeout fault)")
+      ->check(CLI::Range(1e-3, 10.0))
+      ->capture_default_str();
   cmd.add_option("--seed", a.seed, "sim: random seed")->check(seed_check())->capture_default_str();
 }
 

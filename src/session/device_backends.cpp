@@ -20,6 +20,7 @@ std::unique_ptr<device::Device> make_backend(const BackendArgs& a, const strings
   sc.port = a.port;
   sc.baud = a.baud;
   sc.check_link_budget = a.check_link_budget;
+  sc.read_timeout_s = a.read_timeout_s;
   sc.string_count = cfg.string_count();
   sc.counter_bits = cfg.counter_bits;
   sc.command_min = cfg.command_range().min;

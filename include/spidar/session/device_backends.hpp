@@ -15,6 +15,9 @@ struct BackendArgs {
   std::string port;             ///< serial: tty path
   int baud = 2000000;  ///< enough for 24 strings at 1 kHz (link_budget.hpp)
   bool check_link_budget = true;  ///< false: a pty or a transport faster than its baud setting
+  /// serial: the device is lost after this long without a reading [s] (SerialDeviceConfig::
+  /// read_timeout_s), > 0.
+  double read_timeout_s = 0.05;
   std::uint64_t seed = 1;
 };
 
