@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include "spidar/session/json_text.hpp"
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "device_backends.hpp"
@@ -158,7 +159,7 @@ Action add_calibrate_strings(CLI::App& app) {
     // read-only folder, a full disk), the result is on stdout and nothing is lost.
     report["dry_run"] = a->dry_run;
     require_finite_json(report, "calibrate-strings report");
-    std::cout << report.dump(2) << "\n" << std::flush;
+    std::cout << session::json_text(report, 2) << "\n" << std::flush;
     if (a->dry_run) return 0;
     try {
       const std::string backup = strings::write_device_config(path, text);

@@ -4,6 +4,7 @@
 #include <memory>
 #include <sstream>
 
+#include "spidar/session/json_text.hpp"
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "device_backends.hpp"
@@ -98,7 +99,7 @@ Action add_device_test(CLI::App& app) {
                           {"unexpected", l.unexpected},     {"decoder_errors", l.decoder.errors()}};
     }
     require_finite_json(j, "device-test report");
-    std::cout << j.dump(2) << "\n";
+    std::cout << session::json_text(j, 2) << "\n";
     return s.faults ? 1 : 0;
   };
 }

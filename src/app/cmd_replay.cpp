@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "spidar/session/json_text.hpp"
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "spidar/session/live_config.hpp"
@@ -97,7 +98,7 @@ Action add_replay(CLI::App& app) {
   return [a] {
     const std::string out = a->out.empty() ? (fs::path(a->dir) / "replay").string() : a->out;
     const auto j = replay_recording(a->dir, out, a->video);
-    std::cout << j.dump(2) << "\n";
+    std::cout << session::json_text(j, 2) << "\n";
     return 0;
   };
 }

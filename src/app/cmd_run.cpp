@@ -9,6 +9,7 @@
 #include <numeric>
 #include <thread>
 
+#include "spidar/session/json_text.hpp"
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "live_exit.hpp"
@@ -119,7 +120,7 @@ Action add_run(CLI::App& app) {
     session->stop();
     const auto j = summary_json(*session, ended_by, wall);
     require_finite_json(j, "run's summary");
-    std::cout << j.dump(2) << "\n";
+    std::cout << session::json_text(j, 2) << "\n";
     return live_exit_code(*session, ended_by);
   };
 }

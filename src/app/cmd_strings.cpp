@@ -5,6 +5,7 @@
 #include <memory>
 #include <sstream>
 
+#include "spidar/session/json_text.hpp"
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "spidar/core/config.hpp"
@@ -162,7 +163,7 @@ Action add_position(CLI::App& app) {
                         {"consistent", est->consistent},
                         {"residual", est->residual}};
     require_finite_json(j, "position output");
-    std::cout << j.dump() << "\n";
+    std::cout << session::json_text(j) << "\n";
     return 0;
   };
 }
@@ -199,7 +200,7 @@ Action add_tension(CLI::App& app) {
                         {"force", to_json(sol->f_displayed)},
                         {"reachable", sol->reachable}};
     require_finite_json(j, "tension output");
-    std::cout << j.dump() << "\n";
+    std::cout << session::json_text(j) << "\n";
     return 0;
   };
 }

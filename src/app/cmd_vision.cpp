@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "spidar/session/json_text.hpp"
 #include "cli_support.hpp"
 #include "spidar/core/file_write.hpp"
 #include "commands.hpp"
@@ -52,7 +53,7 @@ int extrinsics_only(const CalibrateCameraArgs& a, const std::string& base) {
                             {"extrinsics", extr},
                             {"camera_position", to_json(camera.X_WC().p)}};
   require_finite_json(j, "calibrate-camera output");
-  std::cout << j.dump() << "\n";
+  std::cout << session::json_text(j) << "\n";
   return 0;
 }
 
@@ -137,7 +138,7 @@ Action add_calibrate_camera(CLI::App& app) {
         {"extrinsics", extr},
         {"camera_position", to_json(p_WC)}};
     require_finite_json(j, "calibrate-camera output");
-    std::cout << j.dump() << "\n";
+    std::cout << session::json_text(j) << "\n";
     return 0;
   };
 }

@@ -33,6 +33,7 @@
 #include "spidar/strings/calibration.hpp"
 #include "spidar/strings/device_config_write.hpp"
 #include "spidar/strings/stability_check.hpp"
+#include "spidar/session/json_text.hpp"
 
 #ifndef GL_BGR
 #define GL_BGR 0x80E0
@@ -567,7 +568,7 @@ int run_gui(const session::LiveConfig& cfg, const session::LiveSessionOptions& o
     for (const session::HandControl& c : ih->controls())
       summary["hands"].push_back({{"offset_m", c.offset_W}, {"yaw_rad", c.yaw}, {"closeness", c.closeness}});
   }
-  std::cout << summary.dump() << "\n";
+  std::cout << session::json_text(summary) << "\n";
   return live_exit_code(*session, ended_by);
 }
 

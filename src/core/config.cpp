@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "spidar/core/file_read.hpp"
+#include "spidar/core/utf8.hpp"
 #include "yaml_checks.hpp"
 
 namespace spidar::core {
@@ -239,7 +240,13 @@ bool ConfigNode::as_bool() const {
 }
 
 std::string ConfigNode::as_string() const {
-  return scalar("expected a string");
+  const std::string& text = scalar("expected a string");
+  if (const auto bad = first_invalid_utf8(text)) {
+    char byte[8];
+    std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(text[*bad])));
+    fail("expected UTF-8 text, got byte " + std::string(byte) + " at offset " + std::to_string(*bad));
+  }
+  return text;
 }
 
 std::vector<double> ConfigNode::as_doubles() const {

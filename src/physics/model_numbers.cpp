@@ -3,6 +3,7 @@
 #include <mujoco/mjxmacro.h>
 
 #include <cmath>
+#include <sstream>
 #include <type_traits>
 
 namespace spidar::physics {
@@ -44,6 +45,33 @@ std::string first_non_finite_number(const mjModel* m) {
                  {"option viscosity", &m->opt.viscosity, 1}};
   for (const auto& o : options) {
     if (!all_finite(o.values, o.count, &bad)) return std::string(o.name) + "[" + std::to_string(bad) + "]";
+  }
+  return {};
+}
+
+std::string first_implausible_number(const mjModel* m) {
+  std::ostringstream os;
+  // A vector's components are named x, y, z; a single number has no index.
+  auto beyond = [&](const std::string& name, const mjtNum* values, int count, double bound, const char* unit) {
+    for (int i = 0; i < count; ++i) {
+      if (std::abs(values[i]) > bound) {
+        os << name << (count == 3 ? std::string(" ") + "xyz"[i] : std::string()) << " is " << values[i]
+           << "; expected at most " << bound << " " << unit << " in magnitude";
+        return true;
+      }
+    }
+    return false;
+  };
+  if (beyond("option gravity", m->opt.gravity, 3, 1e3, "m/s²") || beyond("option wind", m->opt.wind, 3, 1e3, "m/s") ||
+      beyond("option magnetic", m->opt.magnetic, 3, 1e3, "T") ||
+      beyond("option density", &m->opt.density, 1, 1e5, "kg/m³") ||
+      beyond("option viscosity", &m->opt.viscosity, 1, 1e5, "Pa·s"))
+    return os.str();
+  for (int b = 0; b < m->nbody; ++b) {
+    const char* name = mj_id2name(m, mjOBJ_BODY, b);
+    const std::string body = "body '" + (name ? std::string(name) : std::to_string(b)) + "'";
+    if (beyond(body + " mass", m->body_mass + b, 1, 1e6, "kg") || beyond(body + " pos", m->body_pos + 3 * b, 3, 1e3, "m"))
+      return os.str();
   }
   return {};
 }

@@ -12,4 +12,11 @@ namespace spidar::physics {
 /// finite. MuJoCo 2.2.2 compiles "nan" in an MJCF attribute without a word.
 std::string first_non_finite_number(const mjModel* m);
 
+/// The first of the physical options and bodies' numbers that is finite but beyond what any scene
+/// on a table can mean, so large that the simulation would overflow (a gravity of 1e308 turns the
+/// cube's state to nan): gravity, wind and magnetic field beyond 1000 (m/s², m/s, T) in any
+/// component, density or viscosity beyond 1e5, a body's mass beyond 1e6 kg or its position
+/// beyond 1000 m. A message naming the number, its value and the bound; empty if none.
+std::string first_implausible_number(const mjModel* m);
+
 }  // namespace spidar::physics

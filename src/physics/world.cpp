@@ -83,6 +83,10 @@ Result<std::unique_ptr<World>> World::Load(const std::string& scene_path, const 
     return Error{scene_path + ": the compiled scene has a non-finite number in " + bad +
                  " (a nan or inf in the MJCF?); expected finite numbers"};
   }
+  if (const std::string bad = first_implausible_number(m); !bad.empty()) {
+    mj_deleteModel(m);
+    return Error{scene_path + ": the compiled scene's " + bad};
+  }
   const double dt = m->opt.timestep;
   if (!(dt >= kMinTimestep && dt <= kMaxTimestep)) {
     mj_deleteModel(m);

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 
+#include "spidar/core/config.hpp"
 #include "spidar/core/file_read.hpp"
 #include "spidar/session/recording_reader.hpp"
 
@@ -125,6 +126,14 @@ double CsvCursor::number(std::size_t c) const {
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
   if (s.empty() || ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v))
     fail(c, "expected a finite number, got " + quote(s));
+  return v;
+}
+
+double CsvCursor::number(std::size_t c, double lo, double hi, std::string_view what) const {
+  const double v = number(c);
+  if (v < lo || v > hi)
+    fail(c, "expected " + std::string(what) + " from " + core::number_for_message(lo) + " to " +
+                core::number_for_message(hi) + ", got " + quote(text(c)));
   return v;
 }
 

@@ -37,6 +37,9 @@ class CsvCursor {
   std::uint64_t unsigned_integer(std::size_t c, std::uint64_t hi = std::numeric_limits<std::uint64_t>::max()) const;
   /// A finite floating-point number.
   double number(std::size_t c) const;
+  /// A finite number within [lo, hi]; fails naming `what` and the range otherwise (a value that
+  /// no recording can hold, such as 1e308 for a position, would overflow what is computed from it).
+  double number(std::size_t c, double lo, double hi, std::string_view what) const;
 
   /// Throws RecordingError at column `c` of the current row: `FILE:LINE:COL: NAME: what`.
   [[noreturn]] void fail(std::size_t c, const std::string& what) const;

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include "spidar/session/json_text.hpp"
 #include "spidar/session/data_path.hpp"
 #include "spidar/session/finite_json.hpp"
 #include "spidar/session/scenarios.hpp"
@@ -190,7 +191,7 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
         {"memory", physics_memory_json(ps.memory)}}},
       {"fingers", fingers}};
   require_finite_json(report, (fs::path(o.out) / "report.json").string());
-  core::write_file_atomic((fs::path(o.out) / "report.json").string(), report.dump(2) + "\n");
+  core::write_file_atomic((fs::path(o.out) / "report.json").string(), json_text(report, 2) + "\n");
   out << "wrote " << (fs::path(o.out) / "haptic_trace.csv").string() << " and "
             << (fs::path(o.out) / "report.json").string() << "\n";
   return ss;

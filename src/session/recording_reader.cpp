@@ -30,6 +30,15 @@ std::string location(const std::string& file, int line, int column) {
 
 std::string short_number(double v) { return core::number_for_message(v, 9); }
 
+// Bounds on what a recording's numbers can be (generous: they keep out values whose use would
+// overflow, such as 1e308, not unusual ones). Positions in the world [m], forces and tensions
+// [N], the fits' costs (dimensionless) and pose parameters (wrist position [m], rotation vector
+// and joint angles [rad]).
+constexpr double kMaxPosition_m = 100.0;
+constexpr double kMaxForce_N = 1e4;
+constexpr double kMaxCost = 1e12;
+constexpr double kMaxPoseParameter = 1e3;
+
 /// The sample columns of the current row (faults ... f7z).
 device::FingertipSample read_sample(const CsvCursor& c, int finger_count) {
   device::FingertipSample s;
@@ -43,8 +52,10 @@ device::FingertipSample read_sample(const CsvCursor& c, int finger_count) {
   const std::size_t p0 = c.col("p0x"), f0 = c.col("f0x");
   for (int f = 0; f < device::kMaxFingers; ++f)
     for (int k = 0; k < 3; ++k) {
-      s.p_W[f][k] = c.number(p0 + static_cast<std::size_t>(3 * f + k));
-      s.f_W[f][k] = c.number(f0 + static_cast<std::size_t>(3 * f + k));
+      s.p_W[f][k] = c.number(p0 + static_cast<std::size_t>(3 * f + k), -kMaxPosition_m, kMaxPosition_m,
+                             "a fingertip coordinate [m]");
+      s.f_W[f][k] = c.number(f0 + static_cast<std::size_t>(3 * f + k), -kMaxForce_N, kMaxForce_N,
+                             "a force component [N]");
     }
   return s;
 }
@@ -267,7 +278,7 @@ std::vector<device::FingertipSample> read_fingertips_csv(std::istream& in, const
       s.string_count = string_count;
       for (int i = 0; i < string_count; ++i) {
         const auto k = static_cast<std::size_t>(i);
-        s.tension[k] = c.number(tension0 + k);
+        s.tension[k] = c.number(tension0 + k, -kMaxForce_N, kMaxForce_N, "a string tension [N]");
         s.command[k] = static_cast<std::int32_t>(c.integer(motor0 + k, INT32_MIN, INT32_MAX));
       }
     }
@@ -333,7 +344,9 @@ std::vector<std::vector<Pose>> read_scene_csv(std::istream& in, const std::strin
       c.fail(shape, "expected shape " + std::to_string(poses.size()) + " (each frame lists its shapes 0, 1, 2, ...), got " +
                         std::to_string(s));
     Pose X;
-    X.p = Vec3(c.number(px), c.number(px + 1), c.number(px + 2));
+    X.p = Vec3(c.number(px, -kMaxPosition_m, kMaxPosition_m, "a position coordinate [m]"),
+               c.number(px + 1, -kMaxPosition_m, kMaxPosition_m, "a position coordinate [m]"),
+               c.number(px + 2, -kMaxPosition_m, kMaxPosition_m, "a position coordinate [m]"));
     const double w = c.number(qw), x = c.number(qw + 1), y = c.number(qw + 2), z = c.number(qw + 3);
     const double norm = std::sqrt(w * w + x * x + y * y + z * z);
     if (!(std::abs(norm - 1.0) <= kUnitQuaternionTolerance))
@@ -370,10 +383,11 @@ std::vector<FitRow> read_fits_csv(std::istream& in, const std::string& name) {
     for (std::size_t i = 0; i < r.terms.size(); ++i) numbers.push_back(term0 + i);
     for (std::size_t i = 0; i < r.q.size(); ++i) numbers.push_back(q0 + i);
     if (r.finite) {
-      r.cost_initial = c.number(cost0);
-      r.cost_final = c.number(cost1);
-      for (std::size_t i = 0; i < r.terms.size(); ++i) r.terms[i] = c.number(term0 + i);
-      for (std::size_t i = 0; i < r.q.size(); ++i) r.q[i] = c.number(q0 + i);
+      r.cost_initial = c.number(cost0, 0.0, kMaxCost, "a cost");
+      r.cost_final = c.number(cost1, 0.0, kMaxCost, "a cost");
+      for (std::size_t i = 0; i < r.terms.size(); ++i) r.terms[i] = c.number(term0 + i, 0.0, kMaxCost, "a cost");
+      for (std::size_t i = 0; i < r.q.size(); ++i)
+        r.q[i] = c.number(q0 + i, -kMaxPoseParameter, kMaxPoseParameter, "a pose parameter [m or rad]");
     } else {
       for (std::size_t k : numbers)
         if (!c.empty(k)) c.fail(k, "expected an empty field (finite is 0: the live fit was not finite)");

@@ -1,13 +1,38 @@
 #include "spidar/session/recording_rig.hpp"
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <string>
+#include <utility>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "spidar/core/clock.hpp"
 
 namespace spidar::session {
+namespace {
+
+/// The width and height [px] a PNG file declares (its signature, then the IHDR chunk's first two
+/// big-endian 32-bit fields); nullopt if the file is not a PNG or is too short.
+std::optional<std::pair<long, long>> png_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::array<unsigned char, 24> b{};
+  if (!in.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(b.size()))) return std::nullopt;
+  constexpr std::array<unsigned char, 8> kSignature{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  for (std::size_t i = 0; i < kSignature.size(); ++i)
+    if (b[i] != kSignature[i]) return std::nullopt;
+  if (b[12] != 'I' || b[13] != 'H' || b[14] != 'D' || b[15] != 'R') return std::nullopt;
+  auto be32 = [&](std::size_t o) {
+    return static_cast<long>((std::uint32_t{b[o]} << 24) | (std::uint32_t{b[o + 1]} << 16) |
+                             (std::uint32_t{b[o + 2]} << 8) | std::uint32_t{b[o + 3]});
+  };
+  return std::pair{be32(16), be32(20)};
+}
+
+}  // namespace
 
 /// The recorded frames in processing order, each taken as soon as asked for (no thread, no
 /// dropping: a replay fits every frame the live run fitted, warm-started from the same fit).
@@ -27,14 +52,30 @@ class RecordingRig::Source final : public FrameSource {
     while (next_ < rec_.frames.size()) {
       const std::size_t i = next_++;
       const FrameRow& f = rec_.frames[i];
+      std::string problem;
       if (video_) {
         auto fr = video_->read();
         image_ = fr ? fr->image : cv::Mat();
       } else {
-        image_ = cv::imread((std::filesystem::path(rec_.dir) / f.image).string(), cv::IMREAD_COLOR);
+        // The PNG's own size first: a damaged or foreign file declaring a huge image would
+        // otherwise be decoded into gigabytes before its size could be refused.
+        const std::string path = (std::filesystem::path(rec_.dir) / f.image).string();
+        const auto size = png_size(path);
+        if (size && (size->first != width_ || size->second != height_)) {
+          image_.release();
+          problem = "a PNG of " + std::to_string(size->first) + "x" + std::to_string(size->second) + " px";
+        } else {
+          image_ = cv::imread(path, cv::IMREAD_COLOR);
+        }
       }
-      if (image_.empty() || image_.cols != width_ || image_.rows != height_) {
-        ++decode_errors_;
+      if (problem.empty() && image_.empty()) problem = "no image decoded";
+      if (problem.empty() && (image_.cols != width_ || image_.rows != height_))
+        problem = "an image of " + std::to_string(image_.cols) + "x" + std::to_string(image_.rows) + " px";
+      if (!problem.empty()) {
+        if (decode_errors_++ == 0)
+          first_decode_error_ = "frame " + std::to_string(f.index) + (video_ ? "" : " (" + f.image + ")") + ": " +
+                                problem + ", expected a " + std::to_string(width_) + "x" + std::to_string(height_) +
+                                " px image";
         continue;
       }
       row_ = i;
@@ -57,6 +98,7 @@ class RecordingRig::Source final : public FrameSource {
 
   std::size_t row() const { return row_; }
   int decode_errors() const { return decode_errors_; }
+  const std::string& first_decode_error() const { return first_decode_error_; }
 
  private:
   const Recording& rec_;
@@ -66,6 +108,7 @@ class RecordingRig::Source final : public FrameSource {
   std::size_t next_ = 0, row_ = 0;
   std::uint64_t delivered_ = 0;
   int decode_errors_ = 0;
+  std::string first_decode_error_;
 };
 
 RecordingRig::RecordingRig(Recording recording, int width, int height)
@@ -81,5 +124,6 @@ device::Device& RecordingRig::device() {
 FrameSource& RecordingRig::camera() { return *source_; }
 std::size_t RecordingRig::row() const { return source_->row(); }
 int RecordingRig::decode_errors() const { return source_->decode_errors(); }
+const std::string& RecordingRig::first_decode_error() const { return source_->first_decode_error(); }
 
 }  // namespace spidar::session

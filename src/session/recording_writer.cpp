@@ -7,6 +7,7 @@
 
 #include "checked_file.hpp"
 #include "spidar/core/atomic_write.hpp"
+#include "spidar/session/json_text.hpp"
 
 namespace spidar::session {
 namespace {
@@ -139,7 +140,7 @@ void RecordingWriter::write_session_json(bool complete) const {
                  {"scene", counts_.scene},   {"fits", counts_.fits}};
     j["seconds"] = counts_.seconds;
   }
-  core::write_file_atomic((fs::path(dir_) / files::kSession).string(), j.dump(2) + "\n");
+  core::write_file_atomic((fs::path(dir_) / files::kSession).string(), json_text(j, 2) + "\n");
 }
 
 void RecordingWriter::set_frames_file(const std::string& file, const std::string& codec) {

@@ -10,6 +10,7 @@
 #include "spidar/render/video_output.hpp"
 #include "spidar/session/finite_json.hpp"
 #include "spidar/session/frame_stats.hpp"
+#include "spidar/session/json_text.hpp"
 
 namespace spidar::session {
 namespace {
@@ -98,6 +99,7 @@ nlohmann::json write_replay_report(const std::string& out, const RecordingRig& r
   j["frames"] = rec.frames.size();
   j["frames_replayed"] = f.t.size();
   j["decode_errors"] = rig.decode_errors();
+  if (!rig.first_decode_error().empty()) j["decode_error_first"] = rig.first_decode_error();
   j["recorded"] = {{"device_cycles", rec.device_rows},
                    {"fingertip_samples", rec.fingertips.size()},
                    {"seconds", rec.rows.seconds}};
@@ -157,7 +159,7 @@ nlohmann::json write_replay_report(const std::string& out, const RecordingRig& r
              {{"iterations", f.t, f.iterations, render::plot_colour(2)}});
   const std::string report = (fs::path(out) / "report.json").string();
   require_finite_json(j, report);
-  core::write_file_atomic(report, j.dump(2) + "\n");
+  core::write_file_atomic(report, json_text(j, 2) + "\n");
   return j;
 }
 

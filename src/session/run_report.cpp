@@ -15,6 +15,7 @@
 #include "spidar/render/video_output.hpp"
 #include "spidar/session/finite_json.hpp"
 #include "spidar/session/stats_json.hpp"
+#include "spidar/session/json_text.hpp"
 
 namespace spidar::session {
 namespace {
@@ -523,7 +524,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   report["haptic"]["force_max_n"] = forces;
   require_finite_json(report, (dir / "report.json").string());
   // Whole or not at all (a directory or unwritable path there is an error naming it, exit 2).
-  core::write_file_atomic((dir / "report.json").string(), report.dump(2) + "\n");
+  core::write_file_atomic((dir / "report.json").string(), json_text(report, 2) + "\n");
   write_frames_csv((dir / "frames.csv").string(), t, s.phases);
   if (frames > 1) write_plots(dir, t, s);
 

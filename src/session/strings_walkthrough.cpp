@@ -10,6 +10,7 @@
 #include <sstream>
 #include <random>
 
+#include "spidar/session/json_text.hpp"
 #include "spidar/session/data_path.hpp"
 #include "spidar/session/finite_json.hpp"
 #include "spidar/session/scenarios.hpp"
@@ -340,7 +341,7 @@ void run_strings_walkthrough(const ScenarioOptions& a, std::ostream& out) {
       {"fingers", fingers},
       {"solver_ns_per_fingertip", {{"position", pos_ns * per}, {"tension", ten_ns * per}}}};
   require_finite_json(report, (fs::path(a.out) / "report.json").string());
-  core::write_file_atomic((fs::path(a.out) / "report.json").string(), report.dump(2) + "\n");
+  core::write_file_atomic((fs::path(a.out) / "report.json").string(), json_text(report, 2) + "\n");
   out << "wrote " << (fs::path(a.out) / "walkthrough.csv").string() << " and "
             << (fs::path(a.out) / "report.json").string() << "\n";
 }

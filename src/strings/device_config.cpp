@@ -8,6 +8,10 @@
 namespace spidar::strings {
 namespace {
 
+/// An encoder's resolution [m per count]: from a nanometre to a centimetre.
+constexpr double kMinMetresPerCount = 1e-9;
+constexpr double kMaxMetresPerCount = 1e-2;
+
 std::vector<double> per_string(const core::ConfigNode& finger, std::string_view key, int n,
                                double fallback) {
   auto node = finger.find(key);
@@ -58,8 +62,11 @@ FingerConfig parse_finger(const core::ConfigNode& node, const DeviceConfig& dev,
     if (signs[i] != 1.0 && signs[i] != -1.0) {
       node["signs"].at(i).fail("expected +1 or -1");
     }
-    if (!(mpc[i] > 0.0 && mpc[i] < 1e-2)) {
-      node["metres_per_count"].at(i).fail("expected metres per count in (0, 0.01)");
+    // The same range as the encoder's default (parse_device_config), which a finger without its
+    // own values takes and which was checked at its own key.
+    if (!(mpc[i] >= kMinMetresPerCount && mpc[i] <= kMaxMetresPerCount)) {
+      node["metres_per_count"].at(i).fail("expected metres per count from 1e-09 to 0.01, got " +
+                                          core::number_for_message(mpc[i]));
     }
     f.channels.push_back({static_cast<int>(signs[i]), mpc[i], l0[i]});
   }
@@ -100,9 +107,10 @@ DeviceConfig parse_device_config(const core::ConfigNode& root) {
   const auto enc = root["encoder"];
   enc.expect_keys({"metres_per_count", "counter_bits"});
   const auto mpc_node = enc["metres_per_count"];
-  const double mpc = core::require_in_range(mpc_node, mpc_node.as_double(), 1e-9, 1e-2, "m");
-  dev.counter_bits = static_cast<int>(enc.get_int("counter_bits", 24));
-  if (dev.counter_bits < 8 || dev.counter_bits > 62) enc["counter_bits"].fail("expected 8..62");
+  const double mpc = core::require_in_range(mpc_node, mpc_node.as_double(), kMinMetresPerCount, kMaxMetresPerCount, "m");
+  const std::int64_t counter_bits = enc.get_int("counter_bits", 24);
+  if (counter_bits < 8 || counter_bits > 62) enc["counter_bits"].fail("expected 8..62, got " + std::to_string(counter_bits));
+  dev.counter_bits = static_cast<int>(counter_bits);
 
   const auto motor = root["motor"];
   motor.expect_keys({"pulley_radius", "torque_constant", "amplifier_gain", "dac_bits",
@@ -116,8 +124,9 @@ DeviceConfig parse_device_config(const core::ConfigNode& root) {
   dev.motor.pulley_radius = positive("pulley_radius");
   dev.motor.torque_constant = positive("torque_constant");
   dev.motor.amplifier_gain = positive("amplifier_gain");
-  dev.motor.dac_bits = static_cast<int>(motor["dac_bits"].as_int());
-  if (dev.motor.dac_bits < 1 || dev.motor.dac_bits > 24) motor["dac_bits"].fail("expected 1..24");
+  const std::int64_t dac_bits = motor["dac_bits"].as_int();
+  if (dac_bits < 1 || dac_bits > 24) motor["dac_bits"].fail("expected 1..24, got " + std::to_string(dac_bits));
+  dev.motor.dac_bits = static_cast<int>(dac_bits);
   dev.motor.dac_v_min = motor["dac_v_min"].as_double();
   dev.motor.dac_v_max = motor["dac_v_max"].as_double();
   if (!(dev.motor.dac_v_max > dev.motor.dac_v_min)) {

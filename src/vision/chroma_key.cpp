@@ -38,7 +38,10 @@ ChromaKeyParams parse_chroma_key_params(const core::ConfigNode& node) {
   p.s_background = node.get_double("s_background", p.s_background);
   p.dark_floor = node.get_double("dark_floor", p.dark_floor);
   p.silhouette_threshold = node.get_double("silhouette_threshold", p.silhouette_threshold);
-  p.cleanup_radius_px = static_cast<int>(std::clamp<std::int64_t>(node.get_int("cleanup_radius_px", p.cleanup_radius_px), -1, 11));
+  const std::int64_t cleanup = node.get_int("cleanup_radius_px", p.cleanup_radius_px);
+  if (cleanup < 0 || cleanup > 10)
+    node["cleanup_radius_px"].fail("expected 0..10, got " + std::to_string(cleanup));
+  p.cleanup_radius_px = static_cast<int>(cleanup);
   if (auto d = node.find("despill")) p.despill = d->as_bool();
   p.spill_limit = node.get_double("spill_limit", p.spill_limit);
   if (auto s = validate(p); !s.ok()) core::fail_at_named_key(node, s.error().message, "chroma key: ");

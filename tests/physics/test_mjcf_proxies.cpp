@@ -176,5 +176,30 @@ TEST(MjcfProxies, NonFiniteNumbersInTheSceneAreRefused) {
       << load_error(inf_gravity);
 }
 
+// Finite but far beyond any scene on a table: a gravity of 1e308 stepped the cube's state to nan,
+// and a cube of 1e30 kg turned its top layer 2348°.
+TEST(MjcfProxies, NumbersNoSceneCanMeanAreRefused) {
+  const auto dir = spidar::test::temp_dir("mjcf_huge");
+  const auto gravity = write(dir, "gravity.xml", "<mujoco><option gravity=\"0 0 -1e308\"/><worldbody/></mujoco>");
+  EXPECT_NE(load_error(gravity).find(gravity + ": the compiled scene's option gravity z is -1e+308; expected at most 1000 m/s"),
+            std::string::npos)
+      << load_error(gravity);
+  const auto mass = write(dir, "mass.xml",
+                          "<mujoco><worldbody><body name=\"cube\"><freejoint/>"
+                          "<geom type=\"box\" size=\"0.03 0.03 0.03\" mass=\"1e30\"/></body></worldbody></mujoco>");
+  EXPECT_NE(load_error(mass).find("the compiled scene's body 'cube' mass is 1e+30; expected at most 1e+06 kg"),
+            std::string::npos)
+      << load_error(mass);
+  const auto far = write(dir, "far.xml",
+                         "<mujoco><worldbody><body name=\"b\" pos=\"0 5e3 0\"><geom type=\"sphere\" size=\"0.1\"/>"
+                         "</body></worldbody></mujoco>");
+  EXPECT_NE(load_error(far).find("body 'b' pos y is 5000; expected at most 1000 m"), std::string::npos) << load_error(far);
+  // The shipped scenes are within every bound.
+  for (const char* scene : {"scenes/rubiks_cube.xml", "scenes/blocks.xml"}) {
+    const auto w = World::Load(std::string(SPIDAR_SOURCE_DIR) + "/" + scene);
+    EXPECT_TRUE(w.ok()) << scene << ": " << (w.ok() ? "" : w.error().message);
+  }
+}
+
 }  // namespace
 }  // namespace spidar::physics

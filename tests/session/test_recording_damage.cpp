@@ -81,6 +81,20 @@ TEST_F(Damage, NanInAFitMarkedFiniteIsRefused) {
   EXPECT_HAS(e, where("fits.csv", 2, col) + "q0: expected a finite number, got 'nan'");
 }
 
+// A finite number too large for what it is (1e308 for a position) would overflow what replay
+// computes from it (inf in its report): refused at its column with the range.
+TEST_F(Damage, AHugeFiniteNumberIsRefusedWithTheRange) {
+  const int col = set_field(dir_ / "fingertips.csv", 3, 6, "1e308");  // p0y
+  const std::string e = refusal();
+  EXPECT_HAS(e, where("fingertips.csv", 3, col) + "p0y: expected a fingertip coordinate [m] from -100 to 100, got '1e308'");
+}
+
+TEST_F(Damage, AHugePoseParameterInAFitIsRefused) {
+  const int col = set_field(dir_ / "fits.csv", 2, 12, "-1e300");  // q0 of frame 0, hand 0
+  const std::string e = refusal();
+  EXPECT_HAS(e, where("fits.csv", 2, col) + "q0: expected a pose parameter [m or rad] from -1000 to 1000, got '-1e300'");
+}
+
 TEST_F(Damage, AWrongHeaderIsNamed) {
   const int col = set_field(dir_ / "fingertips.csv", 1, 5, "p0_x");
   const std::string e = refusal();

@@ -47,6 +47,30 @@ TEST(RecordingRig, GivesEveryDecodableFrameInOrderWithItsRecordedInputs) {
   EXPECT_TRUE(cam.ended());
   EXPECT_EQ(cam.delivered(), 3u);
   EXPECT_EQ(rig.decode_errors(), 2);
+  EXPECT_EQ(rig.first_decode_error(), "frame 2 (" + t.frames[2].image + "): no image decoded, expected a 64x48 px image");
+}
+
+// A PNG that declares another size is refused from its header, before it is decoded (a damaged
+// file declaring 30000 x 30000 px would take gigabytes): the header alone is enough to name it.
+TEST(RecordingRig, APngOfAnotherSizeIsRefusedFromItsHeader) {
+  TempFolder d("recording_rig_header");
+  const fs::path dir = d.path() / "rec";
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, dir);
+  for (std::size_t i = 0; i < t.frames.size(); ++i)
+    ASSERT_TRUE(cv::imwrite((dir / t.frames[i].image).string(), cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(9))));
+  // Frame 1: a PNG signature and an IHDR chunk declaring 30000 x 30000 px, and nothing more.
+  const unsigned char header[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                  0, 0, 0x75, 0x30, 0, 0, 0x75, 0x30, 8, 2, 0, 0, 0};
+  spit(dir / t.frames[1].image, std::string(reinterpret_cast<const char*>(header), sizeof header));
+  RecordingRig rig(read_recording(dir.string()), 64, 48);
+  CameraFrame f;
+  std::vector<std::size_t> rows;
+  while (rig.camera().take(&f)) rows.push_back(rig.row());
+  EXPECT_EQ(rows.size(), t.frames.size() - 1);
+  EXPECT_EQ(rig.decode_errors(), 1);
+  EXPECT_EQ(rig.first_decode_error(),
+            "frame 1 (" + t.frames[1].image + "): a PNG of 30000x30000 px, expected a 64x48 px image");
 }
 
 }  // namespace

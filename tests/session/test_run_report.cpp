@@ -10,6 +10,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "spidar/session/json_text.hpp"
 #include "spidar/session/run_report.hpp"
 
 namespace spidar::session {
@@ -49,6 +50,19 @@ nlohmann::json report_of(const MrTrace& t, double seconds, const std::string& ta
   nlohmann::json j = in.good() ? nlohmann::json::parse(in) : nlohmann::json();
   fs::remove_all(dir);
   return j;
+}
+
+// Text that is not UTF-8 (a path from the command line) is written with U+FFFD for its bad bytes:
+// nlohmann's dump() would throw and lose a finished run's report.
+TEST(JsonText, BytesThatAreNotUtf8BecomeTheReplacementCharacter) {
+  nlohmann::json j;
+  j["out"] = std::string("/tmp/run\xFF\xFE");
+  j["device"] = "SPIDAR-8 \xC3\xA9";
+  EXPECT_THROW((void)j.dump(), nlohmann::json::type_error);
+  const std::string text = session::json_text(j);
+  EXPECT_EQ(text, "{\"device\":\"SPIDAR-8 \xC3\xA9\",\"out\":\"/tmp/run\xEF\xBF\xBD\xEF\xBF\xBD\"}");
+  EXPECT_EQ(nlohmann::json::parse(text)["device"], "SPIDAR-8 \xC3\xA9");
+  EXPECT_EQ(session::json_text(nlohmann::json{{"a", 1}}, 2), "{\n  \"a\": 1\n}");
 }
 
 TEST(RunReport, FramesWithoutAHandInViewAreLeftOutOfTheImagesFigures) {

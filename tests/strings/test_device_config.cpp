@@ -119,6 +119,21 @@ TEST(DeviceConfig, OtherMistakesGiveClearErrors) {
                 .find("motor.torque_constant: expected a positive number"),
             std::string::npos);
   EXPECT_NE(with("name: SPIDAR-G4\n", "").find("missing required key 'name'"), std::string::npos);
+  // Integers beyond int's range are refused as written, not wrapped into range (4294967320 is
+  // 24 + 2^32).
+  EXPECT_NE(with("counter_bits: 24", "counter_bits: 4294967320").find("encoder.counter_bits: expected 8..62, got 4294967320"),
+            std::string::npos);
+  EXPECT_NE(with("dac_bits: 12", "dac_bits: 4294967308").find("motor.dac_bits: expected 1..24, got 4294967308"),
+            std::string::npos);
+  // The encoder's resolution at the top of its range is taken, by the fingers too (it was refused
+  // at a finger's key it did not have); a finger's own value out of range is named at its key.
+  EXPECT_EQ(with("metres_per_count: 2.513e-5", "metres_per_count: 0.01"), "no error");
+  EXPECT_NE(with("  - name: grip\n", "  - name: grip\n    metres_per_count: [1e-5, 1e-5, 0.02, 1e-5]\n")
+                .find("fingers[0].metres_per_count[2]: expected metres per count from 1e-09 to 0.01, got 0.02"),
+            std::string::npos);
+  // A name that is not UTF-8 is refused where it is read (it would break the JSON written later).
+  EXPECT_NE(with("name: SPIDAR-G4", "name: SPIDAR\xFF").find("name: expected UTF-8 text, got byte 0xFF at offset 6"),
+            std::string::npos);
   std::string two = g4 + "  - name: grip\n    fulcrums: [[0, 0, 0.3], [0.2, 0, 0.3], [0, 0.2, 0.3]]\n";
   EXPECT_NE(parse_error(two).find("duplicate finger name 'grip'"), std::string::npos);
 }

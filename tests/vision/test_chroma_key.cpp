@@ -124,6 +124,15 @@ TEST(VisionConfig, ShippedFileHasTheDefaults) {
   } catch (const core::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("v.yaml:2: chroma_key"), std::string::npos) << e.what();
   }
+  // The cleanup radius is quoted as written, not as clamped for the check.
+  for (const char* radius : {"100", "1000000000", "-5"}) {
+    try {
+      parse_vision_config(core::ConfigNode::Parse(std::string("chroma_key:\n  cleanup_radius_px: ") + radius + "\n", "v.yaml"));
+      FAIL() << radius;
+    } catch (const core::ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), std::string("v.yaml:2: chroma_key.cleanup_radius_px: expected 0..10, got ") + radius);
+    }
+  }
   try {
     parse_vision_config(core::ConfigNode::Parse("bracelet:\n  hue_low: 3\n", "v.yaml"));
     FAIL();

@@ -32,6 +32,9 @@ class RecordingRig final : public Rig {
   std::size_t row() const;
   /// Frames skipped so far because their image did not decode or had another size.
   int decode_errors() const;
+  /// The first of them, with its file and what was wrong ("frame 10 (frames/000010.png): a PNG
+  /// of 30000x30000 px, expected a 640x480 px image"); empty if none.
+  const std::string& first_decode_error() const;
 
  private:
   class Source;
