@@ -153,6 +153,16 @@ std::string by_phase_line(const nlohmann::ordered_json& by_phase) {
   return line.str() + "\n";
 }
 
+/// A frames.csv cell: the number, or nothing where it is not defined (not finite: a hand out of
+/// view, a wrist behind the camera), as the other missing values are written.
+struct Cell {
+  double v;
+};
+std::ostream& operator<<(std::ostream& o, Cell c) {
+  if (std::isfinite(c.v)) o << c.v;
+  return o;
+}
+
 /// One row per processed frame: what the report's figures are computed from.
 void write_frames_csv(const std::string& path, const MrTrace& t, const std::vector<std::string>& phases) {
   std::ostringstream f;
@@ -168,22 +178,22 @@ void write_frames_csv(const std::string& path, const MrTrace& t, const std::vect
   for (std::size_t i = 0; i < t.frames.size(); ++i) {
     const MrFrame& m = t.frames[i];
     const auto& a = m.truth[0];
-    f << m.t_s << ',' << m.latency_ms << ',' << m.pipeline_ms << ',' << m.registration_ms << ','
-      << m.truth_ms << ',' << m.output_ms << ',' << m.film_ms << ',' << a.iou << ','
-      << 0.5 * (a.fingertip_mm[0] + a.fingertip_mm[1]) << ',' << a.joint_px[0] << ',' << a.joint_px[1]
-      << ',' << a.occlusion_pct << ',' << a.occlusion_pct_paper << ',' << a.contested_pixels << ','
-      << a.contested_pct() << ',' << a.contested_pct_paper() << ',' << m.iterations[0] << ','
-      << m.iterations[1] << ',' << (m.compared ? 1 : 0) << ',';
-    if (m.compared) f << m.truth[1].iou;
-    f << ',' << m.lift_mm << ',' << m.u_angle_deg << ',' << m.turns << ',' << m.servo_rate_hz << ','
-      << m.servo_jitter_max_us << ',' << m.truth_cap_residual_mm[0] << ','
-      << m.truth_cap_residual_mm[1] << ',';
-    if (m.ceiling_measured) f << m.ceiling_iou;
-    for (int h = 0; h < 2; ++h) f << ',' << 1e3 * m.shape[h].length_m << ',' << 1e3 * m.shape[h].width_m;
-    f << ',' << m.dropped_before << ',' << 0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1]) << ','
-      << a.wrist_depth_mm[0] << ',' << a.wrist_depth_mm[1] << ',' << a.wrist_px[0] << ',' << a.wrist_px[1] << ','
-      << a.palm_rotation_deg[0].norm() << ','
-      << a.palm_rotation_deg[0].y() << ',' << a.palm_rotation_deg[1].norm() << ',' << a.palm_rotation_deg[1].y()
+    f << Cell{m.t_s} << ',' << Cell{m.latency_ms} << ',' << Cell{m.pipeline_ms} << ',' << Cell{m.registration_ms}
+      << ',' << Cell{m.truth_ms} << ',' << Cell{m.output_ms} << ',' << Cell{m.film_ms} << ',' << Cell{a.iou} << ','
+      << Cell{0.5 * (a.fingertip_mm[0] + a.fingertip_mm[1])} << ',' << Cell{a.joint_px[0]} << ','
+      << Cell{a.joint_px[1]} << ',' << Cell{a.occlusion_pct} << ',' << Cell{a.occlusion_pct_paper} << ','
+      << a.contested_pixels << ',' << Cell{a.contested_pct()} << ',' << Cell{a.contested_pct_paper()} << ','
+      << m.iterations[0] << ',' << m.iterations[1] << ',' << (m.compared ? 1 : 0) << ',';
+    if (m.compared) f << Cell{m.truth[1].iou};
+    f << ',' << Cell{m.lift_mm} << ',' << Cell{m.u_angle_deg} << ',' << m.turns << ',' << Cell{m.servo_rate_hz} << ','
+      << Cell{m.servo_jitter_max_us} << ',' << Cell{m.truth_cap_residual_mm[0]} << ','
+      << Cell{m.truth_cap_residual_mm[1]} << ',';
+    if (m.ceiling_measured) f << Cell{m.ceiling_iou};
+    for (int h = 0; h < 2; ++h) f << ',' << Cell{1e3 * m.shape[h].length_m} << ',' << Cell{1e3 * m.shape[h].width_m};
+    f << ',' << m.dropped_before << ',' << Cell{0.5 * (a.joint_px_floor[0] + a.joint_px_floor[1])} << ','
+      << Cell{a.wrist_depth_mm[0]} << ',' << Cell{a.wrist_depth_mm[1]} << ',' << Cell{a.wrist_px[0]} << ','
+      << Cell{a.wrist_px[1]} << ',' << Cell{a.palm_rotation_deg[0].norm()} << ',' << Cell{a.palm_rotation_deg[0].y()}
+      << ',' << Cell{a.palm_rotation_deg[1].norm()} << ',' << Cell{a.palm_rotation_deg[1].y()}
       << ',' << (i < phases.size() ? phases[i] : "")
       << '\n';
   }

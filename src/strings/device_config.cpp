@@ -102,6 +102,7 @@ DeviceConfig parse_device_config(const core::ConfigNode& root) {
   DeviceConfig dev;
   dev.source = root.file();
   dev.name = root["name"].as_string();
+  if (dev.name.find_first_not_of(" \t") == std::string::npos) root["name"].fail("expected a non-empty device name");
   if (auto c = root.find("frame_centre")) dev.p_W_centre = c->as_vec3();
 
   const auto enc = root["encoder"];
@@ -127,8 +128,9 @@ DeviceConfig parse_device_config(const core::ConfigNode& root) {
   const std::int64_t dac_bits = motor["dac_bits"].as_int();
   if (dac_bits < 1 || dac_bits > 24) motor["dac_bits"].fail("expected 1..24, got " + std::to_string(dac_bits));
   dev.motor.dac_bits = static_cast<int>(dac_bits);
-  dev.motor.dac_v_min = motor["dac_v_min"].as_double();
-  dev.motor.dac_v_max = motor["dac_v_max"].as_double();
+  // A DAC's output range [V]: within ±1000 V, so that its span and the counts per volt are finite.
+  dev.motor.dac_v_min = core::require_in_range(motor["dac_v_min"], motor["dac_v_min"].as_double(), -1e3, 1e3, "V");
+  dev.motor.dac_v_max = core::require_in_range(motor["dac_v_max"], motor["dac_v_max"].as_double(), -1e3, 1e3, "V");
   if (!(dev.motor.dac_v_max > dev.motor.dac_v_min)) {
     motor["dac_v_max"].fail("expected dac_v_max > dac_v_min");
   }

@@ -54,6 +54,19 @@ TEST(Cli, CheckConfigSummarisesOrFailsWithCode2) {
   auto r = run("check-config " + bad);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(bad + ":3: chroma_key.dark_floor: expected 1..255, got 300"), std::string::npos) << r.err;
+  // A camera whose lens folds the image, refused as demo and run refuse it.
+  const std::string lens = spidar::test::temp_dir("spidar_check_config") + "/camera.yaml";
+  f = fopen(lens.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fputs("camera:\n  image_size: [640, 480]\n  fx: 554.256\n  fy: 554.256\n  cx: 319.5\n  cy: 239.5\n"
+        "  distortion: [-50, 0, 0, 0, 0]\n  pose:\n    position: [0, -0.25, 0.3]\n    look_at: [0, 0, 0]\n",
+        f);
+  fclose(f);
+  auto folded = run("check-config " + lens);
+  EXPECT_EQ(folded.code, 2) << folded.out;
+  EXPECT_NE(folded.err.find(lens + ": camera: lens distortion (k1 -50, k2 0, p1 0, p2 0, k3 0) folds the image"),
+            std::string::npos)
+      << folded.err;
 }
 
 TEST(Cli, PositionPrintsJsonThatRoundTrips) {

@@ -3,11 +3,13 @@
 // out of the image's figures, said so, and counted.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 #include <unistd.h>
 
 #include "spidar/session/json_text.hpp"
@@ -37,7 +39,8 @@ MrFrame frame(double t, double iou, double joints_px, long real_px, long fitted_
 
 /// Writes the report of `t` into a fresh directory named for `tag`, and returns its report.json
 /// (null if none was written) and the summary printed (into `*printed`).
-nlohmann::json report_of(const MrTrace& t, double seconds, const std::string& tag, std::string* printed) {
+nlohmann::json report_of(const MrTrace& t, double seconds, const std::string& tag, std::string* printed,
+                         std::string* frames_csv = nullptr) {
   MrSummary s;
   s.seconds = s.wall_s = seconds;
   const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_" + tag + "_" + std::to_string(::getpid()));
@@ -48,6 +51,12 @@ nlohmann::json report_of(const MrTrace& t, double seconds, const std::string& ta
   *printed = out.str();
   std::ifstream in(dir / "report.json");
   nlohmann::json j = in.good() ? nlohmann::json::parse(in) : nlohmann::json();
+  if (frames_csv) {
+    std::ifstream csv(dir / "frames.csv");
+    std::ostringstream text;
+    text << csv.rdbuf();
+    *frames_csv = text.str();
+  }
   fs::remove_all(dir);
   return j;
 }
@@ -141,10 +150,33 @@ TEST(RunReport, TheWristsImageErrorIsAveragedOverTheWristsInView) {
   t.frames.back().truth[0].wrist_px = {std::nan(""), 9.0};
   t.frames.push_back(frame(0.2, 1.0, 0.0, 0, 0, false, 0));  // out of view: not scored
   t.frames.back().truth[0].wrist_px = {100.0, 100.0};
-  std::string printed;
-  const auto j = report_of(t, 0.3, "wrist", &printed);
+  std::string printed, csv;
+  const auto j = report_of(t, 0.3, "wrist", &printed, &csv);
   ASSERT_FALSE(j.is_null()) << printed;
   EXPECT_DOUBLE_EQ(j["registration"]["wrist_px_mean"].get<double>(), 5.0);
+  // frames.csv leaves the wrist behind the camera empty, as its other missing values, not "nan".
+  EXPECT_EQ(csv.find("nan"), std::string::npos) << csv;
+  std::istringstream lines(csv);
+  std::string header, first, second;
+  std::getline(lines, header);
+  std::getline(lines, first);
+  std::getline(lines, second);
+  auto split = [](const std::string& line) {  // a CSV line's cells, the empty last one included
+    std::vector<std::string> cells(1);
+    for (char ch : line) {
+      if (ch == ',') cells.emplace_back();
+      else cells.back().push_back(ch);
+    }
+    return cells;
+  };
+  auto field = [&](const std::string& row, const std::string& head, const std::string& name) {
+    const auto names = split(head), cells = split(row);
+    const auto k = static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+    return k < cells.size() ? cells[k] : std::string("(no column)");
+  };
+  EXPECT_EQ(field(first, header, "wrist_px_left"), "2");
+  EXPECT_EQ(field(second, header, "wrist_px_left"), "");
+  EXPECT_EQ(field(second, header, "wrist_px_right"), "9");
 }
 
 }  // namespace

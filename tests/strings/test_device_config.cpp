@@ -131,6 +131,10 @@ TEST(DeviceConfig, OtherMistakesGiveClearErrors) {
   EXPECT_NE(with("  - name: grip\n", "  - name: grip\n    metres_per_count: [1e-5, 1e-5, 0.02, 1e-5]\n")
                 .find("fingers[0].metres_per_count[2]: expected metres per count from 1e-09 to 0.01, got 0.02"),
             std::string::npos);
+  EXPECT_NE(with("name: SPIDAR-G4", "name: \"\"").find("name: expected a non-empty device name"), std::string::npos);
+  // A DAC range whose span would overflow (1.7e308 − (−1.7e308)).
+  EXPECT_NE(with("dac_v_min: ", "dac_v_min: -1.7e308 #").find("motor.dac_v_min: expected a value in [-1000, 1000] V"),
+            std::string::npos);
   // A name that is not UTF-8 is refused where it is read (it would break the JSON written later).
   EXPECT_NE(with("name: SPIDAR-G4", "name: SPIDAR\xFF").find("name: expected UTF-8 text, got byte 0xFF at offset 6"),
             std::string::npos);
