@@ -590,9 +590,9 @@ int main(int argc, char** argv) {
       {
         const Pose X_WF{Quat(hand::wrist_bend(X_WH.R.toRotationMatrix(), -axis) * X_WH.R.toRotationMatrix()).normalized(),
                         X_WH.p};
-        if (const auto m = registration::bracelet_midpoint_px(X_WF, truth_models[h].shape.dimensions.width, camera,
-                                                              p.registration))
-          brace_pred.push_back((det - *m).norm());
+        if (const auto mid = registration::bracelet_midpoint_px(X_WF, truth_models[h].shape.dimensions.width, camera,
+                                                                p.registration))
+          brace_pred.push_back((det - *mid).norm());
       }
       for (int k = 0; k < 6; ++k)
         brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
