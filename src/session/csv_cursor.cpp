@@ -18,16 +18,21 @@ CsvCursor::CsvCursor(std::istream& in, std::string name, std::vector<std::string
                                " recording: " + quote(header_row(columns_));
   if (!read_line()) fail_line("empty file; " + expected, 1);
   ++line_;
+  // A UTF-8 byte-order mark (a spreadsheet's "CSV UTF-8") is not part of the first column's name.
+  if (line_text_.rfind("\xEF\xBB\xBF", 0) == 0) {
+    line_text_.erase(0, 3);
+    bom_ = 3;
+  }
   split();
   position_.assign(columns_.size(), SIZE_MAX);
   for (std::size_t i = 0; i < fields_.size(); ++i) {
     std::size_t k = 0;
     while (k < columns_.size() && columns_[k] != fields_[i]) ++k;
     if (k == columns_.size())
-      throw RecordingError(name_, line_, static_cast<int>(starts_[i] + 1),
+      throw RecordingError(name_, line_, static_cast<int>(bom_ + starts_[i] + 1),
                            "unknown column " + quote(fields_[i]) + "; " + expected);
     if (position_[k] != SIZE_MAX)
-      throw RecordingError(name_, line_, static_cast<int>(starts_[i] + 1),
+      throw RecordingError(name_, line_, static_cast<int>(bom_ + starts_[i] + 1),
                            "column " + quote(fields_[i]) + " appears twice; " + expected);
     position_[k] = i;
   }

@@ -63,6 +63,7 @@ class CsvCursor {
   bool line_ended_ = false;
   std::vector<std::string_view> fields_;
   std::vector<std::size_t> starts_;  ///< 0-based byte column of each field
+  std::size_t bom_ = 0;              ///< bytes of a byte-order mark before the header (0 or 3)
   int line_ = 0;
   bool has_optional_ = false;
 };

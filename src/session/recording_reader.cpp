@@ -493,9 +493,12 @@ Recording read_recording(const std::string& dir) {
     auto check_image = [&](std::size_t i, const std::string& image) -> std::string {
       if (r.meta.store != FrameStore::kPng)
         return image == std::to_string(i) ? "" : "expected video frame " + std::to_string(i);
-      if (!inside(d, image)) return "expected a path inside the recording folder (no '..', not absolute)";
+      if (!inside(d, image))
+        return "expected a path inside the recording folder (no '..', not absolute, no symbolic link leading out)";
       const std::string p = (d / image).string();
-      if (::stat(p.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return core::printable_for_message(p) + " is missing";
+      if (::stat(p.c_str(), &st) != 0) return core::printable_for_message(p) + " is missing";
+      if (S_ISDIR(st.st_mode)) return core::printable_for_message(p) + " is a directory, expected a PNG file";
+      if (!S_ISREG(st.st_mode)) return core::printable_for_message(p) + " is not a regular file, expected a PNG file";
       return "";
     };
     r.frames = read_frames_csv(in, frames_path, r.meta.finger_count, check_image);

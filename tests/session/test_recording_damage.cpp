@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include <sys/stat.h>
+
 #include "recording_test_support.hpp"
 #include "spidar/session/recording_reader.hpp"
 
@@ -163,6 +165,30 @@ TEST_F(Damage, AMissingImageIsNamed) {
   const std::string e = refusal();
   EXPECT_HAS(e, where("frames.csv", 4, column_of(lines_of(dir_ / "frames.csv")[3], 2)) + "image: ");
   EXPECT_HAS(e, "000002.png is missing");
+}
+
+// A spreadsheet's "CSV UTF-8" starts with a byte-order mark: not part of the first column's name.
+TEST(CsvWithAByteOrderMark, IsReadAsWithout) {
+  TempFolder tmp("csv_bom");
+  const fs::path dir = tmp.path() / "rec";
+  write_test_recording(make_test_recording(FrameStore::kPng), dir);
+  const Recording plain = read_recording(dir.string());
+  for (const char* file : {"frames.csv", "fingertips.csv", "fits.csv"})
+    spit(dir / file, "\xEF\xBB\xBF" + slurp(dir / file));
+  const Recording marked = read_recording(dir.string());
+  EXPECT_EQ(marked.frames.size(), plain.frames.size());
+  EXPECT_EQ(marked.fingertips.size(), plain.fingertips.size());
+  ASSERT_FALSE(marked.frames.empty());
+  EXPECT_EQ(marked.frames.back().measured.p_W[1][2], plain.frames.back().measured.p_W[1][2]);
+}
+
+TEST_F(Damage, ADirectoryOrAFifoInPlaceOfAnImageIsNamedForWhatItIs) {
+  fs::remove(dir_ / "frames/000002.png");
+  fs::create_directory(dir_ / "frames/000002.png");
+  EXPECT_HAS(refusal(), "000002.png is a directory, expected a PNG file");
+  fs::remove(dir_ / "frames/000002.png");
+  ASSERT_EQ(::mkfifo((dir_ / "frames/000002.png").c_str(), 0600), 0);
+  EXPECT_HAS(refusal(), "000002.png is not a regular file, expected a PNG file");
 }
 
 TEST_F(Damage, ARecordingWithoutItsCompletionMarkerIsIncomplete) {
