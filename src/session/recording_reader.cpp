@@ -64,9 +64,12 @@ device::FingertipSample read_sample(const CsvCursor& c, int finger_count) {
 
 class JsonKeys {
  public:
-  JsonKeys(const json& j, const std::string& name) : j_(j), name_(name) {}
+  /// `prefix`: the object's own path for nested keys ("rows."), so that a message names
+  /// "rows.frames", not a "frames" that could be the top level's.
+  JsonKeys(const json& j, const std::string& name, std::string prefix = "")
+      : j_(j), name_(name), prefix_(std::move(prefix)) {}
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw RecordingError(name_, 0, 0, "key \"" + key + "\": " + what);
+    throw RecordingError(name_, 0, 0, "key \"" + prefix_ + key + "\": " + what);
   }
   const json& at(const std::string& key) const {
     const auto it = j_.find(key);
@@ -95,6 +98,7 @@ class JsonKeys {
  private:
   const json& j_;
   const std::string& name_;
+  std::string prefix_;
 };
 
 /// A file name inside the folder: no separator, not "." or "..", not empty.
@@ -218,7 +222,7 @@ SessionJson parse_session_json(std::string_view text, const std::string& name) {
   if (s.complete) {
     const json& rows = k.at("rows");
     if (!rows.is_object()) k.fail("rows", "expected an object of row counts");
-    const JsonKeys r(rows, name);
+    const JsonKeys r(rows, name, "rows.");
     constexpr std::int64_t kMaxRows = std::int64_t{1} << 50;
     s.rows.device = static_cast<std::uint64_t>(r.integer("device", 0, kMaxRows));
     s.rows.fingertips = static_cast<std::uint64_t>(r.integer("fingertips", 0, kMaxRows));

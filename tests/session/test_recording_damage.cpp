@@ -104,6 +104,17 @@ TEST_F(Damage, AWrongHeaderIsNamed) {
   EXPECT_HAS(e, "version-2 recording");
 }
 
+TEST_F(Damage, ANestedKeyIsNamedWithItsPath) {
+  std::string text = slurp(dir_ / "session.json");
+  const auto rows = text.find("\"rows\"");
+  ASSERT_NE(rows, std::string::npos);
+  const auto frames = text.find("\"frames\":", rows);
+  ASSERT_NE(frames, std::string::npos);
+  text.replace(frames, 9, "\"frames\": 1e18, \"was\":");
+  spit(dir_ / "session.json", text);
+  EXPECT_HAS(refusal(), (dir_ / "session.json").string() + ": key \"rows.frames\": expected an integer");
+}
+
 TEST_F(Damage, AnotherVersionIsRefusedSayingWhichOne) {
   std::string text = slurp(dir_ / "session.json");
   text.replace(text.find("\"version\": 2"), 12, "\"version\": 1");
