@@ -45,7 +45,11 @@ std::string status_line(const MrFrame& m, const sim::RubiksTask& task) {
   std::ostringstream st;
   st << std::fixed << std::setprecision(1) << "t " << m.t_s << " s  "
      << std::left << std::setw(24) << task.phase(m.t_s) << std::right
-     << std::setprecision(3) << " IoU " << m.truth[0].iou << std::setprecision(1)
+     << std::setprecision(3) << " IoU ";
+  // No hand in view: no IoU to show (1 by definition for two empty silhouettes).
+  if (m.truth[0].scored_in_image()) st << m.truth[0].iou;
+  else st << "n/a  ";
+  st << std::setprecision(1)
      << "  tip " << 0.5 * (m.truth[0].fingertip_mm[0] + m.truth[0].fingertip_mm[1])
      << " mm  occlusion " << m.truth[0].occlusion_pct << " % (paper "
      << m.truth[0].occlusion_pct_paper << " %)  layer " << m.u_angle_deg << " deg";

@@ -30,6 +30,13 @@ double quantile(std::vector<double> v, double q) {
   const double f = pos - static_cast<double>(i);
   return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
 }
+/// `v` with `decimals` digits after the point.
+std::string number_text(double v, int decimals) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(decimals) << v;
+  return o.str();
+}
+
 double mean(const std::vector<double>& v) {
   double s = 0;
   for (double x : v) s += x;
@@ -550,10 +557,13 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                    std::to_string(reg["frames_scored_in_image"].get<std::size_t>()) +
                    " (frames_scored_in_image); check the camera's pose and the scene\n"
              : std::string())
-     << "  registration   IoU mean " << reg["iou_mean"].get<double>() << " (p5 "
-     << reg["iou_p5"].get<double>() << "), fingertip " << std::setprecision(2)
-     << reg["fingertip_mm_mean"].get<double>() << " mm, joints " << reg["joint_px_mean"].get<double>()
-     << " px, wrist depth " << std::setprecision(1) << reg["wrist_depth_mm_mean"].get<double>() << " mm, "
+     << "  registration   "
+     << (reg["frames_scored_in_image"].get<std::size_t>() == 0
+             ? std::string("IoU n/a, joints n/a (no hand in view in any frame)")
+             : "IoU mean " + number_text(reg["iou_mean"].get<double>(), 3) + " (p5 " +
+                   number_text(reg["iou_p5"].get<double>(), 3) + "), joints " +
+                   number_text(reg["joint_px_mean"].get<double>(), 2) + " px")
+     << ", fingertip " << std::setprecision(2) << reg["fingertip_mm_mean"].get<double>() << " mm, wrist depth " << std::setprecision(1) << reg["wrist_depth_mm_mean"].get<double>() << " mm, "
      << std::setprecision(2) << reg["ms_per_frame_median"].get<double>() << " ms/frame (both hands), "
      << reg["iterations_mean"].get<double>() << " iterations\n"
      << "  model ceiling  IoU " << std::setprecision(3) << mean(ceiling)

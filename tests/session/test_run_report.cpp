@@ -141,6 +141,21 @@ TEST(RunReport, TheIousLossIsAveragedPerHandAndPartBesideTheCeilings) {
       << printed;
 }
 
+// No hand in view in any frame (a camera turned away): the summary says so instead of an IoU of
+// an empty set of frames (it printed "IoU mean 0.000", "joints 0.00 px").
+TEST(RunReport, NoHandInViewIsSaidInsteadOfAnIou) {
+  MrTrace t;
+  for (int i = 0; i < 3; ++i) t.frames.push_back(frame(0.1 * i, 1.0, 0.0, 0, 0, false, 0));
+  std::string printed;
+  const auto j = report_of(t, 0.3, "none_in_view", &printed);
+  ASSERT_FALSE(j.is_null()) << printed;
+  EXPECT_EQ(j["registration"]["frames_scored_in_image"].get<int>(), 0);
+  EXPECT_NE(printed.find("registration   IoU n/a, joints n/a (no hand in view in any frame), fingertip"),
+            std::string::npos)
+      << printed;
+  EXPECT_EQ(printed.find("IoU mean 0.000"), std::string::npos) << printed;
+}
+
 // The wrists' image error: both hands of the scored frames, a wrist behind the camera (NaN) left out.
 TEST(RunReport, TheWristsImageErrorIsAveragedOverTheWristsInView) {
   MrTrace t;
