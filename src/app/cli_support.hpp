@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "spidar/core/result.hpp"
 #include "spidar/session/data_path.hpp"
@@ -31,21 +32,52 @@ class UsageError : public SpidarError {
 /// Resolves a data file given relative to the project (session::resolve_data_path).
 using session::resolve_data_path;
 
-/// Finger by index ("3") or by name ("left_ring"); UsageError listing the valid ones otherwise.
-int find_finger(const strings::DeviceConfig& cfg, const std::string& finger);
+/// Finger by index ("3") or by name ("left_ring"); UsageError naming `option` and listing the
+/// valid ones otherwise.
+int find_finger(const strings::DeviceConfig& cfg, const std::string& finger, std::string_view option = "--finger");
+
+/// Fingers from a comma-separated list of indices or names ("0,left_index"), in the order given;
+/// UsageError naming `option` for an unknown, empty or repeated item.
+std::vector<int> parse_finger_list(const strings::DeviceConfig& cfg, const std::string& list,
+                                   std::string_view option = "--fingers");
 
 using session::to_json;
 
 /// UsageError unless lo <= x <= hi (NaN is refused too): "--seconds: expected 0 to 600 s, got nan".
+/// A subnormal number (1e-320: no quantity a user means) is refused as well.
 void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit = "");
+
+/// UsageError unless lo < x <= hi (NaN and subnormal numbers refused): "--tolerance: expected
+/// more than 0 and at most 20 mm, got 0".
+void require_above(double x, double lo, double hi, std::string_view option, std::string_view unit = "");
 
 /// UsageError naming `option` when a path it takes is empty (`what`: what it names, e.g. "a
 /// hands YAML file").
 void require_path(const std::string& path, std::string_view option, std::string_view what);
 
-/// Makes the output directory `dir` (and its parents) up front, before any input is loaded:
-/// UsageError naming `option` and the reason when it cannot (a file in the way, no permission).
+/// Checks, without creating anything, that the output directory `dir` can be made or used:
+/// UsageError naming `option` for an empty path, the filesystem's root, a file in the way, or a
+/// nearest existing parent that is not a writable folder. Call it before any input is loaded, and
+/// make the folder (make_output_dir) only once the inputs are known good, so that a refused run
+/// leaves nothing behind.
+void check_output_dir(const std::string& dir, std::string_view option);
+
+/// Checks, without creating anything, that the output file `path` can be written: UsageError
+/// naming `option` for an empty path, something other than a file in its place, or a nearest
+/// existing parent that is not a writable folder (`what`: what it names, e.g. "a PNG file").
+void check_output_file(const std::string& path, std::string_view option, std::string_view what);
+
+/// check_output_dir, then makes `dir` (and its parents): UsageError naming `option` and the reason
+/// when it cannot.
 void make_output_dir(const std::string& dir, std::string_view option);
+
+/// UsageError for any option or positional argument of `app` or its parsed subcommands given an
+/// empty value (`--seconds ''`): CLI11 would turn it into 0 or the default without a word.
+void refuse_empty_values(const CLI::App& app);
+
+/// Check for a number option: lo <= x <= hi, NaN and subnormal numbers refused (CLI::Range lets
+/// NaN through); CLI11 names the option in its message.
+CLI::Validator range_check(double lo, double hi, std::string_view unit = "");
 
 /// The largest seed a --seed option takes.
 inline constexpr std::uint64_t kMaxSeed = 4294967295u;

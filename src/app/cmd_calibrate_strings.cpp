@@ -60,20 +60,18 @@ Action add_calibrate_strings(CLI::App& app) {
   return [a] {
     if (!(a->jig == 0 || (a->jig >= 2 && a->jig <= 5)))
       throw UsageError("--jig: expected 0 (pole) or 2 to 5, got " + std::to_string(a->jig));
-    if (!(a->jig_spacing > 0.005 && a->jig_spacing < 0.2)) throw UsageError("--jig-spacing: expected 0.005 to 0.2 m");
-    if (!(a->hold_s >= 0.05 && a->hold_s <= 10)) throw UsageError("--hold: expected 0.05 to 10 s");
-    if (!(a->tolerance_mm > 0 && a->tolerance_mm <= 20)) throw UsageError("--tolerance: expected 0 to 20 mm");
-    if (!(a->near_mm >= 0 && a->near_mm <= 1000)) throw UsageError("--near: expected 0 to 1000 mm");
-    if (!(a->timeout_s > 0 && a->timeout_s <= 600)) throw UsageError("--timeout: expected 0 to 600 s");
+    require_range(a->jig_spacing, 0.005, 0.2, "--jig-spacing", "m");
+    require_range(a->hold_s, 0.05, 10, "--hold", "s");
+    require_above(a->tolerance_mm, 0, 20, "--tolerance", "mm");
+    require_range(a->near_mm, 0, 1000, "--near", "mm");
+    require_above(a->timeout_s, 0, 600, "--timeout", "s");
     const std::string path = resolve_data_path(a->backend.config);
     const strings::DeviceConfig cfg = strings::load_device_config(path);
     std::vector<int> fingers;
     if (a->fingers.empty()) {
       for (int f = 0; f < static_cast<int>(cfg.fingers.size()); ++f) fingers.push_back(f);
     } else {
-      std::stringstream ss(a->fingers);
-      std::string name;
-      while (std::getline(ss, name, ',')) fingers.push_back(find_finger(cfg, name));
+      fingers = parse_finger_list(cfg, a->fingers, "--fingers");
     }
     // The device: the simulated SPIDAR with a simulated user who follows the guidance, stepped
     // 1 ms per reading (simulated time, as fast as it computes), or the hardware in real time.

@@ -85,6 +85,7 @@ Action add_demo(CLI::App& app) {
     require_range(o->width, 64, 3840, "--width", "px");
     require_range(o->height, 48, 2160, "--height", "px");
     require_range(o->fps, 1, 240, "--fps", "Hz");
+    check_output_dir(o->out, "--out");
     if (o->scenario == "strings") return run_strings_demo(*o);
     if (o->scenario == "haptic") return run_haptic_demo(*o);
     return run_mr_demo(*o);

@@ -33,6 +33,7 @@ Action add_render_test(CLI::App& app) {
     require_range(a->frames, 0, 10000, "--frames");
     require_range(a->fps, 1, 240, "--fps", "Hz");
     require_range(a->registration_error_mm, -100, 100, "--registration-error-mm", "mm");
+    check_output_dir(a->out, "--out");
     const session::RenderTestResult r = session::run_render_test(*a);
     std::cout << "render-test: GL " << r.gl_renderer << "\n"
               << "  wrote " << a->out << "/{virtual,camera,matte,composite_depth,composite_paper,"

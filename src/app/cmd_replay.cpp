@@ -97,6 +97,7 @@ Action add_replay(CLI::App& app) {
   cmd->add_flag("!--no-video", a->video, "do not write replay.mp4");
   return [a] {
     const std::string out = a->out.empty() ? (fs::path(a->dir) / "replay").string() : a->out;
+    check_output_dir(out, a->out.empty() ? "--out (DIR/replay)" : "--out");
     const auto j = replay_recording(a->dir, out, a->video);
     std::cout << session::json_text(j, 2) << "\n";
     return 0;

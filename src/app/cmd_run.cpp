@@ -11,6 +11,7 @@
 
 #include "spidar/session/json_text.hpp"
 #include "cli_support.hpp"
+#include "spidar/session/recording_writer.hpp"
 #include "commands.hpp"
 #include "live_exit.hpp"
 #include "live_gui.hpp"
@@ -77,6 +78,14 @@ Action add_run(CLI::App& app) {
                   "window: save the window's pixels to this PNG just before exiting (tests)");
   return [a] {
     require_range(a->seconds, 0, 86400, "--seconds", "s");
+    if (!a->screenshot.empty()) {
+      if (a->headless) throw UsageError("--screenshot: saves the window's pixels; there is no window with --headless");
+      check_output_file(a->screenshot, "--screenshot", "a PNG file");
+    }
+    if (!a->record.empty()) {
+      check_output_dir(a->record, "--record");
+      session::check_new_recording_folder(a->record);  // before the device and camera start
+    }
     SignalScope signals;  // from the start: a signal during start-up ends the session once it runs
     const session::LiveConfig cfg = session::load_live_config(a->config);
     session::LiveSessionOptions opt;

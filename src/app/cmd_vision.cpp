@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "spidar/vision/camera_config.hpp"
 #include "spidar/vision/chessboard.hpp"
+#include "spidar/core/file_read.hpp"
 #include "spidar/vision/markers.hpp"
 
 namespace spidar::app {
@@ -25,6 +26,25 @@ struct CalibrateCameraArgs {
   std::string out = "configs/camera.yaml";
   bool k3 = false;
 };
+
+/// Refuses an --out that would overwrite something other than a camera file (its own --markers,
+/// a device config, a folder): calibrate-camera replaces only a camera file, keeping it as .bak.
+void check_camera_out(const CalibrateCameraArgs& a) {
+  check_output_file(a.out, "--out", "a camera file");
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::string shown = "--out " + core::printable_for_message(a.out);
+  for (const auto& [input, option] : {std::pair{&a.markers, "--markers"}, std::pair{&a.images, "--images"}})
+    if (!input->empty() && fs::equivalent(a.out, *input, ec))
+      throw UsageError(shown + ": is the " + option + " input; expected another path for the camera file");
+  if (!fs::exists(a.out, ec)) return;
+  try {
+    (void)vision::load_camera_file(a.out);
+  } catch (const SpidarError& e) {
+    throw UsageError(shown + ": exists and is not a camera file (" + e.what() +
+                     "); calibrate-camera replaces only a camera file: choose another path");
+  }
+}
 
 /// Extrinsics alone (no --images): the markers against the intrinsics of `base` (the existing
 /// camera file; the default rig camera if there is none), written with the new pose.
@@ -78,6 +98,7 @@ Action add_calibrate_camera(CLI::App& app) {
   cmd->add_option("--out", a->out, "camera file to write")->capture_default_str();
   cmd->add_flag("--k3", a->k3, "also estimate the k3 distortion coefficient (default: k3 = 0)");
   return [a] {
+    check_camera_out(*a);
     // The camera file whose parts are kept (intrinsics without --images, pose without --markers).
     std::string base = a->base;
     if (base.empty() && std::filesystem::exists(a->out)) base = a->out;

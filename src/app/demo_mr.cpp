@@ -66,7 +66,7 @@ int run_mr_demo(const DemoOptions& o) {
   require_path(o.scene, "--scene", "an MJCF scene file");
   require_path(o.camera, "--camera", "a camera YAML file");
   require_path(o.config, "--config", "a device config YAML file");
-  make_output_dir(o.out, "--out");
+  check_output_dir(o.out, "--out");  // made once the inputs are known good (a refused run leaves nothing)
   const auto cfg = strings::load_device_config(resolve_data_path(o.config));
   if (cfg.fingers.size() != 8) throw UsageError("--config: the rubiks demo needs 8 fingers");
   const std::string scene_path = resolve_data_path(o.scene);
@@ -99,8 +99,6 @@ int run_mr_demo(const DemoOptions& o) {
   if (!scene_r) throw UsageError("--scene: " + scene_r.error().message);
   session::Scene& scene = *scene_r.value();
   const auto& cube = scene.cube;
-  fs::create_directories(o.out);
-  fs::create_directories(fs::path(o.out) / "keyframes");
   const sim::RubiksTask& task = *scene.task;
   const double seconds = task.params().deadline;
   // The object must be where the device's strings can follow the fingers to it: inside the frame
@@ -143,7 +141,9 @@ int run_mr_demo(const DemoOptions& o) {
   sp.seconds = seconds;
   sp.end_with_script = true;
 
-  // --- the rig, the session and its sinks ---
+  // --- the outputs' folder (the inputs are good), the rig, the session and its sinks ---
+  make_output_dir(o.out, "--out");
+  make_output_dir((fs::path(o.out) / "keyframes").string(), "--out");
   auto ctx_r = o.window ? render::Context::create_window({o.width, o.height, "spidar-mr demo"})
                         : render::Context::create_headless();
   if (!ctx_r) throw SpidarError("OpenGL: " + ctx_r.error().message);

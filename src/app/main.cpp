@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
   try {
+    refuse_empty_values(app);
     for (auto& [cmd, action] : actions) {
       if (cmd->parsed()) return action();
     }

@@ -64,6 +64,11 @@ Result<std::unique_ptr<VideoOutput>> VideoOutput::open(const std::string& path, 
   std::error_code ec;
   const auto parent = std::filesystem::path(path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  if (ec) return Error{"video: cannot create the folder " + parent.string() + " for " + path + ": " + ec.message()};
+  // A folder (or a device, a FIFO) where the video goes: say so, rather than falling back to
+  // another format's file beside it (the fallbacks are for a missing encoder, not a blocked path).
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    return Error{"video: " + path + " exists and is not a file; expected a video file's path"};
   std::string tried;
   for (const Candidate& c : candidates) {
     if (only && *only != c.format) continue;

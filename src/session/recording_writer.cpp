@@ -1,5 +1,7 @@
 #include "spidar/session/recording_writer.hpp"
 
+#include "spidar/core/file_read.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -84,6 +86,22 @@ std::string fit_row_text(const FitRow& r) {
   // finite; 0 when unknown (not a size in (0, 1) m).
   for (double v : {r.length_m, r.width_m}) row += ',' + (v > 0.0 && v < 1.0 ? number_text(v) : std::string("0"));
   return row + '\n';
+}
+
+void check_new_recording_folder(const std::string& dir) {
+  const fs::path d(dir);
+  std::error_code ec;
+  if (!fs::exists(d, ec)) return;
+  if (fs::exists(d / files::kSession, ec))
+    throw SpidarError("--record " + dir + ": already holds a recording (session.json); choose a new folder");
+  if (!fs::is_directory(d, ec)) throw SpidarError("--record " + dir + ": exists and is not a folder; choose a new folder");
+  if (fs::is_empty(d, ec) && !ec) return;
+  std::string held = ec ? "cannot list it: " + ec.message() : "it holds files";
+  for (fs::directory_iterator it(d, ec); !ec && it != fs::directory_iterator(); ++it) {
+    held = "it holds " + core::printable_for_message(it->path().filename().string());
+    break;
+  }
+  throw SpidarError("--record " + dir + ": is not empty (" + held + "); a recording goes into a new or empty folder");
 }
 
 RecordingWriter::RecordingWriter(std::string dir, const RecordingMeta& meta, std::string_view config_yaml)

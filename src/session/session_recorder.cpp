@@ -60,6 +60,7 @@ Status RecordingDevice::write(std::span<const std::int32_t> commands) {
 SessionRecorder::SessionRecorder(const std::string& dir, FrameStore store, const RecorderSetup& meta,
                                  const RecordingDevice& device, const device::ServoLoop& servo)
     : dir_(dir), store_(store), meta_(meta), device_(&device), servo_(&servo) {
+  check_new_recording_folder(dir);
   writer_ = std::make_unique<RecordingWriter>(dir, schema_meta(meta, store), meta.config_yaml);
   if (store_ != FrameStore::kPng) {
     const render::VideoFormat mjpg = render::VideoFormat::kAviMjpg;

@@ -480,10 +480,10 @@ TEST(Cli, MixedRealityDemoRejectsBadSceneAndHandFiles) {
   }
   r = run("demo --seconds 1 --no-video --out \"\"");
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("--out: expected a directory, got an empty path"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--out: expected a value, got an empty one"), std::string::npos) << r.err;
   r = run("demo --seconds 1 --no-video --out " + bad_hand);
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("--out: cannot make the output directory"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--out " + bad_hand + ": exists and is not a folder"), std::string::npos) << r.err;
 }
 
 }  // namespace

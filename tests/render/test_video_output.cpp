@@ -90,6 +90,19 @@ TEST(VideoOutput, MjpgFallbackAlwaysWorks) {
   std::filesystem::remove_all(dir);
 }
 
+// A folder where the video goes is an error naming it; no .avi appears beside it instead.
+TEST(VideoOutput, ABlockedPathIsAnErrorNotAnotherFormat) {
+  namespace fs = std::filesystem;
+  const auto dir = scratch("blocked");
+  fs::create_directories(dir / "clip.mp4");
+  auto video = VideoOutput::open((dir / "clip.mp4").string(), 160, 120, 10);
+  ASSERT_FALSE(video.ok()) << (*video)->path();
+  EXPECT_NE(video.error().message.find((dir / "clip.mp4").string() + " exists and is not a file"), std::string::npos)
+      << video.error().message;
+  EXPECT_FALSE(fs::exists(dir / "clip.avi"));
+  fs::remove_all(dir);
+}
+
 #ifdef SPIDAR_MR
 TEST(RenderCli, RenderTestWritesCompositedPngs) {
   const auto dir = scratch("cli");

@@ -216,6 +216,34 @@ TEST(RecordingWriter, RefusesAFolderHoldingARecording) {
   }
 }
 
+TEST(RecordingWriter, ANewRecordingGoesOnlyIntoANewOrEmptyFolder) {
+  TempFolder d("notempty");
+  const fs::path dir = d.path() / "mine";
+  fs::create_directories(dir);
+  { std::ofstream(dir / "config.yaml") << "my own notes\n"; }
+  try {
+    check_new_recording_folder(dir.string());
+    FAIL() << "a recording into a folder holding other files";
+  } catch (const SpidarError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not empty (it holds config.yaml)"), std::string::npos) << e.what();
+  }
+  { std::ofstream(d.path() / "a_file") << "x"; }
+  EXPECT_THROW(check_new_recording_folder((d.path() / "a_file").string()), SpidarError);
+  // A folder that does not exist yet, or an empty one (made beforehand, e.g. by mktemp -d), is fine.
+  EXPECT_NO_THROW(check_new_recording_folder((d.path() / "new").string()));
+  fs::create_directories(d.path() / "empty");
+  EXPECT_NO_THROW(check_new_recording_folder((d.path() / "empty").string()));
+  // A recording is named as one.
+  const TestRecording t = make_test_recording(FrameStore::kPng);
+  write_test_recording(t, d.path() / "rec");
+  try {
+    check_new_recording_folder((d.path() / "rec").string());
+    FAIL() << "a second recording into the same folder";
+  } catch (const SpidarError& e) {
+    EXPECT_NE(std::string(e.what()).find("already holds a recording"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RecordingWriter, AFullDiskFailsNamingTheFileAndLeavesNoCompletionMarker) {
   TempFolder d("full");
   const fs::path dir = d.path() / "rec";

@@ -22,9 +22,15 @@ namespace spidar::session {
 
 class CheckedFile;
 
+/// SpidarError unless `dir` is a folder a recording may go into: one that does not exist yet, or
+/// an empty one. A recording's files (config.yaml, device.csv, frames/...) would overwrite what
+/// another folder holds; one holding session.json is named as a recording already.
+void check_new_recording_folder(const std::string& dir);
+
 class RecordingWriter {
  public:
-  /// Creates the folder `dir` (it must not hold a session.json already), and frames/ for the PNG
+  /// Creates the folder `dir` (it must not hold a session.json already; callers check the whole
+  /// folder first with check_new_recording_folder), and frames/ for the PNG
   /// store; writes config.yaml (`config_yaml`) and session.json ("complete": false); creates the
   /// CSVs with their header rows. Throws core::FileError naming the path on any failure, or
   /// SpidarError if `dir` holds a recording already or `meta` is out of range.
