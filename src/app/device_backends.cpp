@@ -17,7 +17,7 @@ void add_backend_options(CLI::App& cmd, BackendArgs& a) {
   CLI::Option* timeout = cmd.add_option("--read-timeout", a.read_timeout_s,
                                         "serial: seconds without a reading after which the device "
                                         "counts as lost (a read timeout fault)")
-                             ->check(range_check(1e-3, 10.0, "s"))
+                             ->check(range_check(1e-3, device::kMaxReadTimeout_s, "s"))
                              ->capture_default_str();
   CLI::Option* seed = cmd.add_option("--seed", a.seed, "sim: random seed")->check(seed_check())->capture_default_str();
   // An option of the other backend is a mistake worth saying (a --port with --backend sim would

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "spidar/core/clock.hpp"
+#include "spidar/core/config.hpp"
 #include "spidar/device/link_budget.hpp"
 
 namespace spidar::device {
@@ -104,7 +105,14 @@ Status SerialDevice::open() {
     d += std::to_string(config_.command_max);
     return bad(d);
   }
-  if (!(config_.read_timeout_s > 0.0)) return bad("read_timeout_s must be > 0 s");
+  // The servo thread waits up to this long for room to write a frame: bounded, so that a stuck
+  // link cannot hold the loop (and its safe state) for longer than a second.
+  if (!(config_.read_timeout_s > 0.0 && config_.read_timeout_s <= kMaxReadTimeout_s)) {
+    std::string d = "read_timeout_s ";
+    d += core::number_for_message(config_.read_timeout_s, 6);
+    d += " s out of range (expected more than 0 and at most 1 s)";
+    return bad(d);
+  }
 
   Result<SerialPort> port = SerialPort::open(config_.port, config_.baud);
   if (!port) return port.error();
@@ -153,6 +161,18 @@ void SerialDevice::close() {
 }
 
 Status SerialDevice::check_rate(double rate_hz) const {
+  // Shorter than two periods, every reading that comes a period late would lose the device.
+  if (rate_hz > 0.0 && config_.read_timeout_s < 2.0 / rate_hz) {
+    std::string m = info_.name;
+    m += ": read_timeout_s ";
+    m += core::number_for_message(config_.read_timeout_s, 6);
+    m += " s is shorter than two servo periods at ";
+    m += core::number_for_message(rate_hz, 6);
+    m += " Hz (";
+    m += core::number_for_message(2.0 / rate_hz, 6);
+    m += " s): expected at least that";
+    return Error{m};
+  }
   if (!config_.check_link_budget || port_.baud_ignored()) return Ok{};
   return check_link_budget(info_.name.c_str(), config_.baud, config_.string_count, rate_hz);
 }

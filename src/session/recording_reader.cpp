@@ -30,14 +30,11 @@ std::string location(const std::string& file, int line, int column) {
 
 std::string short_number(double v) { return core::number_for_message(v, 9); }
 
-// Bounds on what a recording's numbers can be (generous: they keep out values whose use would
-// overflow, such as 1e308, not unusual ones). Positions in the world [m], forces and tensions
-// [N], the fits' costs (dimensionless) and pose parameters (wrist position [m], rotation vector
-// and joint angles [rad]).
-constexpr double kMaxPosition_m = 100.0;
-constexpr double kMaxForce_N = 1e4;
-constexpr double kMaxCost = 1e12;
-constexpr double kMaxPoseParameter = 1e3;
+// Bounds on what a recording's numbers can be (recording_schema.hpp; the writer keeps within them).
+constexpr double kMaxPosition_m = recording_bounds::kPosition_m;
+constexpr double kMaxForce_N = recording_bounds::kForce_N;
+constexpr double kMaxCost = recording_bounds::kCost;
+constexpr double kMaxPoseParameter = recording_bounds::kPoseParameter;
 
 /// The sample columns of the current row (faults ... f7z).
 device::FingertipSample read_sample(const CsvCursor& c, int finger_count) {

@@ -2,6 +2,7 @@
 
 #include "spidar/core/file_read.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -17,12 +18,18 @@ namespace {
 namespace fs = std::filesystem;
 namespace files = recording_files;
 
+namespace bounds = recording_bounds;
+
+/// `v` saturated to [-bound, bound] (a solve from a glitched reading may land anywhere; the
+/// recording keeps it readable), as text.
+std::string bounded_text(double v, double bound) { return number_text(std::clamp(v, -bound, bound)); }
+
 void append_sample(std::string& row, const device::FingertipSample& s) {
   row += std::to_string(s.faults) + ',' + std::to_string(s.consistent) + ',' + std::to_string(s.finger_count);
   for (const auto& p : s.p_W)
-    for (double v : p) row += ',' + number_text(v);
+    for (double v : p) row += ',' + bounded_text(v, bounds::kPosition_m);
   for (const auto& f : s.f_W)
-    for (double v : f) row += ',' + number_text(v);
+    for (double v : f) row += ',' + bounded_text(v, bounds::kForce_N);
 }
 
 std::unique_ptr<CheckedFile> open_csv(const fs::path& dir, std::string_view name,
@@ -52,7 +59,8 @@ std::string device_row_text(const DeviceCycleRecord& r, int string_count) {
 std::string fingertip_row_text(const device::FingertipSample& s, int string_count) {
   std::string row = std::to_string(s.t_ns) + ',' + std::to_string(s.cycle) + ',';
   append_sample(row, s);
-  for (int i = 0; i < string_count; ++i) row += ',' + number_text(i < s.string_count ? s.tension[i] : 0.0);
+  for (int i = 0; i < string_count; ++i)
+    row += ',' + bounded_text(i < s.string_count ? s.tension[i] : 0.0, bounds::kForce_N);
   for (int i = 0; i < string_count; ++i) row += ',' + std::to_string(i < s.string_count ? s.command[i] : 0);
   return row + '\n';
 }
@@ -65,16 +73,18 @@ std::string frame_row_text(const FrameRow& f) {
 
 std::string scene_row_text(std::int64_t frame, std::size_t shape, const Pose& X) {
   std::string row = std::to_string(frame) + ',' + std::to_string(shape);
-  for (double v : {X.p.x(), X.p.y(), X.p.z(), X.R.w(), X.R.x(), X.R.y(), X.R.z()}) row += ',' + number_text(v);
+  for (double v : {X.p.x(), X.p.y(), X.p.z()}) row += ',' + bounded_text(v, bounds::kPosition_m);
+  for (double v : {X.R.w(), X.R.x(), X.R.y(), X.R.z()}) row += ',' + number_text(v);
   return row + '\n';
 }
 
 std::string fit_row_text(const FitRow& r) {
-  // A fit with a NaN or infinity is marked finite = 0 and its numbers left empty: a number in a
-  // recording is always finite, and the reader refuses "nan" as damage.
-  bool finite = r.finite && std::isfinite(r.cost_initial) && std::isfinite(r.cost_final);
-  for (double v : r.terms) finite = finite && std::isfinite(v);
-  for (double v : r.q) finite = finite && std::isfinite(v);
+  // A fit with a NaN or infinity, or beyond the recording's bounds (a diverged fit), is marked
+  // finite = 0 and its numbers left empty: the reader refuses "nan" or 1e300 as damage.
+  auto cost_ok = [](double c) { return std::isfinite(c) && c >= 0.0 && c <= bounds::kCost; };
+  bool finite = r.finite && cost_ok(r.cost_initial) && cost_ok(r.cost_final);
+  for (double v : r.terms) finite = finite && cost_ok(v);
+  for (double v : r.q) finite = finite && std::isfinite(v) && std::abs(v) <= bounds::kPoseParameter;
   std::string row = std::to_string(r.frame) + ',' + std::to_string(r.hand) + ',' + std::to_string(r.iterations) +
                     ',' + (r.converged ? "1" : "0") + ',' + (finite ? "1" : "0");
   auto add = [&](double v) { row += ',' + (finite ? number_text(v) : std::string()); };

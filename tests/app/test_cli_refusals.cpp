@@ -90,7 +90,8 @@ TEST(CliRefusals, AnOptionOfTheOtherBackendIsRefused) {
   expect_refused("device-test --read-timeout 0.5", "--read-timeout: applies to --backend serial");
   expect_refused("device-test --backend serial --port /dev/null --seed 3", "--seed: applies to --backend sim");
   expect_refused("device-test --backend serial --port /dev/null --read-timeout nan",
-                 "--read-timeout: expected 0.001 to 10 s, got 'nan'");
+                 "--read-timeout: expected 0.001 to 1 s, got 'nan'");
+  expect_refused("device-test --backend serial --port /dev/null --read-timeout 5", "--read-timeout: expected 0.001 to 1 s, got '5'");
   expect_refused("calibrate-strings --backend sim --baud 9600", "--baud: applies to --backend serial");
 }
 

@@ -116,6 +116,28 @@ TEST(LinkBudget, TheServoLoopRefusesARateTheBaudRateCannotCarry) {
   EXPECT_TRUE(unchecked.check_rate(1000).ok());
 }
 
+// The servo thread waits up to read_timeout_s for room to write: at most a second; and a timeout
+// shorter than two servo periods would lose the device on any late reading.
+TEST(SerialReadTimeout, IsBoundedAndAtLeastTwoPeriods) {
+  SerialDeviceConfig c;
+  c.port = "/nonexistent/tty";
+  c.string_count = 24;
+  c.read_timeout_s = 5.0;
+  SerialDevice slow(c);
+  const Status s = slow.open();
+  ASSERT_FALSE(s.ok());
+  EXPECT_TRUE(contains(s.error().message, "read_timeout_s 5 s out of range (expected more than 0 and at most 1 s)"))
+      << s.error().message;
+  c.read_timeout_s = 0.001;
+  c.check_link_budget = false;
+  SerialDevice fast(c);
+  const Status r = fast.check_rate(1000);
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(contains(r.error().message, "read_timeout_s 0.001 s is shorter than two servo periods at 1000 Hz (0.002 s)"))
+      << r.error().message;
+  EXPECT_TRUE(fast.check_rate(2000).ok());  // two periods of 0.5 ms fit into 1 ms
+}
+
 TEST(HeartbeatTimeout, IsBoundedToOneSecond) {
   EXPECT_TRUE(validate(DeviceEmulatorOptions{0.1}).ok());
   EXPECT_TRUE(validate(DeviceEmulatorOptions{kMaxHeartbeatTimeoutS}).ok());

@@ -204,6 +204,28 @@ TEST(RecordingRoundTrip, FitSizeColumnsAreOptionalButAllOrNone) {
   EXPECT_EQ(r.fits[2][1].q, t.fits[2][1].q);
 }
 
+// What the reader refuses as damage, the writer never writes: a diverged fit (a cost of 1e13, a
+// joint of 1e4 rad) is marked not finite, a fingertip solved 1 km away is saturated at the bound.
+TEST(RecordingWriter, ARunsOwnRecordingStaysReadableWhateverItsNumbers) {
+  TempFolder d("bounds");
+  const fs::path dir = d.path() / "rec";
+  TestRecording t = make_test_recording(FrameStore::kPng);
+  t.fits[1][0].cost_final = 1e13;
+  t.fits[2][1].q[7] = -1e4;
+  t.fingertips[3].p_W[1][2] = -1000.0;
+  t.fingertips[4].f_W[0][0] = 1e9;
+  t.scene[0][0].p = Vec3(5e3, 0, 0);
+  write_test_recording(t, dir);
+  const Recording r = read_recording(dir.string());
+  EXPECT_FALSE(r.fits[1][0].finite);
+  EXPECT_TRUE(std::isnan(r.fits[1][0].cost_final));
+  EXPECT_FALSE(r.fits[2][1].finite);
+  EXPECT_TRUE(r.fits[2][0].finite);  // the other hand's fit of that frame is kept
+  EXPECT_EQ(r.fingertips[3].p_W[1][2], -recording_bounds::kPosition_m);
+  EXPECT_EQ(r.fingertips[4].f_W[0][0], recording_bounds::kForce_N);
+  EXPECT_EQ(r.scene[0][0].p.x(), recording_bounds::kPosition_m);
+}
+
 TEST(RecordingWriter, RefusesAFolderHoldingARecording) {
   TempFolder d("twice");
   const TestRecording t = make_test_recording(FrameStore::kPng);

@@ -41,6 +41,9 @@
 
 namespace spidar::device {
 
+/// The longest SerialDeviceConfig::read_timeout_s [s]: a write waits this long at most.
+inline constexpr double kMaxReadTimeout_s = 1.0;
+
 struct SerialDeviceConfig {
   std::string port;            ///< tty path, e.g. /dev/ttyACM0 or a pty slave
   int baud = 921600;           ///< a standard rate (see baud_to_speed)
@@ -50,6 +53,7 @@ struct SerialDeviceConfig {
   std::int32_t command_max = 4095;  ///< largest motor command [DAC counts]
   /// The device is lost (read_timeout fault) when no new Counts frame has arrived for this long;
   /// also the longest the first read after open() waits, and a write waits for room [s].
+  /// open() takes (0, kMaxReadTimeout_s]; check_rate wants at least two servo periods.
   double read_timeout_s = 0.05;
   /// Longest a read waits for the answer to the latest request before it returns the newest
   /// reading it has [s]. 0: never wait (servo loops: the answer to the previous cycle's write has

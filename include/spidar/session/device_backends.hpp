@@ -5,6 +5,7 @@
 #include <string>
 
 #include "spidar/device/device.hpp"
+#include "spidar/device/serial_device.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::session {
@@ -16,8 +17,8 @@ struct BackendArgs {
   int baud = 2000000;  ///< enough for 24 strings at 1 kHz (link_budget.hpp)
   bool check_link_budget = true;  ///< false: a pty or a transport faster than its baud setting
   /// serial: the device is lost after this long without a reading [s] (SerialDeviceConfig::
-  /// read_timeout_s), > 0.
-  double read_timeout_s = 0.05;
+  /// read_timeout_s: (0, 1] s, and at least two servo periods).
+  double read_timeout_s = device::SerialDeviceConfig{}.read_timeout_s;
   std::uint64_t seed = 1;
 };
 

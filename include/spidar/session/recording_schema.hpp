@@ -43,6 +43,17 @@ inline constexpr std::string_view kRecordingFormat = "spidar-mr recording";
 /// fit_size_columns): a reader takes a file with all of a group's columns or none.
 inline constexpr int kRecordingVersion = 2;
 
+/// Bounds on what a recording's numbers can be: the reader refuses a number beyond them as damage,
+/// and the writer keeps within them (it saturates a sample's or a scene pose's coordinate, and
+/// marks a fit beyond them not finite), so that a run's own recording always replays. Generous:
+/// they keep out values whose use would overflow (1e308), not unusual ones.
+namespace recording_bounds {
+inline constexpr double kPosition_m = 100.0;  ///< |a world coordinate| [m]
+inline constexpr double kForce_N = 1e4;       ///< |a force or a string tension| [N]
+inline constexpr double kCost = 1e12;         ///< a fit's cost (dimensionless, >= 0)
+inline constexpr double kPoseParameter = 1e3; ///< |a pose parameter| (wrist [m], rotation vector and joints [rad])
+}  // namespace recording_bounds
+
 /// File names inside a recording folder.
 namespace recording_files {
 inline constexpr std::string_view kSession = "session.json";
