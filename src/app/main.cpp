@@ -17,10 +17,9 @@ int main(int argc, char** argv) {
   // fps instead of 15–16, latency median 75 instead of 90 ms, session 9). Before any thread or
   // GL context exists; an LP_NUM_THREADS of the user's wins.
   spidar::render::render_in_drawing_thread();
-  // OpenCV decodes an image of up to 2^30 pixels by default: a damaged or foreign file declaring
-  // one would take gigabytes. 64 Mpx covers any camera's frame or calibration picture (a user's
-  // OPENCV_IO_MAX_IMAGE_PIXELS wins); before any image is read.
-  setenv("OPENCV_IO_MAX_IMAGE_PIXELS", "67108864", 0);
+  // (Image files are read through vision::read_image, which checks the size a header declares:
+  // OpenCV reads OPENCV_IO_MAX_IMAGE_PIXELS once, as its library loads, so setting it here would
+  // not lower its bound.)
   using namespace spidar::app;
   // Logs and warnings (e.g. "SCHED_FIFO not permitted") go to stderr: stdout carries only the
   // command's result (JSON for device-test, position, tension).

@@ -1,4 +1,5 @@
 #include "spidar/session/recording_rig.hpp"
+#include "spidar/vision/image_file.hpp"
 
 #include <array>
 #include <cstdint>
@@ -13,26 +14,6 @@
 #include "spidar/core/clock.hpp"
 
 namespace spidar::session {
-namespace {
-
-/// The width and height [px] a PNG file declares (its signature, then the IHDR chunk's first two
-/// big-endian 32-bit fields); nullopt if the file is not a PNG or is too short.
-std::optional<std::pair<long, long>> png_size(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::array<unsigned char, 24> b{};
-  if (!in.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(b.size()))) return std::nullopt;
-  constexpr std::array<unsigned char, 8> kSignature{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  for (std::size_t i = 0; i < kSignature.size(); ++i)
-    if (b[i] != kSignature[i]) return std::nullopt;
-  if (b[12] != 'I' || b[13] != 'H' || b[14] != 'D' || b[15] != 'R') return std::nullopt;
-  auto be32 = [&](std::size_t o) {
-    return static_cast<long>((std::uint32_t{b[o]} << 24) | (std::uint32_t{b[o + 1]} << 16) |
-                             (std::uint32_t{b[o + 2]} << 8) | std::uint32_t{b[o + 3]});
-  };
-  return std::pair{be32(16), be32(20)};
-}
-
-}  // namespace
 
 /// The recorded frames in processing order, each taken as soon as asked for (no thread, no
 /// dropping: a replay fits every frame the live run fitted, warm-started from the same fit).
@@ -60,12 +41,15 @@ class RecordingRig::Source final : public FrameSource {
         // The PNG's own size first: a damaged or foreign file declaring a huge image would
         // otherwise be decoded into gigabytes before its size could be refused.
         const std::string path = (std::filesystem::path(rec_.dir) / f.image).string();
-        const auto size = png_size(path);
-        if (size && (size->first != width_ || size->second != height_)) {
+        const auto size = vision::image_file_size(path);
+        if (size && (size->width != width_ || size->height != height_)) {
           image_.release();
-          problem = "a PNG of " + std::to_string(size->first) + "x" + std::to_string(size->second) + " px";
+          problem = "a " + std::string(size->format) + " of " + std::to_string(size->width) + "x" +
+                    std::to_string(size->height) + " px";
+        } else if (auto read = vision::read_image(path, cv::IMREAD_COLOR)) {
+          image_ = std::move(read).value();
         } else {
-          image_ = cv::imread(path, cv::IMREAD_COLOR);
+          image_.release();  // "no image decoded" below
         }
       }
       if (problem.empty() && image_.empty()) problem = "no image decoded";

@@ -1,4 +1,5 @@
 #include "spidar/vision/capture.hpp"
+#include "spidar/vision/image_file.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -109,9 +110,17 @@ Result<Capture> Capture::open(const std::string& source, const CaptureOptions& o
         return Error{"image sequence " + source +
                      ": expected exactly one integer field such as %04d in the pattern"};
       }
-      if (!first_sequence_file(source)) {
+      const auto first = first_sequence_file(source);
+      if (!first) {
         return Error{"image sequence " + source +
                      ": no file matches the pattern (tried indices 0..1000)"};
+      }
+      // The first file's declared size (a sequence's files share one): a foreign or damaged file
+      // declaring a huge image is refused before OpenCV decodes it.
+      if (const auto size = image_file_size(*first);
+          size && !declares_at_most(*size, kMaxImagePixels)) {
+        return Error{"image sequence " + source + ": " + *first + " declares " + std::to_string(size->width) + "x" +
+                     std::to_string(size->height) + " px; expected 1 to " + std::to_string(kMaxImagePixels) + " pixels"};
       }
       if (!cap->open(source, cv::CAP_IMAGES) || !cap->isOpened()) {
         return Error{"image sequence " + source + ": OpenCV cannot read it"};

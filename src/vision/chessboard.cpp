@@ -1,4 +1,5 @@
 #include "spidar/vision/chessboard.hpp"
+#include "spidar/vision/image_file.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -162,8 +163,9 @@ Result<ChessboardFolderResult> calibrate_chessboard_folder(const std::string& di
   std::vector<std::vector<Vec2>> corners;
   cv::Size size;
   for (const auto& f : *files) {
-    const cv::Mat img = cv::imread(f, cv::IMREAD_GRAYSCALE);
-    if (img.empty()) return Error{f + ": cannot read image"};
+    auto read = read_image(f, cv::IMREAD_GRAYSCALE);
+    if (!read) return read.error();
+    const cv::Mat img = std::move(read).value();
     if (size.area() == 0) {
       size = img.size();
     } else if (img.size() != size) {
