@@ -28,7 +28,6 @@
 #include "spidar/session/session.hpp"
 #include "spidar/session/truth_scorer.hpp"
 #include "spidar/vision/camera_config.hpp"
-#include "spidar/vision/lens_undistortion.hpp"
 
 namespace spidar::app {
 
@@ -77,9 +76,7 @@ int run_mr_demo(const DemoOptions& o) {
   const vision::Camera calibrated = vision::load_camera_file(resolve_data_path(o.camera)).camera;
   // A calibration with lens distortion: the synthetic camera films through that lens, and the
   // session undistorts its frames into the lens's pinhole camera, as with a real camera
-  // (vision::LensUndistortion). A lens that cannot be undistorted is refused here.
-  if (auto st = vision::LensUndistortion::check(calibrated.intrinsics()); !st)
-    throw UsageError("--camera " + o.camera + ": camera: " + st.error().message);
+  // (vision::LensUndistortion). A lens that cannot be undistorted is refused as the file loads.
   {
     // Scaling a calibration to another aspect ratio would make its pixels non-square.
     const double a = static_cast<double>(o.width) / o.height;

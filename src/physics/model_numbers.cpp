@@ -69,7 +69,7 @@ std::string first_implausible_number(const mjModel* m) {
     return os.str();
   for (int b = 0; b < m->nbody; ++b) {
     const char* name = mj_id2name(m, mjOBJ_BODY, b);
-    const std::string body = "body '" + (name ? std::string(name) : std::to_string(b)) + "'";
+    const std::string body = name && *name ? "body '" + std::string(name) + "'" : "body " + std::to_string(b) + " (unnamed)";
     if (beyond(body + " mass", m->body_mass + b, 1, 1e6, "kg") || beyond(body + " pos", m->body_pos + 3 * b, 3, 1e3, "m"))
       return os.str();
   }

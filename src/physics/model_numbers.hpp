@@ -16,7 +16,9 @@ std::string first_non_finite_number(const mjModel* m);
 /// on a table can mean, so large that the simulation would overflow (a gravity of 1e308 turns the
 /// cube's state to nan): gravity, wind and magnetic field beyond 1000 (m/s², m/s, T) in any
 /// component, density or viscosity beyond 1e5, a body's mass beyond 1e6 kg or its position
-/// beyond 1000 m. A message naming the number, its value and the bound; empty if none.
+/// relative to its parent body beyond 1000 m (MJCF's `pos`; nested bodies could sum further, a
+/// case no scene file writes by accident). A message naming the number (a body by its name, or
+/// "body 3 (unnamed)"), its value and the bound; empty if none.
 std::string first_implausible_number(const mjModel* m);
 
 }  // namespace spidar::physics

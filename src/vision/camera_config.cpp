@@ -1,4 +1,5 @@
 #include "spidar/vision/camera_config.hpp"
+#include "spidar/vision/lens_undistortion.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -83,6 +84,10 @@ CameraFile parse_camera_file(const core::ConfigNode& root) {
     in.distortion = {k[0], k[1], k[2], k[3], k[4]};
   }
   if (auto s = validate_intrinsics(in); !s.ok()) node.fail(s.error().message);
+  // A lens whose distortion folds the image cannot be undistorted (LensUndistortion): refused
+  // here, at its key, for every command that reads a camera file.
+  if (auto d = node.find("distortion"); d && !in.distortion.is_zero())
+    if (auto st = LensUndistortion::check(in); !st) d->fail(st.error().message);
 
   CameraFile out;
   out.source = root.file();

@@ -194,6 +194,10 @@ TEST(MjcfProxies, NumbersNoSceneCanMeanAreRefused) {
                          "<mujoco><worldbody><body name=\"b\" pos=\"0 5e3 0\"><geom type=\"sphere\" size=\"0.1\"/>"
                          "</body></worldbody></mujoco>");
   EXPECT_NE(load_error(far).find("body 'b' pos y is 5000; expected at most 1000 m"), std::string::npos) << load_error(far);
+  const auto unnamed = write(dir, "unnamed.xml",
+                             "<mujoco><worldbody><body pos=\"0 0 -2e3\"><geom type=\"sphere\" size=\"0.1\"/>"
+                             "</body></worldbody></mujoco>");
+  EXPECT_NE(load_error(unnamed).find("body 1 (unnamed) pos z is -2000"), std::string::npos) << load_error(unnamed);
   // The shipped scenes are within every bound.
   for (const char* scene : {"scenes/rubiks_cube.xml", "scenes/blocks.xml"}) {
     const auto w = World::Load(std::string(SPIDAR_SOURCE_DIR) + "/" + scene);
