@@ -291,6 +291,19 @@ double require_in_range(const ConfigNode& node, double value, double lo, double 
   return value;
 }
 
+std::int64_t require_int_in_range(const ConfigNode& node, std::int64_t lo, std::int64_t hi) {
+  const std::int64_t v = node.as_int();
+  if (v < lo || v > hi) node.fail("expected " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + std::to_string(v));
+  return v;
+}
+
+std::string require_non_blank(const ConfigNode& node, std::string_view what) {
+  std::string text = node.as_string();
+  if (text.find_first_not_of(" \t") == std::string::npos)
+    node.fail("expected a non-blank " + std::string(what) + ", got '" + printable_for_message(text) + "'");
+  return text;
+}
+
 std::string number_for_message(double v, int significant) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.*g", std::clamp(significant, 1, 17), v);

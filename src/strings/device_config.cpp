@@ -29,10 +29,7 @@ FingerConfig parse_finger(const core::ConfigNode& node, const DeviceConfig& dev,
   node.expect_keys({"name", "hand", "unit", "fulcrums", "signs", "metres_per_count",
                     "length_at_zero"});
   FingerConfig f;
-  f.name = node["name"].as_string();
-  if (f.name.find_first_not_of(" \t") == std::string::npos) {
-    node["name"].fail("expected a non-empty finger name");
-  }
+  f.name = core::require_non_blank(node["name"], "finger name");
   if (auto hand = node.find("hand")) {
     f.hand = hand->as_string();
     if (f.hand != "left" && f.hand != "right") hand->fail("expected 'left' or 'right'");
@@ -64,10 +61,8 @@ FingerConfig parse_finger(const core::ConfigNode& node, const DeviceConfig& dev,
     }
     // The same range as the encoder's default (parse_device_config), which a finger without its
     // own values takes and which was checked at its own key.
-    if (!(mpc[i] >= kMinMetresPerCount && mpc[i] <= kMaxMetresPerCount)) {
-      node["metres_per_count"].at(i).fail("expected metres per count from 1e-09 to 0.01, got " +
-                                          core::number_for_message(mpc[i]));
-    }
+    if (node.has("metres_per_count"))
+      core::require_in_range(node["metres_per_count"].at(i), mpc[i], kMinMetresPerCount, kMaxMetresPerCount, "m");
     f.channels.push_back({static_cast<int>(signs[i]), mpc[i], l0[i]});
   }
   return f;
@@ -101,17 +96,14 @@ DeviceConfig parse_device_config(const core::ConfigNode& root) {
   root.expect_keys({"name", "frame_centre", "encoder", "motor", "tension", "fingers"});
   DeviceConfig dev;
   dev.source = root.file();
-  dev.name = root["name"].as_string();
-  if (dev.name.find_first_not_of(" \t") == std::string::npos) root["name"].fail("expected a non-empty device name");
+  dev.name = core::require_non_blank(root["name"], "device name");
   if (auto c = root.find("frame_centre")) dev.p_W_centre = c->as_vec3();
 
   const auto enc = root["encoder"];
   enc.expect_keys({"metres_per_count", "counter_bits"});
   const auto mpc_node = enc["metres_per_count"];
   const double mpc = core::require_in_range(mpc_node, mpc_node.as_double(), kMinMetresPerCount, kMaxMetresPerCount, "m");
-  const std::int64_t counter_bits = enc.get_int("counter_bits", 24);
-  if (counter_bits < 8 || counter_bits > 62) enc["counter_bits"].fail("expected 8..62, got " + std::to_string(counter_bits));
-  dev.counter_bits = static_cast<int>(counter_bits);
+  if (enc.has("counter_bits")) dev.counter_bits = static_cast<int>(core::require_int_in_range(enc["counter_bits"], 8, 62));
 
   const auto motor = root["motor"];
   motor.expect_keys({"pulley_radius", "torque_constant", "amplifier_gain", "dac_bits",
@@ -125,9 +117,7 @@ DeviceConfig parse_device_config(const core::ConfigNode& root) {
   dev.motor.pulley_radius = positive("pulley_radius");
   dev.motor.torque_constant = positive("torque_constant");
   dev.motor.amplifier_gain = positive("amplifier_gain");
-  const std::int64_t dac_bits = motor["dac_bits"].as_int();
-  if (dac_bits < 1 || dac_bits > 24) motor["dac_bits"].fail("expected 1..24, got " + std::to_string(dac_bits));
-  dev.motor.dac_bits = static_cast<int>(dac_bits);
+  dev.motor.dac_bits = static_cast<int>(core::require_int_in_range(motor["dac_bits"], 1, 24));
   // A DAC's output range [V]: within ±1000 V, so that its span and the counts per volt are finite.
   dev.motor.dac_v_min = core::require_in_range(motor["dac_v_min"], motor["dac_v_min"].as_double(), -1e3, 1e3, "V");
   dev.motor.dac_v_max = core::require_in_range(motor["dac_v_max"], motor["dac_v_max"].as_double(), -1e3, 1e3, "V");

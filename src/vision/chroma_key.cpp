@@ -20,8 +20,8 @@ Status validate(const ChromaKeyParams& p) {
     return Error{"chroma key: silhouette_threshold: expected a value in (0, 1), got " +
                  core::number_for_message(p.silhouette_threshold)};
   }
-  if (p.cleanup_radius_px < 0 || p.cleanup_radius_px > 10) {
-    return Error{"chroma key: cleanup_radius_px: expected 0..10, got " +
+  if (p.cleanup_radius_px < 0 || p.cleanup_radius_px > kMaxCleanupRadius_px) {
+    return Error{"chroma key: cleanup_radius_px: expected 0.." + std::to_string(kMaxCleanupRadius_px) + ", got " +
                  std::to_string(p.cleanup_radius_px)};
   }
   if (!(p.spill_limit >= 0.5 && p.spill_limit <= 2.0)) {
@@ -38,10 +38,8 @@ ChromaKeyParams parse_chroma_key_params(const core::ConfigNode& node) {
   p.s_background = node.get_double("s_background", p.s_background);
   p.dark_floor = node.get_double("dark_floor", p.dark_floor);
   p.silhouette_threshold = node.get_double("silhouette_threshold", p.silhouette_threshold);
-  const std::int64_t cleanup = node.get_int("cleanup_radius_px", p.cleanup_radius_px);
-  if (cleanup < 0 || cleanup > 10)
-    node["cleanup_radius_px"].fail("expected 0..10, got " + std::to_string(cleanup));
-  p.cleanup_radius_px = static_cast<int>(cleanup);
+  if (auto c = node.find("cleanup_radius_px"))
+    p.cleanup_radius_px = static_cast<int>(core::require_int_in_range(*c, 0, kMaxCleanupRadius_px));
   if (auto d = node.find("despill")) p.despill = d->as_bool();
   p.spill_limit = node.get_double("spill_limit", p.spill_limit);
   if (auto s = validate(p); !s.ok()) core::fail_at_named_key(node, s.error().message, "chroma key: ");

@@ -129,9 +129,9 @@ TEST(DeviceConfig, OtherMistakesGiveClearErrors) {
   // at a finger's key it did not have); a finger's own value out of range is named at its key.
   EXPECT_EQ(with("metres_per_count: 2.513e-5", "metres_per_count: 0.01"), "no error");
   EXPECT_NE(with("  - name: grip\n", "  - name: grip\n    metres_per_count: [1e-5, 1e-5, 0.02, 1e-5]\n")
-                .find("fingers[0].metres_per_count[2]: expected metres per count from 1e-09 to 0.01, got 0.02"),
+                .find("fingers[0].metres_per_count[2]: expected a value in [1e-09, 0.01] m, got 0.02"),
             std::string::npos);
-  EXPECT_NE(with("name: SPIDAR-G4", "name: \"\"").find("name: expected a non-empty device name"), std::string::npos);
+  EXPECT_NE(with("name: SPIDAR-G4", "name: \"\"").find("name: expected a non-blank device name, got ''"), std::string::npos);
   // A DAC range whose span would overflow (1.7e308 − (−1.7e308)).
   EXPECT_NE(with("dac_v_min: ", "dac_v_min: -1.7e308 #").find("motor.dac_v_min: expected a value in [-1000, 1000] V"),
             std::string::npos);
@@ -158,7 +158,7 @@ TEST(DeviceConfig, UnitsNamesCountsAndTheFrameCentreAreChecked) {
   EXPECT_NE(with("unit: 3\n", "unit: 99\n").find("fingers[1].unit: expected a unit number 0..7 (one per fingertip), got 99"),
             std::string::npos) << with("unit: 3\n", "unit: 99\n");
   EXPECT_NE(with("unit: 3\n", "unit: -1\n").find("got -1"), std::string::npos);
-  EXPECT_NE(with("name: left_index", "name: \"\"").find("fingers[1].name: expected a non-empty finger name"),
+  EXPECT_NE(with("name: left_index", "name: \"\"").find("fingers[1].name: expected a non-blank finger name, got ''"),
             std::string::npos) << with("name: left_index", "name: \"\"");
   const std::string far = with("frame_centre: [0.0, 0.0, 0.0]", "frame_centre: [100.0, 0.0, 0.0]");
   EXPECT_NE(far.find("s8.yaml:"), std::string::npos) << far;

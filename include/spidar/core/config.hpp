@@ -126,6 +126,14 @@ class ConfigNode {
 double require_in_range(const ConfigNode& node, double value, double lo, double hi,
                         std::string_view unit);
 
+/// `node` as a whole number in [lo, hi]; fails at `node` with "expected lo..hi, got N" otherwise
+/// (a number beyond 64 bits, or with a fraction, fails as as_int() fails).
+std::int64_t require_int_in_range(const ConfigNode& node, std::int64_t lo, std::int64_t hi);
+
+/// `node` as text with something besides blanks (a name); fails at `node` with "expected a
+/// non-blank `what`, got '...'" otherwise.
+std::string require_non_blank(const ConfigNode& node, std::string_view what);
+
 /// A number as an error message shows it: `significant` digits, no trailing zeros (300, 0.15,
 /// 1e-05, 3e+09), so that a message quotes what was written rather than 300.000000.
 std::string number_for_message(double v, int significant = 6);

@@ -18,6 +18,9 @@
 
 namespace spidar::vision {
 
+/// The largest ChromaKeyParams::cleanup_radius_px [px].
+inline constexpr int kMaxCleanupRadius_px = 10;
+
 struct ChromaKeyParams {
   double s_foreground = 0.10;   ///< s at or below this: alpha = 1 (hand)
   double s_background = 0.35;   ///< s at or above this: alpha = 0 (screen)
