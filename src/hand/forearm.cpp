@@ -28,6 +28,11 @@ Mat3 wrist_bend(const Mat3& R_WH, const Vec3& toward_elbow_W) {
   return Quat::FromTwoVectors(-R_WH.col(1), toward_elbow_W).toRotationMatrix();
 }
 
+Pose forearm_pose(const Pose& X_WH, const Vec3& toward_elbow_W) {
+  const Mat3 R = X_WH.R.toRotationMatrix();
+  return Pose{Quat(wrist_bend(R, toward_elbow_W) * R).normalized(), X_WH.p};
+}
+
 Vec3 elbow_in_line(const HandParams& q, double forearm_length_m) {
   return q.p_W_wrist() - forearm_length_m * rotation_from_vector(q.r_W_hand()).col(1);
 }

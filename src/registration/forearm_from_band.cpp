@@ -35,8 +35,7 @@ std::optional<Vec3> forearm_from_band(const Pose& X_WH, double hand_width_m, con
   // The cost of the forearm bent_forearm_H(bend, φ); +∞ where its band is not in front of the camera.
   auto cost_of = [&](double bend, double phi) {
     const Vec3 d_H = bent_forearm_H(bend, phi);
-    const Vec3 d_W = R * d_H;
-    const Pose X_WF{Quat(hand::wrist_bend(R, d_W) * R).normalized(), X_WH.p};
+    const Pose X_WF = hand::forearm_pose(X_WH, R * d_H);
     constexpr double kInf = std::numeric_limits<double>::infinity();
     const BandProfile profile = bracelet_band_profile(X_WF, hand_width_m, camera, params, across,
                                                          kForearmBandSamplesPerRim);

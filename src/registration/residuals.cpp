@@ -13,6 +13,7 @@
 #include "spidar/core/units.hpp"
 #include "spidar/hand/forearm.hpp"
 #include "spidar/registration/coverage.hpp"
+#include "spidar/vision/bracelet.hpp"
 
 #include "residual_terms.hpp"
 
@@ -304,34 +305,62 @@ void for_each_near_triangle(const BandNearSide& n, F&& f) {
   }
 }
 
+/// The near side's area [px²], first moment [px³] and second moments about the image origin
+/// [px⁴], summed over its triangles (a triangle's second moment: A/12 (Σ vᵢvᵢᵀ + (Σ vᵢ)(Σ vᵢ)ᵀ)).
+struct NearSideMoments {
+  double area = 0;
+  Vec2 first = Vec2::Zero();
+  Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
+};
+
+NearSideMoments near_side_moments(const BandNearSide& n) {
+  NearSideMoments m;
+  for_each_near_triangle(n, [&](const Vec2& p0, const Vec2& p1, const Vec2& p2) {
+    const Vec2 e1 = p1 - p0, e2 = p2 - p0;
+    const double t = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    const Vec2 sum = p0 + p1 + p2;
+    m.area += t;
+    m.first += t * sum / 3.0;
+    m.second += (t / 12.0) * (p0 * p0.transpose() + p1 * p1.transpose() + p2 * p2.transpose() + sum * sum.transpose());
+  });
+  return m;
+}
+
+/// The near side's rim points' smallest and largest image coordinate along `dir` [px], and the
+/// world points where they are (lo > hi when none is near).
+struct NearSideExtent {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  std::array<Vec3, 2> ends{};
+};
+
+NearSideExtent near_side_extent(const BandNearSide& n, const Vec2& dir) {
+  NearSideExtent e;
+  for (int r = 0; r < 2; ++r)
+    for (int k = 0; k < n.samples; ++k) {
+      if (!n.near[r][k]) continue;
+      const double u = n.image[r][k].dot(dir);
+      if (u < e.lo) e.lo = u, e.ends[0] = n.point[r][k];
+      if (u > e.hi) e.hi = u, e.ends[1] = n.point[r][k];
+    }
+  return e;
+}
+
 }  // namespace
 
 BandProfile bracelet_band_profile(const Pose& X_WH, double hand_width_m, const vision::Camera& camera,
                                   const RegistrationParams& params, const Vec2& across_px, int samples_per_rim) {
   BandNearSide n;
   if (!band_near_side(X_WH, hand_width_m, camera, params, samples_per_rim, &n)) return BandProfile{};
+  const NearSideExtent e = near_side_extent(n, across_px);
+  if (!(e.hi > e.lo)) return BandProfile{};
+  const NearSideMoments m = near_side_moments(n);
   BandProfile out;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (int r = 0; r < 2; ++r)
-    for (int k = 0; k < n.samples; ++k) {
-      if (!n.near[r][k]) continue;
-      const double u = n.image[r][k].dot(across_px);
-      if (u < lo) lo = u, out.ends[0] = n.point[r][k];
-      if (u > hi) hi = u, out.ends[1] = n.point[r][k];
-    }
-  if (!(hi > lo)) return BandProfile{};
-  // The near side's triangles: their areas and centroids along across_px.
-  double area = 0, moment = 0;
-  for_each_near_triangle(n, [&](const Vec2& p0, const Vec2& p1, const Vec2& p2) {
-    const Vec2 e1 = p1 - p0, e2 = p2 - p0;
-    const double t = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-    area += t;
-    moment += t * (p0 + p1 + p2).dot(across_px) / 3.0;
-  });
-  out.lo_px = lo;
-  out.hi_px = hi;
-  out.area_px = area;
-  out.centroid_px = area > 0 ? moment / area : 0.5 * (lo + hi);
+  out.ends = e.ends;
+  out.lo_px = e.lo;
+  out.hi_px = e.hi;
+  out.area_px = m.area;
+  out.centroid_px = m.area > 0 ? m.first.dot(across_px) / m.area : 0.5 * (e.lo + e.hi);
   return out;
 }
 
@@ -339,35 +368,14 @@ std::optional<Vec2> bracelet_midpoint_px(const Pose& X_WF, double hand_width_m, 
                                          const RegistrationParams& params, int samples_per_rim) {
   BandNearSide n;
   if (!band_near_side(X_WF, hand_width_m, camera, params, samples_per_rim, &n)) return std::nullopt;
-  // The near side's area, centroid and second moments about the origin (a triangle's:
-  // A/12 (Σ vᵢvᵢᵀ + (Σ vᵢ)(Σ vᵢ)ᵀ)).
-  double area = 0;
-  Vec2 first = Vec2::Zero();
-  Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
-  for_each_near_triangle(n, [&](const Vec2& p0, const Vec2& p1, const Vec2& p2) {
-    const Vec2 e1 = p1 - p0, e2 = p2 - p0;
-    const double t = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-    const Vec2 sum = p0 + p1 + p2;
-    area += t;
-    first += t * sum / 3.0;
-    second += (t / 12.0) * (p0 * p0.transpose() + p1 * p1.transpose() + p2 * p2.transpose() + sum * sum.transpose());
-  });
-  if (!(area > 1e-9)) return std::nullopt;
-  const Vec2 c = first / area;
-  const Eigen::Matrix2d cov = second / area - c * c.transpose();
-  // The major axis, as vision/bracelet.cpp takes it from the red pixels' moments.
-  const double angle = 0.5 * std::atan2(2.0 * cov(0, 1), cov(0, 0) - cov(1, 1));
-  const Vec2 axis(std::cos(angle), std::sin(angle));
-  double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
-  for (int r = 0; r < 2; ++r)
-    for (int k = 0; k < n.samples; ++k) {
-      if (!n.near[r][k]) continue;
-      const double t = (n.image[r][k] - c).dot(axis);
-      t_min = std::min(t_min, t);
-      t_max = std::max(t_max, t);
-    }
-  if (!(t_max > t_min)) return std::nullopt;
-  const Vec2 out = c + 0.5 * (t_min + t_max) * axis;
+  const NearSideMoments m = near_side_moments(n);
+  if (!(m.area > 1e-9)) return std::nullopt;
+  const Vec2 c = m.first / m.area;
+  // The major axis, as the detector takes it from the red pixels' moments.
+  const Vec2 axis = vision::major_axis(m.second / m.area - c * c.transpose());
+  const NearSideExtent e = near_side_extent(n, axis);
+  if (!(e.hi > e.lo)) return std::nullopt;
+  const Vec2 out = c + (0.5 * (e.lo + e.hi) - c.dot(axis)) * axis;
   if (!out.allFinite()) return std::nullopt;
   return out;
 }
@@ -380,6 +388,50 @@ double bracelet_band_thickness(const Pose& X_WH, double hand_width_m, const visi
   if (ends) *ends = b.ends;
   return b.hi_px - b.lo_px;
 }
+
+namespace {
+
+/// The wrist terms' frozen targets (FrozenTargets' wrist, band and thickness parts) at pose q
+/// (PoseState s), when the bracelet was detected.
+void freeze_wrist(const ResidualProblem& pr, const hand::HandParams& q, const detail::PoseState& s,
+                  const vision::Camera& camera, FrozenTargets* tg) {
+  const HandObservation& obs = *pr.observation;
+  const Pose X_WH = hand::hand_pose(q);
+  const double width = pr.model->shape.dimensions.width;
+  Vec3 p = bracelet_visible_point(X_WH, width, camera.X_WC().p, *pr.params, &tg->bracelet_shift_W, obs.forearm_H);
+  tg->wrist_active = camera.depth(p) >= detail::kMinImageDepth;
+  if (!tg->wrist_active) return;
+  if (pr.params->bracelet_detector_midpoint) {
+    // The point at the visible point's depth that projects where the detector would put the
+    // band's midpoint: the shift, frozen, moves it with the band's centre.
+    const Pose X_WF = hand::forearm_pose(X_WH, X_WH.R * obs.forearm_H);
+    if (const auto m = bracelet_midpoint_px(X_WF, width, camera, *pr.params)) {
+      const Vec3 centre = p - tg->bracelet_shift_W;
+      p = camera.unproject(*m, camera.depth(p));
+      tg->bracelet_shift_W = p - centre;
+    }
+  }
+  if (pr.params->bracelet_length_sigma > 0 && std::isfinite(obs.wrist_length_px) && obs.wrist_length_px > 0) {
+    const auto ends = bracelet_band_ends(X_WH, width, camera.X_WC().p, *pr.params);
+    tg->band_active =
+        camera.depth(ends[0]) >= detail::kMinImageDepth && camera.depth(ends[1]) >= detail::kMinImageDepth;
+    // Right-hand H coordinates (PoseState::A maps them to world), so that rigid_point moves them.
+    for (std::size_t k = 0; k < 2; ++k) tg->band_end_H[k] = s.A.transpose() * (ends[k] - s.p_W_wrist);
+  }
+  const Vec2& axis = obs.wrist_axis_px;
+  if (pr.params->bracelet_thickness_sigma > 0 && std::isfinite(obs.wrist_thickness_px) &&
+      obs.wrist_thickness_px > 0 && axis.allFinite() && std::abs(axis.squaredNorm() - 1.0) < 1e-6) {
+    const Vec2 across(-axis.y(), axis.x());
+    std::array<Vec3, 2> ends;
+    if (bracelet_band_thickness(X_WH, width, camera, *pr.params, across, &ends) > 0) {
+      tg->thickness_active = true;
+      tg->thickness_dir_px = across;
+      for (std::size_t k = 0; k < 2; ++k) tg->thickness_end_H[k] = s.A.transpose() * (ends[k] - s.p_W_wrist);
+    }
+  }
+}
+
+}  // namespace
 
 void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, FrozenTargets* tg) {
   tg->wrist_active = false;
@@ -395,48 +447,7 @@ void freeze_targets(const ResidualProblem& pr, const hand::HandParams& q, Frozen
   detail::PoseState s;
   detail::pose_state(*pr.model, q, false, &s);
   tg->bracelet_shift_W = Vec3::Zero();
-  if (detail::wrist_observed(*pr.observation)) {
-    const Pose X_WH = hand::hand_pose(q);
-    const double width = pr.model->shape.dimensions.width;
-    Vec3 p = bracelet_visible_point(X_WH, width, camera.X_WC().p, *pr.params, &tg->bracelet_shift_W,
-                                    pr.observation->forearm_H);
-    tg->wrist_active = camera.depth(p) >= detail::kMinImageDepth;
-    if (tg->wrist_active && pr.params->bracelet_detector_midpoint) {
-      // The point at the visible point's depth that projects where the detector would put the
-      // band's midpoint: the shift, frozen, moves it with the band's centre.
-      const Mat3 R = X_WH.R.toRotationMatrix();
-      const Pose X_WF{Quat(hand::wrist_bend(R, R * pr.observation->forearm_H) * R).normalized(), X_WH.p};
-      if (const auto m = bracelet_midpoint_px(X_WF, width, camera, *pr.params)) {
-        const Vec3 centre = p - tg->bracelet_shift_W;
-        p = camera.unproject(*m, camera.depth(p));
-        tg->bracelet_shift_W = p - centre;
-      }
-    }
-    const HandObservation& obs = *pr.observation;
-    if (tg->wrist_active && pr.params->bracelet_length_sigma > 0 && std::isfinite(obs.wrist_length_px) &&
-        obs.wrist_length_px > 0) {
-      const auto ends = bracelet_band_ends(hand::hand_pose(q), pr.model->shape.dimensions.width,
-                                           camera.X_WC().p, *pr.params);
-      tg->band_active = camera.depth(ends[0]) >= detail::kMinImageDepth &&
-                        camera.depth(ends[1]) >= detail::kMinImageDepth;
-      // Right-hand H coordinates (PoseState::A maps them to world), so that rigid_point moves them.
-      for (std::size_t k = 0; k < 2; ++k) tg->band_end_H[k] = s.A.transpose() * (ends[k] - s.p_W_wrist);
-    }
-    const Vec2& axis = obs.wrist_axis_px;
-    if (tg->wrist_active && pr.params->bracelet_thickness_sigma > 0 &&
-        std::isfinite(obs.wrist_thickness_px) && obs.wrist_thickness_px > 0 && axis.allFinite() &&
-        std::abs(axis.squaredNorm() - 1.0) < 1e-6) {
-      const Vec2 across(-axis.y(), axis.x());
-      std::array<Vec3, 2> ends;
-      if (bracelet_band_thickness(hand::hand_pose(q), pr.model->shape.dimensions.width, camera, *pr.params,
-                                  across, &ends) > 0) {
-        tg->thickness_active = true;
-        tg->thickness_dir_px = across;
-        for (std::size_t k = 0; k < 2; ++k)
-          tg->thickness_end_H[k] = s.A.transpose() * (ends[k] - s.p_W_wrist);
-      }
-    }
-  }
+  if (detail::wrist_observed(*pr.observation)) freeze_wrist(pr, q, s, camera, tg);
   if (!image->alpha.empty() && (image->alpha.type() == CV_32FC1 || image->alpha.type() == CV_8UC1)) {
     joint_ball_targets(*pr.model, s.points, camera, image->alpha, *pr.params, &tg->balls);
     if (pr.params->silhouette_term && pr.params->digit_axis_sigma_px > 0)

@@ -16,6 +16,11 @@ constexpr int kMaxImagePixels = 16384 * 16384;
 constexpr int kMaxImageSpanPx = 16384 * 2;
 }  // namespace
 
+Vec2 major_axis(const Eigen::Matrix2d& cov) {
+  const double angle = 0.5 * std::atan2(2.0 * cov(0, 1), cov(0, 0) - cov(1, 1));
+  return {std::cos(angle), std::sin(angle)};
+}
+
 Status validate(const BraceletParams& p) {
   auto bad = [](const std::string& m) { return Status(Error{"bracelet: " + m}); };
   if (p.hue_low_max < 0 || p.hue_low_max > 60) return bad("hue_low_max: expected 0..60");
@@ -118,13 +123,16 @@ double principal_sd(const Accum& q, double sign) {
 }
 double minor_sd(const Accum& q) { return principal_sd(q, -1.0); }
 
-/// Unit direction of a pixel set's principal (long) axis.
-Vec2 major_axis(const Accum& q) {
+/// The covariance of a pixel set [px²].
+Eigen::Matrix2d covariance(const Accum& q) {
   const double cx = q.sx / q.n, cy = q.sy / q.n;
-  const double cxx = q.sxx / q.n - cx * cx, cxy = q.sxy / q.n - cx * cy, cyy = q.syy / q.n - cy * cy;
-  const double angle = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);
-  return {std::cos(angle), std::sin(angle)};
+  Eigen::Matrix2d c;
+  c << q.sxx / q.n - cx * cx, q.sxy / q.n - cx * cy, q.sxy / q.n - cx * cy, q.syy / q.n - cy * cy;
+  return c;
 }
+
+/// Unit direction of a pixel set's principal (long) axis.
+Vec2 major_axis(const Accum& q) { return vision::major_axis(covariance(q)); }
 
 double box_gap(const cv::Rect& a, const cv::Rect& b) {
   const int dx = std::max({0, b.x - (a.x + a.width), a.x - (b.x + b.width)});
@@ -262,11 +270,7 @@ void find_bracelet_candidates(const cv::Mat& mask, const BraceletParams& p, Brac
                r.y + r.height == mask.rows;
     }
     const Vec2 c(acc.sx / acc.n, acc.sy / acc.n);
-    const double cxx = acc.sxx / acc.n - c.x() * c.x();
-    const double cxy = acc.sxy / acc.n - c.x() * c.y();
-    const double cyy = acc.syy / acc.n - c.y() * c.y();
-    const double angle = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);  // major axis
-    const Vec2 axis(std::cos(angle), std::sin(angle));
+    const Vec2 axis = major_axis(acc);
     const Vec2 across(-axis.y(), axis.x());
     double t_min = 1e300, t_max = -1e300, s_min = 1e300, s_max = -1e300;
     for (int id : members) {

@@ -118,9 +118,9 @@ Result<Capture> Capture::open(const std::string& source, const CaptureOptions& o
       // The first file's declared size (a sequence's files share one): a foreign or damaged file
       // declaring a huge image is refused before OpenCV decodes it.
       if (const auto size = image_file_size(*first);
-          size && !declares_at_most(*size, kMaxImagePixels)) {
+          size && !declares_at_most(*size, kMaxDecodedPixels)) {
         return Error{"image sequence " + source + ": " + *first + " declares " + std::to_string(size->width) + "x" +
-                     std::to_string(size->height) + " px; expected 1 to " + std::to_string(kMaxImagePixels) + " pixels"};
+                     std::to_string(size->height) + " px; expected 1 to " + std::to_string(kMaxDecodedPixels) + " pixels"};
       }
       if (!cap->open(source, cv::CAP_IMAGES) || !cap->isOpened()) {
         return Error{"image sequence " + source + ": OpenCV cannot read it"};

@@ -342,6 +342,7 @@ int main(int argc, char** argv) {
   std::array<double, 6> brace_k{};
   std::vector<double> brace_term;
   std::vector<double> brace_pred;  // the detector's midpoint predicted from the true band (bracelet_midpoint_px)
+  std::vector<double> brace_term_where_pred;  // brace_term on the frames brace_pred has (like for like)
   std::array<double, 6> joint_part_sum{}, joint_floor_sum{}, joint_part_n{};  // wrist, thumb … little
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
@@ -587,12 +588,11 @@ int main(int argc, char** argv) {
       brace_term.push_back((det - camera.project(registration::bracelet_visible_point(
                                       X_WH, truth_models[h].shape.dimensions.width, camera.X_WC().p,
                                       p.registration, nullptr))).norm());
-      {
-        const Pose X_WF{Quat(hand::wrist_bend(X_WH.R.toRotationMatrix(), -axis) * X_WH.R.toRotationMatrix()).normalized(),
-                        X_WH.p};
-        if (const auto mid = registration::bracelet_midpoint_px(X_WF, truth_models[h].shape.dimensions.width, camera,
-                                                                p.registration))
-          brace_pred.push_back((det - *mid).norm());
+      if (const auto mid = registration::bracelet_midpoint_px(hand::forearm_pose(X_WH, -axis),
+                                                              truth_models[h].shape.dimensions.width, camera,
+                                                              p.registration)) {
+        brace_pred.push_back((det - *mid).norm());
+        brace_term_where_pred.push_back(brace_term.back());
       }
       for (int k = 0; k < 6; ++k)
         brace_k[k] += (det - camera.project(p_WB + 0.2 * k * radius * n)).norm();
@@ -854,8 +854,10 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 6; ++k) std::printf("  shift %.1f r: %.2f px\n", 0.2 * k, brace_k[k] / std::max(brace_n, 1));
   std::printf("  the wrist term's point at the true pose: %.2f px (p95 %.2f)\n", mean(brace_term),
               quantile(brace_term, 0.95));
-  std::printf("  the detector's midpoint predicted from the true band: %.2f px (p95 %.2f)\n", mean(brace_pred),
-              quantile(brace_pred, 0.95));
+  std::printf("  the detector's midpoint predicted from the true band: %.2f px (p95 %.2f) on %zu of %zu frames "
+              "(the wrist term's point on the same frames: %.2f px)\n",
+              mean(brace_pred), quantile(brace_pred, 0.95), brace_pred.size(), brace_term.size(),
+              mean(brace_term_where_pred));
   if (!chord_ratio.empty()) {
     std::sort(chord_ratio.begin(), chord_ratio.end());
     auto q = [&](double f) { return chord_ratio[static_cast<std::size_t>(f * static_cast<double>(chord_ratio.size() - 1))]; };

@@ -180,7 +180,7 @@ TEST(BraceletMidpoint, TheWristTermExpectsItWhenAsked) {
       continue;
     }
     const Mat3 R = X_WH.R.toRotationMatrix();
-    const Pose X_WF{Quat(hand::wrist_bend(R, R * obs.forearm_H) * R).normalized(), X_WH.p};
+    const Pose X_WF = hand::forearm_pose(X_WH, R * obs.forearm_H);
     const auto m = bracelet_midpoint_px(X_WF, model.shape.dimensions.width, camera, p);
     ASSERT_TRUE(m.has_value());
     EXPECT_NEAR((camera.project(expected_point) - *m).norm(), 0.0, 1e-6);

@@ -46,6 +46,13 @@ TEST(RegistrationParams, ValidateNamesTheField) {
   EXPECT_NE(validate(p).error().message.find("digit_axis_sigma_px"), std::string::npos);
 }
 
+TEST(RegistrationParams, TheDetectorMidpointSwitchIsRead) {
+  const auto root = core::ConfigNode::Parse("registration:\n  bracelet_detector_midpoint: true\n", "r.yaml");
+  EXPECT_TRUE(parse_registration_params(root["registration"]).bracelet_detector_midpoint);
+  const auto off = core::ConfigNode::Parse("registration:\n  bracelet_detector_midpoint: false\n", "r.yaml");
+  EXPECT_FALSE(parse_registration_params(off["registration"]).bracelet_detector_midpoint);
+}
+
 TEST(RegistrationParams, ShippedConfigIsTheDefaults) {
   const auto root = core::ConfigNode::LoadFile(SPIDAR_SOURCE_DIR "/configs/registration.yaml");
   const RegistrationParams p = parse_registration_params(root["registration"]);

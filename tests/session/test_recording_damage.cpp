@@ -184,13 +184,23 @@ TEST(CsvWithAByteOrderMark, IsReadAsWithout) {
   const fs::path dir = tmp.path() / "rec";
   write_test_recording(make_test_recording(FrameStore::kPng), dir);
   const Recording plain = read_recording(dir.string());
-  for (const char* file : {"frames.csv", "fingertips.csv", "fits.csv"})
+  for (const char* file : {"frames.csv", "fingertips.csv", "fits.csv", "scene.csv"})
     spit(dir / file, "\xEF\xBB\xBF" + slurp(dir / file));
   const Recording marked = read_recording(dir.string());
   EXPECT_EQ(marked.frames.size(), plain.frames.size());
   EXPECT_EQ(marked.fingertips.size(), plain.fingertips.size());
+  EXPECT_EQ(marked.scene.size(), plain.scene.size());
   ASSERT_FALSE(marked.frames.empty());
   EXPECT_EQ(marked.frames.back().measured.p_W[1][2], plain.frames.back().measured.p_W[1][2]);
+  // A damaged header after the mark: its column counts the mark's three bytes, as the file holds them.
+  const int col = set_field(dir / "fingertips.csv", 1, 5, "p0_x");
+  try {
+    (void)read_recording(dir.string());
+    FAIL() << "an unknown column after a byte-order mark was read";
+  } catch (const RecordingError& e) {
+    const std::string at = (dir / "fingertips.csv").string() + ":1:" + std::to_string(col) + ": ";
+    EXPECT_NE(std::string(e.what()).find(at + "unknown column 'p0_x'"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(Damage, ADirectoryOrAFifoInPlaceOfAnImageIsNamedForWhatItIs) {

@@ -98,10 +98,10 @@ TEST(ImageFile, AHeaderDeclaringAHugeImageIsRefusedWithoutDecoding) {
   ASSERT_FALSE(cap.ok());
   EXPECT_NE(cap.error().message.find("seq_0003.png declares 30000x30000 px"), std::string::npos) << cap.error().message;
   // Sides whose product would overflow 64 bits, and a zero side.
-  EXPECT_FALSE(declares_at_most({0xFFFFFFFFll, 0xFFFFFFFFll, "PNG"}, kMaxImagePixels));
-  EXPECT_FALSE(declares_at_most({0, 10, "PNG"}, kMaxImagePixels));
-  EXPECT_TRUE(declares_at_most({8192, 8192, "PNG"}, kMaxImagePixels));
-  EXPECT_FALSE(declares_at_most({8192, 8193, "PNG"}, kMaxImagePixels));
+  EXPECT_FALSE(declares_at_most({0xFFFFFFFFll, 0xFFFFFFFFll, "PNG"}, kMaxDecodedPixels));
+  EXPECT_FALSE(declares_at_most({0, 10, "PNG"}, kMaxDecodedPixels));
+  EXPECT_TRUE(declares_at_most({8192, 8192, "PNG"}, kMaxDecodedPixels));
+  EXPECT_FALSE(declares_at_most({8192, 8193, "PNG"}, kMaxDecodedPixels));
 }
 
 }  // namespace

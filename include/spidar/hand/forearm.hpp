@@ -7,6 +7,7 @@
 /// and bends away from the hand's axis by at most a given angle, the same in every direction (a
 /// cone: a simplification of the wrist's flexion and deviation ranges); beyond it, the elbow gives
 /// way.
+#include "spidar/core/pose.hpp"
 #include "spidar/core/types.hpp"
 #include "spidar/hand/parameters.hpp"
 
@@ -21,6 +22,10 @@ Vec3 forearm_direction(const Mat3& R_WH, const Vec3& p_W_wrist, const Vec3& p_W_
 /// toward_elbow_W (unit). Applied to the forearm drawn in line with the hand, it points the
 /// forearm along toward_elbow_W, pronated with the hand.
 Mat3 wrist_bend(const Mat3& R_WH, const Vec3& toward_elbow_W);
+
+/// The forearm's frame F: the hand's pose X_WH bent at the wrist (wrist_bend) so that its −y axis
+/// points along toward_elbow_W (unit, world); at the wrist, p_WF = p_WH.
+Pose forearm_pose(const Pose& X_WH, const Vec3& toward_elbow_W);
 
 /// The elbow of a forearm in line with the hand at pose q, forearm_length_m from the wrist [world].
 Vec3 elbow_in_line(const HandParams& q, double forearm_length_m);

@@ -105,6 +105,10 @@ struct BraceletWorkspace {
   std::vector<BraceletCandidate> candidates;
 };
 
+/// Unit direction of the major (long) axis of a pixel set whose covariance is `cov` [px²]: the
+/// detector's axis of a band, which the registration's bracelet midpoint mirrors.
+Vec2 major_axis(const Eigen::Matrix2d& cov);
+
 /// The red mask (CV_8UC1, 255 = red) of an 8-bit BGR frame.
 Status red_mask(const cv::Mat& bgr, const BraceletParams& params, cv::Mat* mask);
 

@@ -18,7 +18,7 @@ namespace spidar::vision {
 
 /// The largest image read_image decodes by default [px]: 64 Mpx, more than any camera's frame or
 /// calibration picture.
-inline constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 26;
+inline constexpr std::int64_t kMaxDecodedPixels = std::int64_t{1} << 26;
 
 /// Width and height [px] an image file declares in its header.
 struct ImageFileSize {
@@ -36,6 +36,6 @@ bool declares_at_most(const ImageFileSize& s, std::int64_t max_pixels);
 
 /// cv::imread(path, flags) after the header's size is checked: Error naming the file when it
 /// declares more than `max_pixels` (or a zero size), or when nothing decodes.
-Result<cv::Mat> read_image(const std::string& path, int flags, std::int64_t max_pixels = kMaxImagePixels);
+Result<cv::Mat> read_image(const std::string& path, int flags, std::int64_t max_pixels = kMaxDecodedPixels);
 
 }  // namespace spidar::vision
