@@ -31,7 +31,7 @@ double quantile(std::vector<double> v, double q) {
   return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
 }
 /// `v` with `decimals` digits after the point.
-std::string number_text(double v, int decimals) {
+std::string fixed_text(double v, int decimals) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(decimals) << v;
   return o.str();
@@ -545,24 +545,24 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
   write_frames_csv((dir / "frames.csv").string(), t, s.phases);
   if (frames > 1) write_plots(dir, t, s);
 
+  const std::size_t scored_in_image = reg["frames_scored_in_image"].get<std::size_t>();
   os << "\nresult (" << frames << " frames in " << std::fixed << std::setprecision(1) << s.wall_s
      << " s, " << s.dropped << " dropped"
      << (s.camera_skipped > 0 ? ", " + std::to_string(s.camera_skipped) + " not filmed in time by the simulated camera" : std::string())
      << "):\n"
      << std::setprecision(3)
-     << (reg["frames_scored_in_image"].get<std::size_t>() < static_cast<std::size_t>(frames)
+     << (scored_in_image < static_cast<std::size_t>(frames)
              ? "  warning        the hands were out of the camera's view in " +
-                   std::to_string(static_cast<std::size_t>(frames) - reg["frames_scored_in_image"].get<std::size_t>()) +
-                   " frames: IoU and joints are over the other " +
-                   std::to_string(reg["frames_scored_in_image"].get<std::size_t>()) +
+                   std::to_string(static_cast<std::size_t>(frames) - scored_in_image) +
+                   " frames: IoU and joints are over the other " + std::to_string(scored_in_image) +
                    " (frames_scored_in_image); check the camera's pose and the scene\n"
              : std::string())
      << "  registration   "
-     << (reg["frames_scored_in_image"].get<std::size_t>() == 0
+     << (scored_in_image == 0
              ? std::string("IoU n/a, joints n/a (no hand in view in any frame)")
-             : "IoU mean " + number_text(reg["iou_mean"].get<double>(), 3) + " (p5 " +
-                   number_text(reg["iou_p5"].get<double>(), 3) + "), joints " +
-                   number_text(reg["joint_px_mean"].get<double>(), 2) + " px")
+             : "IoU mean " + fixed_text(reg["iou_mean"].get<double>(), 3) + " (p5 " +
+                   fixed_text(reg["iou_p5"].get<double>(), 3) + "), joints " +
+                   fixed_text(reg["joint_px_mean"].get<double>(), 2) + " px")
      << ", fingertip " << std::setprecision(2) << reg["fingertip_mm_mean"].get<double>() << " mm, wrist depth " << std::setprecision(1) << reg["wrist_depth_mm_mean"].get<double>() << " mm, "
      << std::setprecision(2) << reg["ms_per_frame_median"].get<double>() << " ms/frame (both hands), "
      << reg["iterations_mean"].get<double>() << " iterations\n"
