@@ -79,6 +79,21 @@ Action add_demo(CLI::App& app) {
   cmd->add_flag_callback("--no-idle-spin", [o] { o->idle_spin = 0; }, "let the servo's CPU halt between cycles "
                          "(the rubiks scenario's default)");
   cmd->add_option("--seed", o->seed, "random seed")->check(seed_check())->capture_default_str();
+  // Options of the mixed-reality demo alone (the camera, the hands, the registration, the video)
+  // are a mistake with the haptic or strings scenario, which would ignore them.
+  cmd->parse_complete_callback([cmd, o] {
+    if (o->scenario == "rubiks") return;
+    for (const CLI::Option* opt : cmd->get_options()) {
+      if (opt->count() == 0) continue;
+      const std::string name = opt->get_name();
+      const bool everywhere = name == "--scenario" || name == "--config" || name == "--out" || name == "--seconds" ||
+                              name == "--rate" || name == "--idle-spin" || name == "--no-idle-spin" ||
+                              name == "--seed" || name == "--help";
+      if (everywhere || (name == "--scene" && o->scenario == "haptic")) continue;
+      throw CLI::ValidationError(name, "applies to --scenario " + std::string(name == "--scene" ? "rubiks or haptic" : "rubiks") +
+                                           ", not to --scenario " + o->scenario);
+    }
+  });
   return [o] {
     require_range(o->seconds, 0, 600, "--seconds", "s");
     require_range(o->rate_hz, 10, 20000, "--rate", "Hz");

@@ -95,6 +95,13 @@ TEST(CliRefusals, AnOptionOfTheOtherBackendIsRefused) {
   expect_refused("calibrate-strings --backend sim --baud 9600", "--baud: applies to --backend serial");
 }
 
+TEST(CliRefusals, AnOptionOfTheMixedRealityDemoIsRefusedInTheOtherScenarios) {
+  expect_refused("demo --scenario haptic --camera configs/camera.yaml", "--camera: applies to --scenario rubiks, not to --scenario haptic");
+  expect_refused("demo --scenario strings --no-video", "--no-video: applies to --scenario rubiks, not to --scenario strings");
+  expect_refused("demo --scenario strings --scene scenes/blocks.xml", "--scene: applies to --scenario rubiks or haptic");
+  expect_refused("demo --scenario haptic --user-hand configs/users/large.yaml", "--user-hand: applies to --scenario rubiks");
+}
+
 TEST(CliRefusals, RunRecordsOnlyIntoANewOrEmptyFolderAndSaysSoBeforeStarting) {
   const fs::path tmp = spidar::test::temp_dir("spidar_cli_refusals_record");
   fs::create_directories(tmp / "mine");

@@ -14,6 +14,7 @@
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/vision/camera.hpp"
+#include "band_near_side_points.hpp"
 
 namespace spidar::registration {
 namespace {
@@ -95,8 +96,6 @@ TEST(BraceletMidpoint, IsWhereTheDetectorsRulePutsTheBandsPixels) {
   RegistrationParams p;
   const vision::Camera camera = vision::default_rig_camera();
   const double width = 0.083;
-  const double a = bracelet_radius_m(p, width);
-  const double b = p.bracelet_depth_ratio * p.bracelet_radius_per_width * width + p.bracelet_standoff_m;
   const Vec3 p_W_wrist = camera.X_WC().p + 0.45 * (camera.X_WC().R * Vec3::UnitZ());  // 45 cm ahead
   int checked = 0;
   for (const Vec3& rot : {Vec3(0, 0, 0), Vec3(0.3, -0.2, 1.0), Vec3(-1.2, 0.4, 0.1), Vec3(1.4, 0.2, -0.5)}) {
@@ -109,18 +108,9 @@ TEST(BraceletMidpoint, IsWhereTheDetectorsRulePutsTheBandsPixels) {
       ASSERT_TRUE(predicted.has_value());
       // The pixels.
       cv::Mat mask(camera.height(), camera.width(), CV_8UC1, cv::Scalar(0));
-      const Vec3 x = R_F.col(0), y = R_F.col(1), z = R_F.col(2);
-      for (int j = 0; j <= 60; ++j) {
-        const double along = p.bracelet_offset_m + p.bracelet_width_m * (j / 60.0 - 0.5);
-        for (int k = 0; k < 2000; ++k) {
-          const double phi = 2.0 * 3.14159265358979 * k / 2000;
-          const Vec3 q = X_WH.p - along * y + a * std::cos(phi) * x + b * std::sin(phi) * z;
-          const Vec3 normal = (std::cos(phi) / a) * x + (std::sin(phi) / b) * z;
-          if (normal.dot(camera.X_WC().p - q) <= 0) continue;
-          const Vec2 uv = camera.project(q);
-          const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
-          if (u >= 0 && v >= 0 && u < mask.cols && v < mask.rows) mask.at<std::uint8_t>(v, u) = 255;
-        }
+      for (const Vec2& uv : testing::band_near_side_points(R_F, X_WH.p, width, camera, p, 60, 2000)) {
+        const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
+        if (u >= 0 && v >= 0 && u < mask.cols && v < mask.rows) mask.at<std::uint8_t>(v, u) = 255;
       }
       const cv::Moments m = cv::moments(mask, true);
       ASSERT_GT(m.m00, 50.0);

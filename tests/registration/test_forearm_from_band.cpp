@@ -17,6 +17,7 @@
 #include "spidar/registration/forearm_from_band.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/vision/camera.hpp"
+#include "band_near_side_points.hpp"
 
 namespace spidar::registration {
 namespace {
@@ -27,21 +28,7 @@ namespace {
 BandObservation draw_band(const Pose& X_WH, const Vec3& d_W, double width, const vision::Camera& camera,
                           const RegistrationParams& p) {
   const Mat3 R = hand::wrist_bend(X_WH.R.toRotationMatrix(), d_W) * X_WH.R.toRotationMatrix();
-  const Vec3 x = R.col(0), y = R.col(1), z = R.col(2);
-  const double a = bracelet_radius_m(p, width);
-  const double b = p.bracelet_depth_ratio * p.bracelet_radius_per_width * width + p.bracelet_standoff_m;
-  std::vector<Vec2> pts;
-  constexpr int kAlong = 40;
-  for (int j = 0; j <= kAlong; ++j) {
-    const double along = p.bracelet_offset_m + p.bracelet_width_m * (static_cast<double>(j) / kAlong - 0.5);
-    for (int k = 0; k < 720; ++k) {
-      const double phi = 2.0 * 3.14159265358979 * k / 720;
-      const Vec3 q = X_WH.p - along * y + a * std::cos(phi) * x + b * std::sin(phi) * z;
-      const Vec3 normal = (std::cos(phi) / a) * x + (std::sin(phi) / b) * z;
-      if (normal.dot(camera.X_WC().p - q) <= 0) continue;
-      pts.push_back(camera.project(q));
-    }
-  }
+  const std::vector<Vec2> pts = testing::band_near_side_points(R, X_WH.p, width, camera, p, 40, 720);
   // Principal axis of the points (their covariance), then the extents.
   Vec2 mean = Vec2::Zero();
   for (const Vec2& q : pts) mean += q;
