@@ -46,7 +46,8 @@ Action add_calibrate_strings(CLI::App& app) {
                   "multi-point jig with N x N x N points around the frame centre (N >= 2; fits offsets, "
                   "metres per count and signs); 0 = pole calibration")
       ->capture_default_str();
-  cmd->add_option("--jig-spacing", a->jig_spacing, "jig point spacing [m]")->capture_default_str();
+  CLI::Option* spacing =
+      cmd->add_option("--jig-spacing", a->jig_spacing, "jig point spacing [m]")->capture_default_str();
   cmd->add_option("--hold", a->hold_s, "the fingertip must hold still this long before a sample [s]")
       ->capture_default_str();
   cmd->add_option("--tolerance", a->tolerance_mm, "largest string movement while holding still [mm]")
@@ -57,9 +58,11 @@ Action add_calibrate_strings(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--timeout", a->timeout_s, "give up on a finger after this long [s]")->capture_default_str();
   cmd->add_flag("--dry-run", a->dry_run, "print the results, do not write the config");
-  return [a] {
+  return [a, spacing] {
     if (!(a->jig == 0 || (a->jig >= 2 && a->jig <= 5)))
       throw UsageError("--jig: expected 0 (pole) or 2 to 5, got " + std::to_string(a->jig));
+    if (a->jig == 0 && spacing->count() > 0)
+      throw UsageError("--jig-spacing: applies to a jig (--jig 2 to 5), not to the pole calibration (--jig 0)");
     require_range(a->jig_spacing, 0.005, 0.2, "--jig-spacing", "m");
     require_range(a->hold_s, 0.05, 10, "--hold", "s");
     require_above(a->tolerance_mm, 0, 20, "--tolerance", "mm");

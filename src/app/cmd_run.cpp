@@ -69,15 +69,17 @@ Action add_run(CLI::App& app) {
   cmd->add_option("--seconds", a->seconds, "stop after this long [s] (0: until closed, Ctrl-C or SIGTERM)");
   cmd->add_flag("--headless", a->headless, "no window: process frames and print a summary");
   cmd->add_option("--record", a->record, "record the session into this new folder (docs/recording.md)");
-  cmd->add_option("--record-frames", a->record_frames,
+  CLI::Option* record_frames = cmd->add_option("--record-frames", a->record_frames,
                   "video: camera.mp4 (H.264: small, lossy); mjpg: camera.avi (Motion-JPEG: larger, "
                   "nearly lossless); png: frames/NNNNNN.png (lossless: replay reproduces the fits exactly)")
       ->check(CLI::IsMember({"video", "mjpg", "png"}))
       ->capture_default_str();
   cmd->add_option("--screenshot", a->screenshot,
                   "window: save the window's pixels to this PNG just before exiting (tests)");
-  return [a] {
+  return [a, record_frames] {
     require_range(a->seconds, 0, 86400, "--seconds", "s");
+    if (a->record.empty() && record_frames->count() > 0)
+      throw UsageError("--record-frames: applies with --record DIR (it chooses how the frames are recorded)");
     if (!a->screenshot.empty()) {
       if (a->headless) throw UsageError("--screenshot: saves the window's pixels; there is no window with --headless");
       check_output_file(a->screenshot, "--screenshot", "a PNG file");

@@ -82,6 +82,8 @@ TEST(CliRefusals, FingerListsAndRangesSayWhatIsExpected) {
   expect_refused("calibrate-strings --tolerance 0", "--tolerance: expected more than 0 and at most 20 mm, got 0");
   expect_refused("calibrate-strings --timeout 0", "--timeout: expected more than 0 and at most 600 s, got 0");
   expect_refused("calibrate-strings --jig 3 --jig-spacing 0.3", "--jig-spacing: expected 0.005 to 0.2 m, got 0.3");
+  expect_refused("calibrate-strings --jig-spacing 0.05", "--jig-spacing: applies to a jig (--jig 2 to 5), not to the pole calibration");
+  expect_refused("run --config configs/lab-example.yaml --headless --record-frames png", "--record-frames: applies with --record DIR");
   expect_refused("demo --seconds 1e-320", "--seconds: expected 0 to 600 s, got 9.99989e-321 (too small to be a value");
 }
 
