@@ -123,6 +123,18 @@ void check_output_dir(const std::string& dir, std::string_view option) {
   if (!fs::is_directory(absolute, ec))
     throw UsageError(what + ": exists and is not a folder; expected a folder for the outputs");
   if (::access(absolute.c_str(), W_OK | X_OK) != 0) throw UsageError(what + ": is a folder this user cannot write into");
+  // An output file's name taken by something else (a folder called report.json, a FIFO): found
+  // now rather than after the run has written its other files. The outputs are .json, .csv,
+  // .png, .mp4 and .avi files; a folder holding very many entries is scanned in part.
+  int seen = 0;
+  for (fs::directory_iterator it(absolute, ec); !ec && it != fs::directory_iterator() && seen < 10000; it.increment(ec), ++seen) {
+    const std::string ext = it->path().extension().string();
+    if (ext != ".json" && ext != ".csv" && ext != ".png" && ext != ".mp4" && ext != ".avi") continue;
+    std::error_code e2;  // a link to a file not yet there is written through: fine
+    if (fs::exists(it->path(), e2) && !fs::is_regular_file(it->path(), e2))
+      throw UsageError(what + ": " + core::printable_for_message(it->path().string()) +
+                       " is not a file, where an output file may go; remove it or choose another folder");
+  }
 }
 
 void check_output_file(const std::string& path, std::string_view option, std::string_view what_file) {

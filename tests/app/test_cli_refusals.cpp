@@ -46,6 +46,11 @@ TEST(CliRefusals, OutputFoldersAreCheckedBeforeAnythingAndARefusedRunLeavesNothi
   expect_refused("demo --out " + (tmp / "a_file").string(), "exists and is not a folder");
   expect_refused("demo --out " + (tmp / "a_file" / "sub").string(), "cannot be made: " + (tmp / "a_file").string() + " is not a folder");
   expect_refused("replay " + tmp.string() + " --out " + (tmp / "a_file").string(), "exists and is not a folder");
+  // Something other than a file where an output file goes: refused before the run writes the others.
+  fs::create_directories(tmp / "used" / "report.json");
+  expect_refused("demo --out " + (tmp / "used").string(),
+                 (tmp / "used" / "report.json").string() + " is not a file, where an output file may go");
+  expect_refused("replay " + tmp.string() + " --out " + (tmp / "used").string(), "report.json is not a file");
   // A bad input: refused, and the output folder it named was not made.
   const fs::path fresh = tmp / "fresh";
   expect_refused("demo --out " + fresh.string() + " --scene /nonexistent/scene.xml", "/nonexistent/scene.xml");
