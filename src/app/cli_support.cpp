@@ -36,7 +36,10 @@ std::vector<int> parse_finger_list(const strings::DeviceConfig& cfg, const std::
   std::size_t begin = 0;
   while (begin <= list.size()) {
     const std::size_t end = std::min(list.find(',', begin), list.size());
-    const std::string item = list.substr(begin, end - begin);
+    std::string item = list.substr(begin, end - begin);
+    // "0, 1": the blanks around an item are not part of its name.
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
     if (item.empty())
       throw UsageError(std::string(option) + " " + core::printable_for_message(list) +
                        ": expected comma-separated finger names or indices, got an empty item at character " +
@@ -141,6 +144,7 @@ void check_output_file(const std::string& path, std::string_view option, std::st
   require_path(path, option, what_file);
   namespace fs = std::filesystem;
   const std::string what = std::string(option) + " " + core::printable_for_message(path);
+  if (path.back() == '/') throw UsageError(what + ": ends with '/'; expected " + std::string(what_file) + ", not a folder");
   const fs::path absolute = resolved(path, what);
   std::error_code ec;
   if (!fs::exists(absolute, ec)) return require_writable_parent(absolute, what);

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "spidar/vision/camera_config.hpp"
 #include "spidar/vision/chessboard.hpp"
+#include "spidar/vision/lens_undistortion.hpp"
 #include "spidar/core/file_read.hpp"
 #include "spidar/vision/markers.hpp"
 
@@ -26,6 +27,15 @@ struct CalibrateCameraArgs {
   std::string out = "configs/camera.yaml";
   bool k3 = false;
 };
+
+/// Refuses a calibration whose lens folds the image (the camera-file loader, and every session,
+/// would refuse it) before it is written: the images' views do not fit one real camera.
+void require_usable_lens(const vision::Camera& camera, const std::string& out) {
+  if (auto st = vision::LensUndistortion::check(camera.intrinsics()); !st)
+    throw UsageError("--images: the calibration found is not a usable camera (" + st.error().message +
+                     "); nothing written to " + core::printable_for_message(out) +
+                     ": take the chessboard in more and better-spread views, or fix k3 (no --k3)");
+}
 
 /// Refuses an --out that would overwrite something other than a camera file (its own --markers,
 /// a device config, a folder): calibrate-camera replaces only a camera file, keeping it as .bak.
@@ -138,6 +148,7 @@ Action add_calibrate_camera(CLI::App& app) {
       notes.method = "chessboard";
     }
     const vision::Camera camera(cal.intrinsics, X_CW);
+    require_usable_lens(camera, a->out);
     const std::string backup = core::keep_previous_version(a->out);  // the previous calibration stays
     if (auto s = vision::save_camera_file(a->out, camera, notes); !s.ok()) {
       throw UsageError("--out " + s.error().message);

@@ -170,7 +170,7 @@ Status SerialDevice::check_rate(double rate_hz) const {
     m += core::number_for_message(rate_hz, 6);
     m += " Hz (";
     m += core::number_for_message(2.0 / rate_hz, 6);
-    m += " s): expected at least that";
+    m += " s): expected at least that (raise the read timeout, or the rate)";
     return Error{m};
   }
   if (!config_.check_link_budget || port_.baud_ignored()) return Ok{};

@@ -23,26 +23,35 @@ bool all_digits(const std::string& s) {
          std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
-/// The first file of an image-sequence pattern (OpenCV starts at the first index found).
-std::optional<std::string> first_sequence_file(const std::string& pattern) {
+/// The file name of index i in an image-sequence pattern (one %d field); empty if it cannot be formatted.
+std::string sequence_name(const std::string& pattern, int i) {
+  std::string name(pattern.size() + 32, '\0');
+  const int n = std::snprintf(name.data(), name.size(), pattern.c_str(), i);
+  if (n <= 0 || static_cast<std::size_t>(n) >= name.size()) return {};
+  name.resize(static_cast<std::size_t>(n));
+  return name;
+}
+
+/// The first index of an image-sequence pattern that names a file (OpenCV starts there).
+std::optional<int> first_sequence_index(const std::string& pattern) {
   for (int i = 0; i <= 1000; ++i) {
-    std::string name(pattern.size() + 32, '\0');
-    const int n = std::snprintf(name.data(), name.size(), pattern.c_str(), i);
-    if (n <= 0) return std::nullopt;
-    name.resize(static_cast<std::size_t>(n));
     std::error_code ec;
-    if (fs::is_regular_file(name, ec)) return name;
+    const std::string name = sequence_name(pattern, i);
+    if (name.empty()) return std::nullopt;
+    if (fs::is_regular_file(name, ec)) return i;
   }
   return std::nullopt;
 }
 
-/// Accepts exactly one printf integer conversion (%d, %04d, ...) and no other '%'.
+/// Accepts exactly one printf integer conversion (%d, %04d, ... with a width of at most two
+/// digits: %999999999d would format names of a gigabyte) and no other '%'.
 bool valid_sequence_pattern(const std::string& p) {
   int conversions = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (p[i] != '%') continue;
     std::size_t j = i + 1;
     while (j < p.size() && std::isdigit(static_cast<unsigned char>(p[j]))) ++j;
+    if (j - (i + 1) > 2) return false;
     if (j >= p.size() || p[j] != 'd') return false;
     ++conversions;
     i = j;
@@ -110,17 +119,19 @@ Result<Capture> Capture::open(const std::string& source, const CaptureOptions& o
         return Error{"image sequence " + source +
                      ": expected exactly one integer field such as %04d in the pattern"};
       }
-      const auto first = first_sequence_file(source);
+      const auto first = first_sequence_index(source);
       if (!first) {
         return Error{"image sequence " + source +
                      ": no file matches the pattern (tried indices 0..1000)"};
       }
-      // The first file's declared size (a sequence's files share one): a foreign or damaged file
-      // declaring a huge image is refused before OpenCV decodes it.
-      if (const auto size = image_file_size(*first);
-          size && !declares_at_most(*size, kMaxDecodedPixels)) {
-        return Error{"image sequence " + source + ": " + *first + " declares " + std::to_string(size->width) + "x" +
-                     std::to_string(size->height) + " px; expected 1 to " + std::to_string(kMaxDecodedPixels) + " pixels"};
+      // Every file's declared size, from its header, as the sequence opens: a foreign or damaged
+      // file declaring a huge image (or one whose header cannot be read) is refused before OpenCV
+      // decodes it. (Files added to the sequence while it plays are not checked.)
+      for (int i = *first;; ++i) {
+        const std::string name = sequence_name(source, i);
+        if (name.empty() || !fs::is_regular_file(name, ec)) break;
+        if (const Status st = check_image_header(name); !st)
+          return Error{"image sequence " + source + ": " + st.error().message};
       }
       if (!cap->open(source, cv::CAP_IMAGES) || !cap->isOpened()) {
         return Error{"image sequence " + source + ": OpenCV cannot read it"};

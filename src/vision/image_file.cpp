@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
@@ -42,6 +43,48 @@ std::optional<ImageFileSize> jpeg_size(std::ifstream& in) {
   return std::nullopt;
 }
 
+/// PNM (P1..P6): whitespace-separated ASCII width and height after the magic, '#' comments.
+std::optional<ImageFileSize> pnm_size(std::ifstream& in) {
+  in.seekg(2);
+  std::int64_t v[2] = {0, 0};
+  for (std::int64_t& x : v) {
+    int c = in.get();
+    while (c == '#' || std::isspace(c)) {
+      if (c == '#')
+        while (c != '\n' && c != EOF) c = in.get();
+      c = in.get();
+    }
+    if (!std::isdigit(c)) return std::nullopt;
+    for (int digits = 0; std::isdigit(c); c = in.get())
+      if (++digits > 10) return std::nullopt;
+      else x = 10 * x + (c - '0');
+  }
+  return ImageFileSize{v[0], v[1], "PNM"};
+}
+
+/// TIFF: the first image file directory's ImageWidth (256) and ImageLength (257), SHORT or LONG.
+std::optional<ImageFileSize> tiff_size(std::ifstream& in, bool little) {
+  auto u16 = [little](const unsigned char* b) { return little ? std::uint32_t{b[0]} | (std::uint32_t{b[1]} << 8) : be16(b); };
+  auto u32 = [little, u16](const unsigned char* b) { return little ? u16(b) | (u16(b + 2) << 16) : be32(b); };
+  unsigned char h[4];
+  in.seekg(4);
+  if (!in.read(reinterpret_cast<char*>(h), 4)) return std::nullopt;
+  in.seekg(u32(h));
+  unsigned char n[2];
+  if (!in.read(reinterpret_cast<char*>(n), 2)) return std::nullopt;
+  std::int64_t w = -1, ht = -1;
+  for (std::uint32_t k = 0, count = u16(n); k < count && k < 4096; ++k) {
+    unsigned char e[12];
+    if (!in.read(reinterpret_cast<char*>(e), 12)) return std::nullopt;
+    const std::uint32_t tag = u16(e), type = u16(e + 2);
+    if (tag != 256 && tag != 257) continue;
+    const std::int64_t value = type == 3 ? u16(e + 8) : type == 4 ? u32(e + 8) : -1;
+    (tag == 256 ? w : ht) = value;
+  }
+  if (w < 0 || ht < 0) return std::nullopt;
+  return ImageFileSize{w, ht, "TIFF"};
+}
+
 }  // namespace
 
 std::optional<ImageFileSize> image_file_size(const std::string& path) {
@@ -49,6 +92,14 @@ std::optional<ImageFileSize> image_file_size(const std::string& path) {
   std::array<unsigned char, 26> b{};
   if (!in.read(reinterpret_cast<char*>(b.data()), 2)) return std::nullopt;
   if (b[0] == 0xFF && b[1] == 0xD8) return jpeg_size(in);
+  if (b[0] == 'P' && b[1] >= '1' && b[1] <= '6') return pnm_size(in);
+  if ((b[0] == 'I' && b[1] == 'I') || (b[0] == 'M' && b[1] == 'M')) {
+    unsigned char m[2];
+    if (!in.read(reinterpret_cast<char*>(m), 2)) return std::nullopt;
+    const bool little = b[0] == 'I';
+    if ((little && m[0] == 42 && m[1] == 0) || (!little && m[0] == 0 && m[1] == 42)) return tiff_size(in, little);
+    return std::nullopt;
+  }
   if (!in.read(reinterpret_cast<char*>(b.data() + 2), static_cast<std::streamsize>(b.size() - 2))) return std::nullopt;
   constexpr std::array<unsigned char, 8> kPng{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   if (std::equal(kPng.begin(), kPng.end(), b.begin())) {
@@ -68,13 +119,28 @@ bool declares_at_most(const ImageFileSize& s, std::int64_t max_pixels) {
          s.width * s.height <= max_pixels;
 }
 
-Result<cv::Mat> read_image(const std::string& path, int flags, std::int64_t max_pixels) {
+Status check_image_header(const std::string& path, std::int64_t max_pixels) {
   if (const auto size = image_file_size(path)) {
     if (!declares_at_most(*size, max_pixels))
       return Error{path + ": the " + std::string(size->format) + " header declares " + std::to_string(size->width) +
                    "x" + std::to_string(size->height) + " px; expected 1 to " + std::to_string(max_pixels) +
                    " pixels (a damaged or foreign file?)"};
+    return Ok{};
   }
+  // A file that starts as one of the formats read here but whose header cannot be read: refused
+  // (a decoder that skips junk would still find a frame declaring any size).
+  std::ifstream in(path, std::ios::binary);
+  unsigned char b[4] = {0, 0, 0, 0};
+  in.read(reinterpret_cast<char*>(b), 4);
+  const bool known = (b[0] == 0x89 && b[1] == 'P' && b[2] == 'N' && b[3] == 'G') || (b[0] == 0xFF && b[1] == 0xD8) ||
+                     (b[0] == 'B' && b[1] == 'M') || (b[0] == 'P' && b[1] >= '1' && b[1] <= '6') ||
+                     (b[0] == 'I' && b[1] == 'I' && b[2] == 42) || (b[0] == 'M' && b[1] == 'M' && b[3] == 42);
+  if (known) return Error{path + ": its image header cannot be read (damaged, or not what its first bytes say)"};
+  return Ok{};
+}
+
+Result<cv::Mat> read_image(const std::string& path, int flags, std::int64_t max_pixels) {
+  if (const Status st = check_image_header(path, max_pixels); !st) return st.error();
   cv::Mat image;
   try {
     image = cv::imread(path, flags);

@@ -75,6 +75,9 @@ TEST(CliRefusals, CalibrateCameraReplacesOnlyACameraFile) {
                  "--out " + device.string() + ": exists and is not a camera file");
   EXPECT_EQ(read_text(device), device_text);
   EXPECT_FALSE(fs::exists(device.string() + ".bak"));
+  expect_refused("calibrate-camera --markers " + markers.string() + " --out " + (tmp / "cam.yaml").string() + "/",
+                 "ends with '/'; expected a camera file, not a folder");
+  EXPECT_FALSE(fs::exists(tmp / "cam.yaml"));
   expect_refused("calibrate-camera --markers " + markers.string() + " --out " + tmp.string(),
                  "exists and is not a file; expected a camera file");
 }
@@ -84,6 +87,7 @@ TEST(CliRefusals, FingerListsAndRangesSayWhatIsExpected) {
   expect_refused("calibrate-strings --fingers 0,,1", "--fingers 0,,1: expected comma-separated finger names or "
                                                      "indices, got an empty item at character 3");
   expect_refused("calibrate-strings --fingers 0,thumb", "--fingers thumb: unknown finger");
+  expect_refused("calibrate-strings --fingers '0, 0'", "--fingers 0, 0: finger 0 (left_thumb) is named twice");
   expect_refused("calibrate-strings --tolerance 0", "--tolerance: expected more than 0 and at most 20 mm, got 0");
   expect_refused("calibrate-strings --timeout 0", "--timeout: expected more than 0 and at most 600 s, got 0");
   expect_refused("calibrate-strings --jig 3 --jig-spacing 0.3", "--jig-spacing: expected 0.005 to 0.2 m, got 0.3");

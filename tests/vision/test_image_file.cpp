@@ -18,6 +18,7 @@ std::string write_image(const std::string& dir, const std::string& name, int w, 
                         const std::vector<int>& params = {}) {
   cv::Mat m(h, w, CV_8UC3, cv::Scalar(30, 90, 200));
   cv::circle(m, {w / 2, h / 2}, std::min(w, h) / 3, cv::Scalar(250, 250, 250), cv::FILLED);
+  if (name.size() > 4 && name.substr(name.size() - 4) == ".pgm") cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
   const std::string path = dir + "/" + name;
   EXPECT_TRUE(cv::imwrite(path, m, params)) << path;
   return path;
@@ -35,7 +36,10 @@ TEST(ImageFile, HeadersDeclareWhatTheEncodersWrote) {
                         {"b.png", 17, 5, {}, "PNG"},
                         {"c.jpg", 641, 479, {}, "JPEG"},
                         {"d.jpg", 33, 1000, {cv::IMWRITE_JPEG_PROGRESSIVE, 1}, "JPEG"},
-                        {"e.bmp", 123, 45, {}, "BMP"}};
+                        {"e.bmp", 123, 45, {}, "BMP"},
+                        {"f.pgm", 77, 31, {}, "PNM"},
+                        {"g.ppm", 64, 48, {}, "PNM"},
+                        {"h.tif", 99, 40, {}, "TIFF"}};
   for (const Case& c : cases) {
     const std::string path = write_image(dir, c.name, c.w, c.h, c.params);
     const auto size = image_file_size(path);
@@ -92,11 +96,28 @@ TEST(ImageFile, AHeaderDeclaringAHugeImageIsRefusedWithoutDecoding) {
   EXPECT_NE(read.error().message.find(path + ": the PNG header declares 30000x30000 px; expected 1 to 67108864 pixels"),
             std::string::npos)
       << read.error().message;
-  // The same file as an image sequence's first frame: refused when the sequence opens.
-  std::filesystem::copy_file(path, dir + "/seq_0003.png");
+  // The same file as a later frame of an image sequence: refused when the sequence opens.
+  write_image(dir, "seq_0003.png", 16, 12);
+  write_image(dir, "seq_0004.png", 16, 12);
+  std::filesystem::copy_file(path, dir + "/seq_0005.png");
   const auto cap = Capture::open(dir + "/seq_%04d.png");
   ASSERT_FALSE(cap.ok());
-  EXPECT_NE(cap.error().message.find("seq_0003.png declares 30000x30000 px"), std::string::npos) << cap.error().message;
+  EXPECT_NE(cap.error().message.find("seq_0005.png: the PNG header declares 30000x30000 px"), std::string::npos)
+      << cap.error().message;
+  // A pattern whose field would format names of a gigabyte.
+  const auto wide = Capture::open(dir + "/seq_%999999999d.png");
+  ASSERT_FALSE(wide.ok());
+  EXPECT_NE(wide.error().message.find("expected exactly one integer field"), std::string::npos) << wide.error().message;
+  // A JPEG whose frame header is hidden behind a stray byte (a decoder that skips junk finds it).
+  std::vector<unsigned char> jpg;
+  cv::imencode(".jpg", cv::Mat(8, 8, CV_8UC3, cv::Scalar(9, 9, 9)), jpg);
+  jpg.insert(jpg.begin() + 2, 0x00);
+  std::ofstream(dir + "/garbled.jpg", std::ios::binary).write(reinterpret_cast<const char*>(jpg.data()),
+                                                              static_cast<std::streamsize>(jpg.size()));
+  const auto garbled = read_image(dir + "/garbled.jpg", cv::IMREAD_COLOR);
+  ASSERT_FALSE(garbled.ok());
+  EXPECT_NE(garbled.error().message.find("garbled.jpg: its image header cannot be read"), std::string::npos)
+      << garbled.error().message;
   // Sides whose product would overflow 64 bits, and a zero side.
   EXPECT_FALSE(declares_at_most({0xFFFFFFFFll, 0xFFFFFFFFll, "PNG"}, kMaxDecodedPixels));
   EXPECT_FALSE(declares_at_most({0, 10, "PNG"}, kMaxDecodedPixels));
