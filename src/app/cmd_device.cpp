@@ -28,11 +28,7 @@ Action add_device_test(CLI::App& app) {
                 "let the servo's CPU halt between cycles (by default a SCHED_IDLE thread keeps it from "
                 "halting before each cycle: docs/realtime.md)");
   return [a, seconds, rate, idle_spin] {
-    if (!(*seconds > 0 && *seconds <= 3600)) {
-      std::ostringstream os;
-      os << "--seconds: expected more than 0 and at most 3600 s, got " << *seconds;
-      throw UsageError(os.str());
-    }
+    require_above(*seconds, 0, 3600, "--seconds", "s");
     require_range(*rate, 10, 20000, "--rate", "Hz");
     const auto cfg = strings::load_device_config(resolve_data_path(a->config));
     auto dev = make_backend(*a, cfg);

@@ -97,8 +97,8 @@ Action add_calibrate_camera(CLI::App& app) {
   cmd->add_option("--images", a->images,
                   "folder of chessboard images (intrinsics); without it the intrinsics are kept "
                   "from --base and only --markers is solved");
-  cmd->add_option("--pattern", a->pattern, "inner corners COLSxROWS")->capture_default_str();
-  cmd->add_option("--square", a->square, "side of one square [m]")->capture_default_str();
+  CLI::Option* pattern_opt = cmd->add_option("--pattern", a->pattern, "inner corners COLSxROWS")->capture_default_str();
+  CLI::Option* square_opt = cmd->add_option("--square", a->square, "side of one square [m]")->capture_default_str();
   cmd->add_option("--markers", a->markers,
                   "markers file (YAML): world + pixel (PnP, >= 4) or world + camera (3, the "
                   "paper's method)");
@@ -107,14 +107,19 @@ Action add_calibrate_camera(CLI::App& app) {
                   "--out if it exists, else the default rig camera)");
   cmd->add_option("--out", a->out, "camera file to write")->capture_default_str();
   cmd->add_flag("--k3", a->k3, "also estimate the k3 distortion coefficient (default: k3 = 0)");
-  return [a] {
+  return [a, pattern_opt, square_opt] {
+    for (const CLI::Option* o : {pattern_opt, square_opt})
+      if (a->images.empty() && o->count() > 0)
+        throw UsageError(o->get_name() + ": applies with --images (the chessboard pictures), not to --markers alone");
     check_camera_out(*a);
     // The camera file whose parts are kept (intrinsics without --images, pose without --markers).
     std::string base = a->base;
     if (base.empty() && std::filesystem::exists(a->out)) base = a->out;
     if (a->images.empty()) return extrinsics_only(*a, base);
     auto pattern = vision::parse_pattern(a->pattern, a->square);
-    if (!pattern) throw UsageError("--pattern/--square: " + pattern.error().message);
+    if (!pattern)
+      throw UsageError((pattern.error().message.rfind("square", 0) == 0 ? "--square: " : "--pattern: ") +
+                       pattern.error().message);
     vision::IntrinsicsOptions options;
     options.fix_k3 = !a->k3;
     auto folder = vision::calibrate_chessboard_folder(a->images, *pattern, options);

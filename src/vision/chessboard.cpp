@@ -1,5 +1,6 @@
 #include "spidar/vision/chessboard.hpp"
 #include "spidar/vision/image_file.hpp"
+#include "spidar/core/config.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -43,8 +44,9 @@ Result<ChessboardPattern> parse_pattern(const std::string& text, double square) 
                  "': expected different corner counts per side (a square board's orientation is "
                  "ambiguous)"};
   }
-  if (!std::isfinite(square) || square <= 0.0 || square > 1.0) {
-    return Error{"square " + std::to_string(square) + ": expected a side in (0, 1] m"};
+  // At least 0.1 mm: a printed board's square; smaller sides make OpenCV's calibration assert.
+  if (!std::isfinite(square) || square < 1e-4 || square > 1.0) {
+    return Error{"square " + core::number_for_message(square) + ": expected a side from 0.0001 to 1 m"};
   }
   return p;
 }

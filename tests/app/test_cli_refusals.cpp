@@ -78,6 +78,10 @@ TEST(CliRefusals, CalibrateCameraReplacesOnlyACameraFile) {
   expect_refused("calibrate-camera --markers " + markers.string() + " --out " + (tmp / "cam.yaml").string() + "/",
                  "ends with '/'; expected a camera file, not a folder");
   EXPECT_FALSE(fs::exists(tmp / "cam.yaml"));
+  expect_refused("calibrate-camera --markers " + markers.string() + " --square 0.03 --out " + (tmp / "c.yaml").string(),
+                 "--square: applies with --images");
+  expect_refused("calibrate-camera --images " + tmp.string() + " --square 1e-310 --out " + (tmp / "c.yaml").string(),
+                 "--square: square 1e-310: expected a side from 0.0001 to 1 m");
   expect_refused("calibrate-camera --markers " + markers.string() + " --out " + tmp.string(),
                  "exists and is not a file; expected a camera file");
 }
@@ -93,6 +97,7 @@ TEST(CliRefusals, FingerListsAndRangesSayWhatIsExpected) {
   expect_refused("calibrate-strings --jig 3 --jig-spacing 0.3", "--jig-spacing: expected 0.005 to 0.2 m, got 0.3");
   expect_refused("calibrate-strings --jig-spacing 0.05", "--jig-spacing: applies to a jig (--jig 2 to 5), not to the pole calibration");
   expect_refused("run --config configs/lab-example.yaml --headless --record-frames png", "--record-frames: applies with --record DIR");
+  expect_refused("device-test --seconds 1e-310", "--seconds: expected more than 0 and at most 3600 s, got 1e-310 (too small");
   expect_refused("demo --seconds 1e-320", "--seconds: expected 0 to 600 s, got 9.99989e-321 (too small to be a value");
 }
 
