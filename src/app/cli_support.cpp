@@ -58,6 +58,9 @@ std::vector<int> parse_finger_list(const strings::DeviceConfig& cfg, const std::
 
 namespace {
 
+/// lo <= x <= hi, and not subnormal (NaN fails).
+bool in_range(double x, double lo, double hi) { return x >= lo && x <= hi && std::fpclassify(x) != FP_SUBNORMAL; }
+
 /// ", got X" with a note when X is subnormal (in range, but no value a user means).
 std::string got_text(double x) {
   std::ostringstream os;
@@ -69,14 +72,14 @@ std::string got_text(double x) {
 }  // namespace
 
 void require_range(double x, double lo, double hi, std::string_view option, std::string_view unit) {
-  if (x >= lo && x <= hi && std::fpclassify(x) != FP_SUBNORMAL) return;
+  if (in_range(x, lo, hi)) return;
   std::ostringstream os;
   os << option << ": expected " << lo << " to " << hi << (unit.empty() ? "" : " ") << unit << got_text(x);
   throw UsageError(os.str());
 }
 
 void require_above(double x, double lo, double hi, std::string_view option, std::string_view unit) {
-  if (x > lo && x <= hi && std::fpclassify(x) != FP_SUBNORMAL) return;
+  if (x > lo && in_range(x, lo, hi)) return;
   std::ostringstream os;
   os << option << ": expected more than " << lo << " and at most " << hi << (unit.empty() ? "" : " ") << unit
      << got_text(x);
@@ -165,6 +168,10 @@ void make_output_dir(const std::string& dir, std::string_view option) {
                      core::printable_for_message(dir) + "': " + ec.message());
 }
 
+void refuse_given(const CLI::Option* option, std::string_view applies) {
+  if (option->count() > 0) throw UsageError(option->get_name() + ": applies " + std::string(applies));
+}
+
 void refuse_empty_values(const CLI::App& app) {
   for (const CLI::Option* opt : app.get_options()) {
     if (opt->count() == 0) continue;
@@ -186,7 +193,7 @@ CLI::Validator range_check(double lo, double hi, std::string_view unit) {
         double x = std::nan("");
         const char* end = s.data() + s.size();
         auto [ptr, ec] = std::from_chars(s.data(), end, x);
-        if (ec == std::errc() && ptr == end && x >= lo && x <= hi && std::fpclassify(x) != FP_SUBNORMAL) return {};
+        if (ec == std::errc() && ptr == end && in_range(x, lo, hi)) return {};
         std::ostringstream os;
         os << "expected " << lo << " to " << hi << (unit.empty() ? "" : " ") << unit << ", got '" << s << "'";
         return os.str();

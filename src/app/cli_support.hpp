@@ -71,6 +71,10 @@ void check_output_file(const std::string& path, std::string_view option, std::st
 /// when it cannot.
 void make_output_dir(const std::string& dir, std::string_view option);
 
+/// UsageError "NAME: applies `applies`" when `option` was given where it does not apply (e.g.
+/// applies = "with --record DIR"): an option that would be ignored is a mistake worth saying.
+void refuse_given(const CLI::Option* option, std::string_view applies);
+
 /// UsageError for any option or positional argument of `app` or its parsed subcommands given an
 /// empty value (`--seconds ''`): CLI11 would turn it into 0 or the default without a word.
 void refuse_empty_values(const CLI::App& app);

@@ -61,8 +61,7 @@ Action add_calibrate_strings(CLI::App& app) {
   return [a, spacing] {
     if (!(a->jig == 0 || (a->jig >= 2 && a->jig <= 5)))
       throw UsageError("--jig: expected 0 (pole) or 2 to 5, got " + std::to_string(a->jig));
-    if (a->jig == 0 && spacing->count() > 0)
-      throw UsageError("--jig-spacing: applies to a jig (--jig 2 to 5), not to the pole calibration (--jig 0)");
+    if (a->jig == 0) refuse_given(spacing, "to a jig (--jig 2 to 5), not to the pole calibration (--jig 0)");
     require_range(a->jig_spacing, 0.005, 0.2, "--jig-spacing", "m");
     require_range(a->hold_s, 0.05, 10, "--hold", "s");
     require_above(a->tolerance_mm, 0, 20, "--tolerance", "mm");

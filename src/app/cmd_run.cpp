@@ -78,8 +78,7 @@ Action add_run(CLI::App& app) {
                   "window: save the window's pixels to this PNG just before exiting (tests)");
   return [a, record_frames] {
     require_range(a->seconds, 0, 86400, "--seconds", "s");
-    if (a->record.empty() && record_frames->count() > 0)
-      throw UsageError("--record-frames: applies with --record DIR (it chooses how the frames are recorded)");
+    if (a->record.empty()) refuse_given(record_frames, "with --record DIR (it chooses how the frames are recorded)");
     if (!a->screenshot.empty()) {
       if (a->headless) throw UsageError("--screenshot: saves the window's pixels; there is no window with --headless");
       check_output_file(a->screenshot, "--screenshot", "a PNG file");

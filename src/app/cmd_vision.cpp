@@ -108,9 +108,9 @@ Action add_calibrate_camera(CLI::App& app) {
   cmd->add_option("--out", a->out, "camera file to write")->capture_default_str();
   cmd->add_flag("--k3", a->k3, "also estimate the k3 distortion coefficient (default: k3 = 0)");
   return [a, pattern_opt, square_opt] {
-    for (const CLI::Option* o : {pattern_opt, square_opt})
-      if (a->images.empty() && o->count() > 0)
-        throw UsageError(o->get_name() + ": applies with --images (the chessboard pictures), not to --markers alone");
+    if (a->images.empty())
+      for (const CLI::Option* o : {pattern_opt, square_opt})
+        refuse_given(o, "with --images (the chessboard pictures), not to --markers alone");
     check_camera_out(*a);
     // The camera file whose parts are kept (intrinsics without --images, pose without --markers).
     std::string base = a->base;

@@ -98,12 +98,22 @@ std::string fit_row_text(const FitRow& r) {
   return row + '\n';
 }
 
+namespace {
+
+/// SpidarError if the folder `dir` holds a recording (its session.json).
+void refuse_a_recording_in(const std::string& dir) {
+  std::error_code ec;
+  if (fs::exists(fs::path(dir) / files::kSession, ec))
+    throw SpidarError("--record " + dir + ": already holds a recording (session.json); choose a new folder");
+}
+
+}  // namespace
+
 void check_new_recording_folder(const std::string& dir) {
   const fs::path d(dir);
   std::error_code ec;
   if (!fs::exists(d, ec)) return;
-  if (fs::exists(d / files::kSession, ec))
-    throw SpidarError("--record " + dir + ": already holds a recording (session.json); choose a new folder");
+  refuse_a_recording_in(dir);
   if (!fs::is_directory(d, ec)) throw SpidarError("--record " + dir + ": exists and is not a folder; choose a new folder");
   if (fs::is_empty(d, ec) && !ec) return;
   std::string held = ec ? "cannot list it: " + ec.message() : "it holds files";
@@ -119,10 +129,9 @@ RecordingWriter::RecordingWriter(std::string dir, const RecordingMeta& meta, std
   if (meta_.string_count < 1 || meta_.string_count > device::kMaxDeviceStrings)
     throw SpidarError("recording " + dir_ + ": string_count " + std::to_string(meta_.string_count) +
                       " is outside 1.." + std::to_string(device::kMaxDeviceStrings));
+  refuse_a_recording_in(dir_);
   const fs::path d(dir_);
   std::error_code ec;
-  if (fs::exists(d / files::kSession, ec))
-    throw SpidarError("--record " + dir_ + ": already holds a recording (session.json); choose a new folder");
   fs::create_directories(d, ec);
   if (ec) throw core::FileError(dir_, "cannot create the folder: " + ec.message());
   if (meta_.store == FrameStore::kPng) {

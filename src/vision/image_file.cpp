@@ -87,31 +87,46 @@ std::optional<ImageFileSize> tiff_size(std::ifstream& in, bool little) {
 
 }  // namespace
 
-std::optional<ImageFileSize> image_file_size(const std::string& path) {
+namespace {
+
+/// The declared size, as image_file_size; `*known` tells whether the first bytes are those of a
+/// format read here (PNG, JPEG, BMP, PNM, TIFF), whether or not the rest of the header could be read.
+std::optional<ImageFileSize> read_header(const std::string& path, bool* known) {
+  *known = false;
   std::ifstream in(path, std::ios::binary);
   std::array<unsigned char, 26> b{};
   if (!in.read(reinterpret_cast<char*>(b.data()), 2)) return std::nullopt;
+  *known = true;
   if (b[0] == 0xFF && b[1] == 0xD8) return jpeg_size(in);
   if (b[0] == 'P' && b[1] >= '1' && b[1] <= '6') return pnm_size(in);
   if ((b[0] == 'I' && b[1] == 'I') || (b[0] == 'M' && b[1] == 'M')) {
     unsigned char m[2];
-    if (!in.read(reinterpret_cast<char*>(m), 2)) return std::nullopt;
     const bool little = b[0] == 'I';
-    if ((little && m[0] == 42 && m[1] == 0) || (!little && m[0] == 0 && m[1] == 42)) return tiff_size(in, little);
-    return std::nullopt;
+    *known = in.read(reinterpret_cast<char*>(m), 2) &&
+             ((little && m[0] == 42 && m[1] == 0) || (!little && m[0] == 0 && m[1] == 42));
+    return *known ? tiff_size(in, little) : std::nullopt;
   }
-  if (!in.read(reinterpret_cast<char*>(b.data() + 2), static_cast<std::streamsize>(b.size() - 2))) return std::nullopt;
+  const bool png = b[0] == 0x89 && b[1] == 'P', bmp = b[0] == 'B' && b[1] == 'M';
+  *known = png || bmp;
+  if (!*known || !in.read(reinterpret_cast<char*>(b.data() + 2), static_cast<std::streamsize>(b.size() - 2)))
+    return std::nullopt;
   constexpr std::array<unsigned char, 8> kPng{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  if (std::equal(kPng.begin(), kPng.end(), b.begin())) {
-    if (b[12] != 'I' || b[13] != 'H' || b[14] != 'D' || b[15] != 'R') return std::nullopt;
+  if (png) {
+    if (!std::equal(kPng.begin(), kPng.end(), b.begin()) || b[12] != 'I' || b[13] != 'H' || b[14] != 'D' ||
+        b[15] != 'R')
+      return std::nullopt;
     return ImageFileSize{be32(&b[16]), be32(&b[20]), "PNG"};
   }
-  if (b[0] == 'B' && b[1] == 'M') {
-    // BITMAPINFOHEADER (or later): width, then height (negative: rows stored top-down).
-    const std::int64_t w = le32(&b[18]), h = le32(&b[22]);
-    return ImageFileSize{w < 0 ? -w : w, h < 0 ? -h : h, "BMP"};
-  }
-  return std::nullopt;
+  // BMP, BITMAPINFOHEADER (or later): width, then height (negative: rows stored top-down).
+  const std::int64_t w = le32(&b[18]), h = le32(&b[22]);
+  return ImageFileSize{w < 0 ? -w : w, h < 0 ? -h : h, "BMP"};
+}
+
+}  // namespace
+
+std::optional<ImageFileSize> image_file_size(const std::string& path) {
+  bool known = false;
+  return read_header(path, &known);
 }
 
 bool declares_at_most(const ImageFileSize& s, std::int64_t max_pixels) {
@@ -120,7 +135,8 @@ bool declares_at_most(const ImageFileSize& s, std::int64_t max_pixels) {
 }
 
 Status check_image_header(const std::string& path, std::int64_t max_pixels) {
-  if (const auto size = image_file_size(path)) {
+  bool known = false;
+  if (const auto size = read_header(path, &known)) {
     if (!declares_at_most(*size, max_pixels))
       return Error{path + ": the " + std::string(size->format) + " header declares " + std::to_string(size->width) +
                    "x" + std::to_string(size->height) + " px; expected 1 to " + std::to_string(max_pixels) +
@@ -129,12 +145,6 @@ Status check_image_header(const std::string& path, std::int64_t max_pixels) {
   }
   // A file that starts as one of the formats read here but whose header cannot be read: refused
   // (a decoder that skips junk would still find a frame declaring any size).
-  std::ifstream in(path, std::ios::binary);
-  unsigned char b[4] = {0, 0, 0, 0};
-  in.read(reinterpret_cast<char*>(b), 4);
-  const bool known = (b[0] == 0x89 && b[1] == 'P' && b[2] == 'N' && b[3] == 'G') || (b[0] == 0xFF && b[1] == 0xD8) ||
-                     (b[0] == 'B' && b[1] == 'M') || (b[0] == 'P' && b[1] >= '1' && b[1] <= '6') ||
-                     (b[0] == 'I' && b[1] == 'I' && b[2] == 42) || (b[0] == 'M' && b[1] == 'M' && b[3] == 42);
   if (known) return Error{path + ": its image header cannot be read (damaged, or not what its first bytes say)"};
   return Ok{};
 }
