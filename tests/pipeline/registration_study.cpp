@@ -9,7 +9,11 @@
 //                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
 //                      [--t0 S] [--t1 S] [--fps F] [--verbose [--q-from S --q-to S]] [--ceiling-scan]
 //                      [--dump DIR [--dump-below IOU]] [--bending-wrists [--oracle-forearm]]
-//                      [--set KEY=VALUE]...
+//                      [--set KEY=VALUE]... [--cube X,Y,YAW]
+//
+// --cube: the cube elsewhere on the table, centre (X, Y) [m] and turned YAW [rad] about the
+// vertical; the scripted user grasps it where it lies (RubiksTask::track), as in the demo with a
+// scene whose cube is placed so.
 //
 // --oracle-forearm: the registration is told where the simulated forearms point
 // (FramePipeline::set_forearm_directions), to measure what an estimate of that direction is worth.
@@ -67,6 +71,9 @@ struct Args {
   double model_length = 0, model_width = 0;
   /// --model-cap x,y,z: the model's fingertip-cap offset (HandDimensions::fingertip_offset) [m]
   std::optional<Vec3> model_cap;
+  /// --cube X,Y,YAW: the cube's centre on the table [m] and its turn about the vertical [rad]
+  /// (the user grasps it where it is, as in the demo with another scene)
+  std::optional<Vec3> cube;
   bool silhouette = false, no_balls = false, no_wrist = false, personalise = false;
   double t0 = 0.3, t1 = 18.0, fps = 30.0;
   bool verbose = false;
@@ -116,6 +123,14 @@ int main(int argc, char** argv) {
         return 2;
       }
       a.model_cap = c;
+    }
+    else if (k == "--cube") {
+      Vec3 c;
+      if (std::sscanf(next().c_str(), "%lf,%lf,%lf", &c.x(), &c.y(), &c.z()) != 3) {
+        std::fprintf(stderr, "registration_study: --cube: expected x,y,yaw [m, m, rad]\n");
+        return 2;
+      }
+      a.cube = c;
     }
     else if (k == "--silhouette") a.silhouette = true;
     else if (k == "--no-balls") a.no_balls = true;
@@ -302,8 +317,21 @@ int main(int argc, char** argv) {
   if (a.shape_w > 0) p.shape_estimator.solve_every = static_cast<int>(a.shape_w);
   if (a.shape_dq > 0) p.shape_estimator.min_pose_change = a.shape_dq;
   if (a.shape_silhouette) p.shape_estimator.silhouette = registration::ShapeSilhouette::kSpill;
-  sim::RubiksTask task({});
+  sim::RubiksTaskParams task_params;
+  core::Latest<sim::CubePoseSample> cube_pose;
+  Pose X_W_cube;
+  if (a.cube) {
+    X_W_cube.p = Vec3(a.cube->x(), a.cube->y(), 0.0);
+    X_W_cube.R = Quat(Eigen::AngleAxisd(a.cube->z(), Vec3::UnitZ()));
+    task_params.p_W_cube = X_W_cube.p;
+    sim::CubePoseSample sample;
+    sample.p_W = {X_W_cube.p.x(), X_W_cube.p.y(), X_W_cube.p.z()};
+    sample.q_WC = {X_W_cube.R.w(), X_W_cube.R.x(), X_W_cube.R.y(), X_W_cube.R.z()};
+    cube_pose.publish(sample);
+  }
+  sim::RubiksTask task(task_params);
   task.fit_to_hands(truth_models);
+  if (a.cube) task.track(&cube_pose);
   sim::SyntheticCameraParams film_params;
   if (a.bending_wrists) film_params.elbows_W = sim::user_elbows(task);
   auto film = sim::SyntheticCamera::create(context, camera, truth_models, film_params).value();
@@ -334,6 +362,7 @@ int main(int argc, char** argv) {
   cube.size = Vec3(0.0285, 0.0285, 0.0285);
   cube.rgba = {0.9f, 0.9f, 0.9f, 1.f};
   cube.body = 1;
+  cube.X_WS = X_W_cube;
   scene.shapes.push_back(cube);
 
   sim::SyntheticFrame frame;

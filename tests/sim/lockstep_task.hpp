@@ -6,6 +6,7 @@
 // timing of a busy machine.
 #include <algorithm>
 #include <functional>
+#include <string>
 #include <span>
 #include <vector>
 
@@ -27,10 +28,11 @@ using LockstepObserver =
 /// Plays the task (the script with the scene's cube and proxy sizes) to its end on the scene
 /// scenes/rubiks_cube.xml. `prepare` sees the task before it starts (e.g. to fit it to hands; the
 /// task lives until run_lockstep returns), `observe` every step after it.
-/// `shaped_fingers`: RubiksTaskParams::shaped_fingers.
+/// `shaped_fingers`: RubiksTaskParams::shaped_fingers. `scene`: another MJCF file with the cube
+/// (empty: scenes/rubiks_cube.xml).
 inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const LockstepObserver& observe,
-                         bool shaped_fingers = false) {
-  auto world = physics::World::Load(spidar::test::source("scenes/rubiks_cube.xml")).value();
+                         bool shaped_fingers = false, const std::string& scene = {}) {
+  auto world = physics::World::Load(scene.empty() ? spidar::test::source("scenes/rubiks_cube.xml") : scene).value();
   auto cube = physics::RubiksCube::Attach(*world).value();
   RubiksTaskParams tp;
   tp.proxy_radius = world->params().proxy.radius;

@@ -8,6 +8,9 @@
 #include <string>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "lockstep_task.hpp"
 #include "spidar/core/units.hpp"
@@ -26,7 +29,7 @@ struct TaskRun {
 };
 
 /// `fit`: the user's hands the script is fitted to (RubiksTask::fit_to_hands), or nullptr.
-TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr) {
+TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr, const std::string& scene = {}) {
   TaskRun r;
   double z0 = 0;
   bool first = true;
@@ -44,7 +47,8 @@ TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr) {
         r.quarter_turns_u = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
         r.unlocks = cube.layer_unlocks();
         r.solved = cube.is_solved();
-      });
+      },
+      false, scene);
   return r;
 }
 
@@ -94,6 +98,55 @@ INSTANTIATE_TEST_SUITE_P(Users, FittedTaskPhysics,
                                            UserShape{1.1, 0.9, hand::Coupling::kLinear},
                                            UserShape{0.9, 0.9, hand::Coupling::kPaperQuadratic},
                                            UserShape{1.1, 1.1, hand::Coupling::kPaperQuadratic}));
+
+// The cube elsewhere on the table and turned about the vertical: the user grasps it where it lies
+// (RubiksTask::track), so the task is the same. A scene of its own per placement, written from
+// scenes/rubiks_cube.xml with the cube's body moved.
+struct CubePlacement {
+  double x_m, y_m, yaw_rad;
+};
+
+std::string placed_cube_scene(const CubePlacement& c) {
+  std::ifstream in(spidar::test::source("scenes/rubiks_cube.xml"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string xml = ss.str();
+  const std::string body = "<body name=\"cube\" pos=\"0 0 -0.00130\">";
+  const auto at = xml.find(body);
+  EXPECT_NE(at, std::string::npos);
+  char placed[160];
+  std::snprintf(placed, sizeof placed, "<body name=\"cube\" pos=\"%.4f %.4f -0.00130\" euler=\"0 0 %.4f\">", c.x_m,
+                c.y_m, c.yaw_rad);
+  xml.replace(at, body.size(), placed);
+  char name[96];
+  std::snprintf(name, sizeof name, "rubiks_placed_%+.3f_%+.3f_%+.3f.xml", c.x_m, c.y_m, c.yaw_rad);
+  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  std::ofstream(path) << xml;
+  return path;
+}
+
+class PlacedCube : public ::testing::TestWithParam<CubePlacement> {};
+
+// Lockstep (the fingertips feel the coupling forces exactly, no strings): at every placement the
+// script, fitted to the default user's hands, lifts the cube and turns the top layer twice.
+TEST_P(PlacedCube, LiftsAndTurnsTheTopLayerTwice) {
+  // The demo's default user (configs/hands.yaml, profile `user`), the script fitted to its hands.
+  hand::HandProfile profile;
+  profile.dimensions.length = 0.1976;
+  profile.dimensions.width = 0.0825;
+  profile.dimensions.fingertip_offset = Vec3(0.0, -0.009, 0.001);
+  const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
+  const TaskRun r = run_task(&hands, placed_cube_scene(GetParam()));
+  std::printf("cube at %.3f, %.3f m, turned %.2f rad: lift %.1f mm, U %d quarter turns\n", GetParam().x_m,
+              GetParam().y_m, GetParam().yaw_rad, r.lift_max_m * 1e3, r.quarter_turns_u);
+  EXPECT_GT(r.lift_max_m, 0.010);
+  EXPECT_EQ(r.quarter_turns_u, 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Placements, PlacedCube,
+                         ::testing::Values(CubePlacement{0.04, 0.03, 0.45}, CubePlacement{-0.05, -0.02, -0.3},
+                                           CubePlacement{0.03, -0.03, -0.5}, CubePlacement{-0.03, 0.04, 0.3},
+                                           CubePlacement{0.0, 0.0, 0.45}, CubePlacement{0.04, 0.03, 0.0}));
 
 }  // namespace
 }  // namespace spidar::sim
