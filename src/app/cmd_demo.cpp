@@ -61,11 +61,14 @@ Action add_demo(CLI::App& app) {
   cmd->add_flag("--shaped-fingers", o->shaped_fingers,
                 "the simulated user's fingertips yield only where their fingers can move (stiffness "
                 "ellipsoids from their hands): their hands then reach the device's caps");
-  cmd->add_flag("--bending-wrists,!--in-line-forearms", o->bending_wrists,
-                "--bending-wrists (the default): the simulated user's forearms point at elbows that "
-                "stay where they were at the script's start, and their wrists bend (up to 60 deg) "
-                "when the hands turn; --in-line-forearms: forearms in line with the hands, as the "
-                "paper's model has them");
+  // Two flags that contradict each other are refused (CLI11 would take the last one given).
+  CLI::Option* bending = cmd->add_flag("--bending-wrists", o->bending_wrists,
+                                       "the simulated user's forearms point at elbows that stay where they were at "
+                                       "the script's start, and their wrists bend (up to 60 deg) when the hands turn "
+                                       "(the default)");
+  cmd->add_flag("!--in-line-forearms", o->bending_wrists,
+                "the simulated user's forearms stay in line with the hands, as the paper's model has them")
+      ->excludes(bending);
   cmd->add_flag("!--paper-registration", o->silhouette,
                 "register the main fit with the paper's joint-balls alone (default: joint-balls and "
                 "the hand-aware silhouette term; the other method always runs as the comparison)");
@@ -73,11 +76,12 @@ Action add_demo(CLI::App& app) {
   cmd->add_option("--out", o->out, "output directory")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "length [s] (0: the scenario's own)");
   cmd->add_option("--rate", o->rate_hz, "servo rate [Hz]")->capture_default_str();
-  cmd->add_flag_callback("--idle-spin", [o] { o->idle_spin = 1; },
-                         "keep the servo's CPU from halting before each cycle (a SCHED_IDLE thread; the "
-                         "haptic scenario's default; docs/realtime.md)");
+  CLI::Option* spin = cmd->add_flag_callback("--idle-spin", [o] { o->idle_spin = 1; },
+                                             "keep the servo's CPU from halting before each cycle (a SCHED_IDLE "
+                                             "thread; the haptic scenario's default; docs/realtime.md)");
   cmd->add_flag_callback("--no-idle-spin", [o] { o->idle_spin = 0; }, "let the servo's CPU halt between cycles "
-                         "(the rubiks scenario's default)");
+                         "(the rubiks scenario's default)")
+      ->excludes(spin);
   cmd->add_option("--seed", o->seed, "random seed")->check(seed_check())->capture_default_str();
   // Options of the mixed-reality demo alone (the camera, the hands, the registration, the video)
   // are a mistake with the haptic or strings scenario, which would ignore them.

@@ -23,15 +23,6 @@
 namespace spidar::app {
 namespace {
 
-Vec3 vec3_arg(const std::vector<double>& v, const char* name) {
-  for (double x : v) {
-    if (!std::isfinite(x)) {
-      throw UsageError(std::string(name) + ": expected finite numbers, got " + std::to_string(x));
-    }
-  }
-  return {v[0], v[1], v[2]};
-}
-
 /// The largest force the CLI takes [N]: far above any string drive (SPIDAR-8's saturates at
 /// 17 N per string); beyond it an input is a typo, not a request.
 constexpr double kMaxForceN = 1000.0;
@@ -46,6 +37,21 @@ std::string num(double x) {
   std::ostringstream os;
   os << x;
   return os.str();
+}
+
+/// Three finite numbers, none subnormal (1e-310 is in range, but no value a user means: a typo for
+/// 1e-3 or so), as a vector; else a UsageError naming the option and the number.
+Vec3 vec3_arg(const std::vector<double>& v, const char* name) {
+  for (double x : v) {
+    if (!std::isfinite(x)) {
+      throw UsageError(std::string(name) + ": expected finite numbers, got " + std::to_string(x));
+    }
+    if (std::fpclassify(x) == FP_SUBNORMAL) {
+      throw UsageError(std::string(name) + ": expected numbers of ordinary size, got " + num(x) +
+                       " (a subnormal number, effectively 0: write 0 if 0 is meant)");
+    }
+  }
+  return {v[0], v[1], v[2]};
 }
 
 /// UsageError unless `p_W` lies in the device's workspace (the fulcrums' box grown by the servo

@@ -86,6 +86,26 @@ TEST(CliRefusals, CalibrateCameraReplacesOnlyACameraFile) {
                  "exists and is not a file; expected a camera file");
 }
 
+TEST(CliRefusals, FlagsThatContradictEachOtherAreRefused) {
+  // CLI11 would take whichever came last, without a word. The message names both, in either order.
+  for (const std::string args : {"demo --idle-spin --no-idle-spin --seconds 1", "demo --no-idle-spin --idle-spin --seconds 1"})
+    expect_refused(args, "--idle-spin excludes --no-idle-spin");
+  for (const std::string args : {"demo --bending-wrists --in-line-forearms --seconds 1",
+                                 "demo --in-line-forearms --bending-wrists --seconds 1"})
+    expect_refused(args, "--bending-wrists excludes --in-line-forearms");
+  // Each alone still works as before (parsed; the demo itself is not run here).
+  expect_refused("demo --in-line-forearms --seconds -1", "--seconds");
+  expect_refused("demo --bending-wrists --seconds -1", "--seconds");
+}
+
+TEST(CliRefusals, ASubnormalCoordinateOrForceIsRefused) {
+  expect_refused("tension --finger 0 --position 1e-310 0 0 --force 0 0 1",
+                 "--position: expected numbers of ordinary size, got 1e-310 (a subnormal number");
+  expect_refused("tension --finger 0 --position 0 0 0 --force 0 -4.9e-324 1", "--force: expected numbers of ordinary size");
+  // 0 itself, and small ordinary numbers, are fine.
+  EXPECT_EQ(run("tension --finger 0 --position 0 1e-300 0 --force 0 0 1").code, 0);
+}
+
 TEST(CliRefusals, FingerListsAndRangesSayWhatIsExpected) {
   expect_refused("calibrate-strings --fingers 0,0", "--fingers 0,0: finger 0 (left_thumb) is named twice");
   expect_refused("calibrate-strings --fingers 0,,1", "--fingers 0,,1: expected comma-separated finger names or "
