@@ -295,6 +295,7 @@ int main(int argc, char** argv) {
     else if (key == "other_depth_rounds") p.other_depth_rounds = std::atoi(value.c_str());
     else if (key == "other_depth_keep") p.other_depth_keep = std::atof(value.c_str());
     else if (key == "other_depth_confirm") p.other_depth_confirm = std::atoi(value.c_str()) != 0;
+    else if (key == "passive_range") p.passive_range = std::atoi(value.c_str()) != 0;
     else if (key.rfind("shape.", 0) == 0) shape_keys += "  " + key.substr(6) + ": " + value + "\n";
     else reg_keys += "  " + key + ": " + value + "\n";
   }
