@@ -13,10 +13,13 @@
 #include "source_path.hpp"
 #include "spidar/core/pose.hpp"
 #include "spidar/device/fingertip_impedance.hpp"
+#include "spidar/device/servo_cycle.hpp"
 #include "spidar/device/simulated_spidar.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/physics/world.hpp"
+#include "spidar/sim/haptic_bridge.hpp"
 #include "spidar/sim/rubiks_task.hpp"
+#include "spidar/strings/device_config.hpp"
 
 namespace spidar::sim {
 
@@ -60,6 +63,76 @@ inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const 
         device::step_fingertip(imp, device::sanitized(hold[i]), goal[i], -f_proxy[i], dt / 4, x[i], v[i]);
     world->step(x, v);
     if (observe) observe(s * dt, x, cube);
+  }
+}
+
+/// run_lockstep through the simulated device (configs/spidar8.yaml): what the demo adds to the
+/// coupling, in lockstep. Every 1 ms the device advances (the user's fingertips follow the goals,
+/// pulled by the strings' tensions), one servo cycle measures the caps from the encoder counts and
+/// turns the coupling forces (sim::HapticForces, against the proxies of the previous physics step)
+/// into tensions, and the physics steps on the measured fingertips. So the user feels only what
+/// three pulling strings per finger can display, as in the demo; the threads' timing is left out.
+/// `observe` as run_lockstep's, with the true caps.
+inline void run_lockstep_device(const std::function<void(RubiksTask&)>& prepare, const LockstepObserver& observe,
+                                const std::string& scene = {}) {
+  auto world = physics::World::Load(scene.empty() ? spidar::test::source("scenes/rubiks_cube.xml") : scene).value();
+  auto cube = physics::RubiksCube::Attach(*world).value();
+  const auto cfg = strings::load_device_config(spidar::test::source("configs/spidar8.yaml"));
+  RubiksTaskParams tp;
+  tp.proxy_radius = world->params().proxy.radius;
+  tp.p_W_cube = cube.core_pose().p;
+  auto task = std::make_shared<RubiksTask>(tp);
+  if (prepare) prepare(*task);
+  core::Latest<CubePoseSample> pose;
+  task->track(&pose);
+  const double dt = world->timestep();
+  device::SimulatedSpidarParams dp;
+  dp.fixed_step_s = dt;
+  device::SimulatedSpidar dev(cfg, dp, task);
+  if (!dev.open().ok()) return;
+  dev.clear_safe_state();  // as the servo loop does once it runs: a device opens in its safe state
+  device::ServoCycle cycle(cfg, dev.info());
+  HapticForces bridge(world->params().coupling, 1.0 / dt);
+  device::EncoderReading reading;
+  device::FingertipSample sample;
+  device::ForceFrame force;
+  std::vector<std::int32_t> commands(static_cast<std::size_t>(cfg.string_count()), dev.info().command_min);
+  std::vector<Vec3> p(8), v(8, Vec3::Zero());
+  bool placed = false;
+  for (int s = 0; s * dt < tp.duration; ++s) {
+    const std::int64_t t_ns = static_cast<std::int64_t>(s) * 1000000;  // the lockstep's clock, not the host's
+    const Pose X = cube.core_pose();
+    pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+    reading.repeats = 0;
+    if (!dev.read(reading).ok()) return;
+    reading.host_time_ns = t_ns;
+    cycle.measure(reading, sample);
+    bridge.forces(sample, force);
+    cycle.command(force, false, sample, commands);
+    if (!dev.write(commands).ok()) return;
+    const auto target = bridge.targets().read();  // the measured fingertips, velocities filtered
+    for (int f = 0; f < 8; ++f) {
+      p[f] = device::fingertip_position(sample, f);
+      if (target) v[f] = Vec3(target->v_W[f][0], target->v_W[f][1], target->v_W[f][2]);
+    }
+    if (!placed) world->place_proxies(p), placed = true;
+    world->step(p, v);
+    ProxyFrame frame;  // what the physics thread publishes after its step
+    frame.t_ns = t_ns;
+    frame.step = static_cast<std::uint64_t>(s) + 1;
+    frame.finger_count = 8;
+    const auto proxies = world->proxies();
+    for (int f = 0; f < 8; ++f) {
+      frame.p_W[f] = {proxies[f].p_W.x(), proxies[f].p_W.y(), proxies[f].p_W.z()};
+      frame.v_W[f] = {proxies[f].v_W.x(), proxies[f].v_W.y(), proxies[f].v_W.z()};
+      frame.plane_count[f] = proxies[f].plane_count;
+      for (int k = 0; k < proxies[f].plane_count; ++k) {
+        const auto& pl = proxies[f].planes[k];
+        frame.planes[f][k] = {pl.n_W.x(), pl.n_W.y(), pl.n_W.z(), pl.offset};
+      }
+    }
+    bridge.proxies().publish(frame);
+    if (observe) observe(s * dt, dev.truth().p_W_fingertip, cube);
   }
 }
 
