@@ -9,6 +9,25 @@
 #include "spidar/core/units.hpp"
 
 namespace spidar::sim {
+
+ProxyFrame proxy_frame(const physics::World& world, int finger_count, std::int64_t t_ns, std::uint64_t step) {
+  ProxyFrame frame;
+  frame.t_ns = t_ns;
+  frame.step = step;
+  frame.finger_count = finger_count;
+  const auto proxies = world.proxies();
+  for (int f = 0; f < finger_count && f < kMaxFingers && f < static_cast<int>(proxies.size()); ++f) {
+    frame.p_W[f] = {proxies[f].p_W.x(), proxies[f].p_W.y(), proxies[f].p_W.z()};
+    frame.v_W[f] = {proxies[f].v_W.x(), proxies[f].v_W.y(), proxies[f].v_W.z()};
+    frame.plane_count[f] = proxies[f].plane_count;
+    for (int k = 0; k < proxies[f].plane_count; ++k) {
+      const auto& pl = proxies[f].planes[k];
+      frame.planes[f][k] = {pl.n_W.x(), pl.n_W.y(), pl.n_W.z(), pl.offset};
+    }
+  }
+  return frame;
+}
+
 namespace {
 
 Vec3 vec(const Xyz& a) { return {a[0], a[1], a[2]}; }
@@ -119,20 +138,7 @@ void PhysicsThread::run() {
     const std::int64_t end = core::monotonic_ns();
     step_ms_.push_back(static_cast<double>(end - start) * 1e-6);
 
-    ProxyFrame frame;
-    frame.t_ns = end;
-    frame.step = ++step;
-    frame.finger_count = n;
-    const auto proxies = world_.proxies();
-    for (int f = 0; f < n && f < kMaxFingers; ++f) {
-      frame.p_W[f] = {proxies[f].p_W.x(), proxies[f].p_W.y(), proxies[f].p_W.z()};
-      frame.v_W[f] = {proxies[f].v_W.x(), proxies[f].v_W.y(), proxies[f].v_W.z()};
-      frame.plane_count[f] = proxies[f].plane_count;
-      for (int k = 0; k < proxies[f].plane_count; ++k) {
-        const auto& pl = proxies[f].planes[k];
-        frame.planes[f][k] = {pl.n_W.x(), pl.n_W.y(), pl.n_W.z(), pl.offset};
-      }
-    }
+    const ProxyFrame frame = proxy_frame(world_, n, end, ++step);
     if (placed) bridge_.proxies().publish(frame);
     if (step % snapshot_every_ == 0) {
       world_.snapshot(snapshots_.back(), snapshot_proxies_);

@@ -116,21 +116,15 @@ int main(int argc, char** argv) {
     else if (k == "--user-file") a.user_file = next();
     else if (k == "--model-user") a.model_user = true;
     else if (k == "--model") std::sscanf(next().c_str(), "%lf,%lf", &a.model_length, &a.model_width);
-    else if (k == "--model-cap") {
+    else if (k == "--model-cap" || k == "--cube") {
+      // Three comma-separated numbers: the cap's x,y,z [m], or the cube's x,y [m] and yaw [rad].
       Vec3 c;
-      if (std::sscanf(next().c_str(), "%lf,%lf,%lf", &c.x(), &c.y(), &c.z()) != 3) {
-        std::fprintf(stderr, "registration_study: --model-cap: expected x,y,z [m]\n");
+      if (std::sscanf(next().c_str(), "%lf,%lf,%lf", &c.x(), &c.y(), &c.z()) != 3 || !c.allFinite()) {
+        std::fprintf(stderr, "registration_study: %s: expected %s\n", k.c_str(),
+                     k == "--cube" ? "x,y,yaw [m, m, rad]" : "x,y,z [m]");
         return 2;
       }
-      a.model_cap = c;
-    }
-    else if (k == "--cube") {
-      Vec3 c;
-      if (std::sscanf(next().c_str(), "%lf,%lf,%lf", &c.x(), &c.y(), &c.z()) != 3) {
-        std::fprintf(stderr, "registration_study: --cube: expected x,y,yaw [m, m, rad]\n");
-        return 2;
-      }
-      a.cube = c;
+      (k == "--cube" ? a.cube : a.model_cap) = c;
     }
     else if (k == "--silhouette") a.silhouette = true;
     else if (k == "--no-balls") a.no_balls = true;

@@ -117,20 +117,8 @@ inline void run_lockstep_device(const std::function<void(RubiksTask&)>& prepare,
     }
     if (!placed) world->place_proxies(p), placed = true;
     world->step(p, v);
-    ProxyFrame frame;  // what the physics thread publishes after its step
-    frame.t_ns = t_ns;
-    frame.step = static_cast<std::uint64_t>(s) + 1;
-    frame.finger_count = 8;
-    const auto proxies = world->proxies();
-    for (int f = 0; f < 8; ++f) {
-      frame.p_W[f] = {proxies[f].p_W.x(), proxies[f].p_W.y(), proxies[f].p_W.z()};
-      frame.v_W[f] = {proxies[f].v_W.x(), proxies[f].v_W.y(), proxies[f].v_W.z()};
-      frame.plane_count[f] = proxies[f].plane_count;
-      for (int k = 0; k < proxies[f].plane_count; ++k) {
-        const auto& pl = proxies[f].planes[k];
-        frame.planes[f][k] = {pl.n_W.x(), pl.n_W.y(), pl.n_W.z(), pl.offset};
-      }
-    }
+    // What the physics thread publishes after its step.
+    const ProxyFrame frame = proxy_frame(*world, 8, t_ns, static_cast<std::uint64_t>(s) + 1);
     bridge.proxies().publish(frame);
     if (observe) observe(s * dt, dev.truth().p_W_fingertip, cube);
   }

@@ -45,6 +45,10 @@ struct ProxyFrame {
   std::array<std::array<std::array<double, 4>, physics::kMaxPlanes>, kMaxFingers> planes{};  ///< n, offset
 };
 
+/// The frame the physics thread publishes after a step: the world's first `finger_count` proxies
+/// (positions [m], velocities [m/s] and contact planes, world) at host time `t_ns`, step `step`.
+ProxyFrame proxy_frame(const physics::World& world, int finger_count, std::int64_t t_ns, std::uint64_t step);
+
 struct HapticStats {
   std::array<physics::PassivityStats, kMaxFingers> ports{};
 };
