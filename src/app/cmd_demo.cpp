@@ -58,6 +58,10 @@ Action add_demo(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--fixed-hand-size", o->fixed_hand_size,
                 "keep the model hand's sizes (default: estimate each hand's length and width online)");
+  cmd->add_flag("--ring-on-side", o->ring_on_side,
+                "the simulated user's left ring finger presses on the cube's left face instead of its "
+                "back: each finger on a face its strings can push it back from, so the layer turns with "
+                "the cube moved or turned (users 10 % longer then miss the caps by up to 2 mm)");
   cmd->add_flag("--shaped-fingers", o->shaped_fingers,
                 "the simulated user's fingertips yield only where their fingers can move (stiffness "
                 "ellipsoids from their hands): their hands then reach the device's caps");

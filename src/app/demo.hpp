@@ -29,6 +29,7 @@ struct DemoOptions {
   bool fixed_hand_size = false;    ///< no online hand-size personalisation (on in the demo)
   bool bending_wrists = true;      ///< the user's wrists bend: forearms point at fixed elbows
   bool shaped_fingers = false;     ///< the user's fingertips held with their fingers' stiffness
+  bool ring_on_side = false;       ///< the user's left ring finger on the cube's left face
   bool video = true;
 };
 

@@ -92,7 +92,7 @@ int run_mr_demo(const DemoOptions& o) {
   auto mode = render::parse_composite_mode(o.compositor);
   if (!mode) throw UsageError("--compositor: " + mode.error().message);
   // The scripted user plays until its task is done (retries included), by --seconds at most.
-  auto scene_r = session::Scene::load(scene_path, truth_models, {o.seconds, o.shaped_fingers});
+  auto scene_r = session::Scene::load(scene_path, truth_models, {o.seconds, o.shaped_fingers, o.ring_on_side});
   if (!scene_r) throw UsageError("--scene: " + scene_r.error().message);
   session::Scene& scene = *scene_r.value();
   const auto& cube = scene.cube;
@@ -245,6 +245,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.main_silhouette = o.silhouette;
   summary.personalised = !o.fixed_hand_size;
   summary.shaped_fingers = o.shaped_fingers;
+  summary.ring_on_side = o.ring_on_side;
   summary.bending_wrists = o.bending_wrists;
   summary.compositor = o.compositor;
   summary.width = o.width;

@@ -451,6 +451,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"user_hand", s.user_hand},
       {"user_hand_profile", s.user_profile},
       {"shaped_fingers", s.shaped_fingers},
+      {"ring_on_side", s.ring_on_side},
       {"bending_wrists", s.bending_wrists},
       {"haptic", [&] {
          nlohmann::json h = servo_timing_json(s.servo);

@@ -64,6 +64,7 @@ Result<std::shared_ptr<sim::RubiksTask>> make_scripted_task(const physics::World
   tp.proxy_radius = proxy_radius;
   tp.has_cube = cube.has_value();
   tp.shaped_fingers = options.shaped_fingers;
+  tp.ring_on_side = options.ring_on_side;
   if (options.deadline_s > 0) tp.deadline = options.deadline_s;
   *X_cube0 = Pose{};
   if (cube) {

@@ -47,6 +47,19 @@ Contacts contacts(const RubiksTaskParams& p) {
   const double az = spread(p, 0.8), ax = spread(p, 0.37);
   c.left = {Vec3(-0.26 * a, -hold, -0.47 * az), Vec3(-0.2 * a, hold, -0.15 * az),
             Vec3(-0.26 * a, hold, -0.45 * az), Vec3(-0.32 * a, hold, -0.8 * az)};
+  // With ring_on_side, on a cube the left ring finger presses on the left face instead, curled
+  // less than the others,
+  // on the middle layer toward its back edge (0.6 pitch behind the centre, where the users ±10 %
+  // reach it within their active ranges; 0.3 pitch put the short, wide user's ring in its passive
+  // range): the device gives each hand two units that pull
+  // toward the back and two toward the front (configs/spidar8.yaml), so a third finger on the
+  // back face (the ring's unit pulls toward the front-top) displays almost nothing there. Every
+  // unit of the left hand pulls toward −x, so the left face is one the ring's strings can push it
+  // back from. Through the device in lockstep, with the cube turned −0.3 … 0.45 rad or moved 5 cm,
+  // this grasp turned the layer twice at 8 of 8 placements, the back-face one at 3 of 8
+  // (docs/measurements.md, "The cube elsewhere on the table"; test PlacedCubeThroughTheDevice). Another object keeps the
+  // back-face layout: its extent across x is not known (the pinch is along y).
+  if (p.has_cube && p.ring_on_side) c.left[3] = Vec3(-hold, 0.6 * a, -0.45 * az);
   // Right hand on the top layer, from above: thumb in front, index and ring behind either side
   // of the middle, which presses on the top. High on the layer: a fingertip on the middle layer
   // would drag it along.
@@ -56,14 +69,17 @@ Contacts contacts(const RubiksTaskParams& p) {
   return c;
 }
 
-/// True for a contact on the top face; the others press on the front or back face. (Goals lie
-/// `squeeze` inside the faces, so a side contact's |y| is less than half the cube: the face a
-/// contact belongs to is told by its height, which only a top contact has above the top.)
+/// True for a contact on the top face; the others press on a side face. (Goals lie `squeeze`
+/// inside the faces, so a side contact's |y| is less than half the cube: the face a contact
+/// belongs to is told by its height, which only a top contact has above the top.)
 bool on_top(const Vec3& c, double half) { return c.z() >= half - 1e-9; }
 
-/// Outward normal of a contact's face, cube frame.
+/// Outward normal of a contact's face, cube frame: the top, or the side face (front, back, left
+/// or right) the contact lies deepest toward.
 Vec3 face_normal(const Vec3& c, double half) {
-  return on_top(c, half) ? Vec3::UnitZ() : Vec3(0, c.y() > 0 ? 1 : -1, 0);
+  if (on_top(c, half)) return Vec3::UnitZ();
+  if (std::abs(c.x()) > std::abs(c.y())) return Vec3(c.x() > 0 ? 1 : -1, 0, 0);
+  return Vec3(0, c.y() > 0 ? 1 : -1, 0);
 }
 
 /// Where a contact's fingertip is with the hand open: out along the face normal, up a little.

@@ -72,15 +72,16 @@ inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const 
 /// turns the coupling forces (sim::HapticForces, against the proxies of the previous physics step)
 /// into tensions, and the physics steps on the measured fingertips. So the user feels only what
 /// three pulling strings per finger can display, as in the demo; the threads' timing is left out.
-/// `observe` as run_lockstep's, with the true caps.
+/// `observe` as run_lockstep's, with the true caps. `ring_on_side`: RubiksTaskParams::ring_on_side.
 inline void run_lockstep_device(const std::function<void(RubiksTask&)>& prepare, const LockstepObserver& observe,
-                                const std::string& scene = {}) {
+                                const std::string& scene = {}, bool ring_on_side = false) {
   auto world = physics::World::Load(scene.empty() ? spidar::test::source("scenes/rubiks_cube.xml") : scene).value();
   auto cube = physics::RubiksCube::Attach(*world).value();
   const auto cfg = strings::load_device_config(spidar::test::source("configs/spidar8.yaml"));
   RubiksTaskParams tp;
   tp.proxy_radius = world->params().proxy.radius;
   tp.p_W_cube = cube.core_pose().p;
+  tp.ring_on_side = ring_on_side;
   auto task = std::make_shared<RubiksTask>(tp);
   if (prepare) prepare(*task);
   core::Latest<CubePoseSample> pose;

@@ -200,10 +200,11 @@ TEST(ClosedLoopUser, ACubeSinkingInTheHoldingHandMakesItGripHarder) {
   EXPECT_LT(steady.progress.firm_since_s, 0.0);
   EXPECT_GT(sinking.progress.firm_since_s, 7.8);  // once the cube is 2 mm (sink) lower
   EXPECT_LT(sinking.progress.firm_since_s, 8.1);
-  // The left thumb presses +y (its face is the front), the fingers −y; the right hand unchanged.
-  EXPECT_NEAR(sinking.goals_at_8_8[0].y() - steady.goals_at_8_8[0].y(), p.firm_squeeze, 1e-4);
-  for (int f = 1; f < 4; ++f)
-    EXPECT_NEAR(sinking.goals_at_8_8[f].y() - steady.goals_at_8_8[f].y(), -p.firm_squeeze, 1e-4) << f;
+  // Each left fingertip goes deeper along its face's inward normal: the thumb +y (its face is the
+  // front), the fingers −y (the back); the right hand unchanged.
+  const std::array<Vec3, 4> inward{Vec3::UnitY(), -Vec3::UnitY(), -Vec3::UnitY(), -Vec3::UnitY()};
+  for (int f = 0; f < 4; ++f)
+    EXPECT_LT((sinking.goals_at_8_8[f] - steady.goals_at_8_8[f] - p.firm_squeeze * inward[f]).norm(), 1e-4) << f;
   for (int f = 4; f < 8; ++f) EXPECT_LT((sinking.goals_at_8_8[f] - steady.goals_at_8_8[f]).norm(), 1e-9) << f;
   EXPECT_LT(sinking.max_step_m, 0.0005);  // ramped in: no jump
 }

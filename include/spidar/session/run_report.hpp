@@ -43,6 +43,7 @@ struct MrSummary {
   bool personalised = false;  ///< the registration estimated the hands' sizes online
   bool bending_wrists = false;  ///< the simulated user's forearms point at fixed elbows
   bool shaped_fingers = false;  ///< the simulated user's fingertips held by their own fingers' stiffness
+  bool ring_on_side = false;    ///< the simulated user's left ring finger on the cube's left face
   int width = 0, height = 0;
   /// Each trace frame's part of the task (sim::RubiksTask::phase_kind), in trace order: the report
   /// gives the registration and the contested pixels per part (registration.by_phase) and

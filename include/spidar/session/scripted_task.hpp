@@ -35,6 +35,7 @@ Status reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp);
 struct ScriptedUserOptions {
   double deadline_s = 0;        ///< > 0: the run time by which it must be done (retries must fit) [s]
   bool shaped_fingers = false;  ///< sim::RubiksTaskParams::shaped_fingers
+  bool ring_on_side = false;    ///< sim::RubiksTaskParams::ring_on_side
 };
 
 /// The scripted user's task in a scene: the cube's start pose (`X_cube0`) when it has one, else the

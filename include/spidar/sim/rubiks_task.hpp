@@ -87,6 +87,14 @@ struct RubiksTaskParams {
   double firm_squeeze = 0.004;   ///< [m]
   double sink = 0.002;           ///< [m]
   bool has_cube = true;          ///< a Rubik's cube (false: another object, held and twisted; no turns)
+  /// On a cube, the holding (left) hand's ring finger presses on the cube's left face instead of
+  /// its back (rubiks_task.cpp, contacts()): each finger then sits on a face its unit's strings can
+  /// push it back from. Through the device in lockstep the layer turns twice at 8 of 8 placements
+  /// (the cube turned −0.3 … 0.45 rad or moved 5 cm) against 3 of 8; in the demo the default
+  /// user's contested pixels go from about 1.1 % to 0.3 % wrong. But the long users (+10 %
+  /// length) miss the device's caps by 1.4–2.0 mm with it, and their fit loses 0.05 of IoU
+  /// (docs/measurements.md, "The cube elsewhere on the table"). Off by default.
+  bool ring_on_side = false;
   /// The user's fingertips held with their own fingers' stiffness (sim/finger_hold.hpp) once
   /// fit_to_hands is called: the caps then yield to the displayed forces only where the fingers
   /// can follow them, so the user's hands reach the device's caps within their active ranges
