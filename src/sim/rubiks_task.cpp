@@ -48,17 +48,17 @@ Contacts contacts(const RubiksTaskParams& p) {
   c.left = {Vec3(-0.26 * a, -hold, -0.47 * az), Vec3(-0.2 * a, hold, -0.15 * az),
             Vec3(-0.26 * a, hold, -0.45 * az), Vec3(-0.32 * a, hold, -0.8 * az)};
   // With ring_on_side, on a cube the left ring finger presses on the left face instead, curled
-  // less than the others,
-  // on the middle layer toward its back edge (0.6 pitch behind the centre, where the users ±10 %
-  // reach it within their active ranges; 0.3 pitch put the short, wide user's ring in its passive
-  // range): the device gives each hand two units that pull
+  // less than the others, on the middle layer toward its back edge: 0.6 pitch behind the face's
+  // centre, where the users ±10 % reach it within their active ranges (at 0.3 pitch the short,
+  // wide user's ring went into its passive range). The device gives each hand two units that pull
   // toward the back and two toward the front (configs/spidar8.yaml), so a third finger on the
   // back face (the ring's unit pulls toward the front-top) displays almost nothing there. Every
   // unit of the left hand pulls toward −x, so the left face is one the ring's strings can push it
   // back from. Through the device in lockstep, with the cube turned −0.3 … 0.45 rad or moved 5 cm,
   // this grasp turned the layer twice at 8 of 8 placements, the back-face one at 3 of 8
-  // (docs/measurements.md, "The cube elsewhere on the table"; test PlacedCubeThroughTheDevice). Another object keeps the
-  // back-face layout: its extent across x is not known (the pinch is along y).
+  // (docs/measurements.md, "The cube elsewhere on the table"; test PlacedCubeThroughTheDevice).
+  // Another object keeps the back-face layout: its extent across x is not known (the pinch is
+  // along y).
   if (p.has_cube && p.ring_on_side) c.left[3] = Vec3(-hold, 0.6 * a, -0.45 * az);
   // Right hand on the top layer, from above: thumb in front, index and ring behind either side
   // of the middle, which presses on the top. High on the layer: a fingertip on the middle layer
