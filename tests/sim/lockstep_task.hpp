@@ -6,6 +6,7 @@
 // timing of a busy machine.
 #include <algorithm>
 #include <functional>
+#include <memory>
 #include <string>
 #include <span>
 #include <vector>
@@ -28,6 +29,28 @@ namespace spidar::sim {
 using LockstepObserver =
     std::function<void(double t_s, std::span<const Vec3> p_W_caps, const physics::RubiksCube& cube)>;
 
+/// The scene (empty: scenes/rubiks_cube.xml) loaded with its cube, and the task's parameters for
+/// it: the world's proxy radius and the cube's start place.
+struct LockstepScene {
+  std::unique_ptr<physics::World> world;
+  physics::RubiksCube cube;
+  RubiksTaskParams params;
+};
+inline LockstepScene load_lockstep_scene(const std::string& scene) {
+  auto world = physics::World::Load(scene.empty() ? spidar::test::source("scenes/rubiks_cube.xml") : scene).value();
+  auto cube = physics::RubiksCube::Attach(*world).value();
+  RubiksTaskParams tp;
+  tp.proxy_radius = world->params().proxy.radius;
+  tp.p_W_cube = cube.core_pose().p;
+  return {std::move(world), std::move(cube), tp};
+}
+
+/// Publishes the cube's present pose for the task to track.
+inline void publish_cube_pose(const physics::RubiksCube& cube, core::Latest<CubePoseSample>& pose) {
+  const Pose X = cube.core_pose();
+  pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+}
+
 /// Plays the task (the script with the scene's cube and proxy sizes) to its end on the scene
 /// scenes/rubiks_cube.xml. `prepare` sees the task before it starts (e.g. to fit it to hands; the
 /// task lives until run_lockstep returns), `observe` every step after it.
@@ -35,11 +58,7 @@ using LockstepObserver =
 /// (empty: scenes/rubiks_cube.xml).
 inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const LockstepObserver& observe,
                          bool shaped_fingers = false, const std::string& scene = {}) {
-  auto world = physics::World::Load(scene.empty() ? spidar::test::source("scenes/rubiks_cube.xml") : scene).value();
-  auto cube = physics::RubiksCube::Attach(*world).value();
-  RubiksTaskParams tp;
-  tp.proxy_radius = world->params().proxy.radius;
-  tp.p_W_cube = cube.core_pose().p;
+  auto [world, cube, tp] = load_lockstep_scene(scene);
   tp.shaped_fingers = shaped_fingers;
   RubiksTask task(tp);
   if (prepare) prepare(task);
@@ -53,8 +72,7 @@ inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const 
   std::vector<device::FingertipHold> hold(8);
   const double dt = world->timestep();
   for (int s = 0; s * dt < tp.duration; ++s) {
-    const Pose X = cube.core_pose();
-    pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+    publish_cube_pose(cube, pose);
     task.goals(s * dt, goal);
     if (!task.holds(hold)) std::fill(hold.begin(), hold.end(), device::FingertipHold{});
     const auto f_proxy = world->coupling_forces();  // the fingertip feels the opposite
@@ -75,12 +93,8 @@ inline void run_lockstep(const std::function<void(RubiksTask&)>& prepare, const 
 /// `observe` as run_lockstep's, with the true caps. `ring_on_side`: RubiksTaskParams::ring_on_side.
 inline void run_lockstep_device(const std::function<void(RubiksTask&)>& prepare, const LockstepObserver& observe,
                                 const std::string& scene = {}, bool ring_on_side = false) {
-  auto world = physics::World::Load(scene.empty() ? spidar::test::source("scenes/rubiks_cube.xml") : scene).value();
-  auto cube = physics::RubiksCube::Attach(*world).value();
+  auto [world, cube, tp] = load_lockstep_scene(scene);
   const auto cfg = strings::load_device_config(spidar::test::source("configs/spidar8.yaml"));
-  RubiksTaskParams tp;
-  tp.proxy_radius = world->params().proxy.radius;
-  tp.p_W_cube = cube.core_pose().p;
   tp.ring_on_side = ring_on_side;
   auto task = std::make_shared<RubiksTask>(tp);
   if (prepare) prepare(*task);
@@ -102,8 +116,7 @@ inline void run_lockstep_device(const std::function<void(RubiksTask&)>& prepare,
   bool placed = false;
   for (int s = 0; s * dt < tp.duration; ++s) {
     const std::int64_t t_ns = static_cast<std::int64_t>(s) * 1000000;  // the lockstep's clock, not the host's
-    const Pose X = cube.core_pose();
-    pose.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}});
+    publish_cube_pose(cube, pose);
     reading.repeats = 0;
     if (!dev.read(reading).ok()) return;
     reading.host_time_ns = t_ns;

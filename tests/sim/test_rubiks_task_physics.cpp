@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "lockstep_task.hpp"
+#include "temp_path.hpp"
 #include "spidar/core/units.hpp"
 #include "spidar/hand/coupling.hpp"
 #include "spidar/hand/hand_config.hpp"
@@ -27,6 +28,11 @@ struct TaskRun {
   std::array<double, 6> other_faces_max_rad{};  ///< D F B R L: largest |angle| seen
   bool solved = true;
 };
+
+/// The top layer's angle in quarter turns, rounded.
+int u_quarter_turns(const physics::RubiksCube& cube) {
+  return static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+}
 
 /// `fit`: the user's hands the script is fitted to (RubiksTask::fit_to_hands), or nullptr.
 TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr, const std::string& scene = {}) {
@@ -44,7 +50,7 @@ TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr, const std:
         for (int f = 1; f < 6; ++f)
           r.other_faces_max_rad[f] = std::max(r.other_faces_max_rad[f], std::abs(cube.face_angle("UDFBRL"[f])));
         // At the end: U's angle, the unlocks, solved or not (kept from the last step).
-        r.quarter_turns_u = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+        r.quarter_turns_u = u_quarter_turns(cube);
         r.unlocks = cube.layer_unlocks();
         r.solved = cube.is_solved();
       },
@@ -118,11 +124,24 @@ std::string placed_cube_scene(const CubePlacement& c) {
   std::snprintf(placed, sizeof placed, "<body name=\"cube\" pos=\"%.4f %.4f -0.00130\" euler=\"0 0 %.4f\">", c.x_m,
                 c.y_m, c.yaw_rad);
   xml.replace(at, body.size(), placed);
+  // In this process's own folder: ctest runs the placements in parallel processes, and one
+  // writing a file while another reads it would race.
   char name[96];
   std::snprintf(name, sizeof name, "rubiks_placed_%+.3f_%+.3f_%+.3f.xml", c.x_m, c.y_m, c.yaw_rad);
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  static const std::string dir = spidar::test::temp_dir("spidar_placed_cube");
+  const std::string path = (std::filesystem::path(dir) / name).string();
   std::ofstream(path) << xml;
   return path;
+}
+
+/// Hands of the demo's default user's sizes and caps (configs/hands.yaml, profile `user`), with the
+/// default joint ranges (that profile's abduction is ±18°).
+std::array<hand::HandModel, 2> user_sizes_hands() {
+  hand::HandProfile profile;
+  profile.dimensions.length = 0.1976;
+  profile.dimensions.width = 0.0825;
+  profile.dimensions.fingertip_offset = Vec3(0.0, -0.009, 0.001);
+  return {profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
 }
 
 class PlacedCube : public ::testing::TestWithParam<CubePlacement> {};
@@ -130,12 +149,7 @@ class PlacedCube : public ::testing::TestWithParam<CubePlacement> {};
 // Lockstep (the fingertips feel the coupling forces exactly, no strings): at every placement the
 // script, fitted to the default user's hands, lifts the cube and turns the top layer twice.
 TEST_P(PlacedCube, LiftsAndTurnsTheTopLayerTwice) {
-  // The demo's default user (configs/hands.yaml, profile `user`), the script fitted to its hands.
-  hand::HandProfile profile;
-  profile.dimensions.length = 0.1976;
-  profile.dimensions.width = 0.0825;
-  profile.dimensions.fingertip_offset = Vec3(0.0, -0.009, 0.001);
-  const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
+  const std::array<hand::HandModel, 2> hands = user_sizes_hands();
   const TaskRun r = run_task(&hands, placed_cube_scene(GetParam()));
   std::printf("cube at %.3f, %.3f m, turned %.2f rad: lift %.1f mm, U %d quarter turns\n", GetParam().x_m,
               GetParam().y_m, GetParam().yaw_rad, r.lift_max_m * 1e3, r.quarter_turns_u);
@@ -149,17 +163,14 @@ TEST_P(PlacedCube, LiftsAndTurnsTheTopLayerTwice) {
 // hands.yaml's `user`, abduction within ±18°: 0.2, 0.35, 0.45 rad; both: none of −0.45 … −0.05):
 // in turn 2 the cube hangs tilted about 20° in the left hand (also without the device), the right
 // index and ring display under 2 N of the 8–14 N the coupling asks for, and at those angles the
-// cube turns as a whole instead of its top layer. Not asserted until the grasp holds there.
+// cube turns as a whole instead of its top layer. PlacedCubeThroughTheDevice checks the grasp that
+// holds there (RubiksTaskParams::ring_on_side).
 TEST(RubiksTask, LockstepPhysicsThroughTheDeviceTurnsTwice) {
-  hand::HandProfile profile;  // the `user` profile's sizes, as PlacedCube (its abduction range left at ±20°)
-  profile.dimensions.length = 0.1976;
-  profile.dimensions.width = 0.0825;
-  profile.dimensions.fingertip_offset = Vec3(0.0, -0.009, 0.001);
-  const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
+  const std::array<hand::HandModel, 2> hands = user_sizes_hands();
   int quarter_turns = 0;
   run_lockstep_device([&](RubiksTask& task) { task.fit_to_hands(hands); },
                       [&](double, std::span<const Vec3>, const physics::RubiksCube& cube) {
-                        quarter_turns = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+                        quarter_turns = u_quarter_turns(cube);
                       });
   EXPECT_EQ(quarter_turns, 2);
 }
@@ -178,7 +189,7 @@ TEST_P(PlacedCubeThroughTheDevice, LiftsAndTurnsTheTopLayerTwice) {
   int quarter_turns = 0;
   run_lockstep_device([&](RubiksTask& task) { task.fit_to_hands(hands); },
                       [&](double, std::span<const Vec3>, const physics::RubiksCube& cube) {
-                        quarter_turns = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+                        quarter_turns = u_quarter_turns(cube);
                       },
                       placed_cube_scene(GetParam()), /*ring_on_side=*/true);
   std::printf("cube at %.3f, %.3f m, turned %.2f rad, through the device: U %d quarter turns\n", GetParam().x_m,
