@@ -331,7 +331,7 @@ NearSideMoments near_side_moments(const BandNearSide& n) {
 struct NearSideExtent {
   double lo = std::numeric_limits<double>::infinity();
   double hi = -std::numeric_limits<double>::infinity();
-  std::array<Vec3, 2> ends{};
+  std::array<Vec3, 2> ends = zeros<Vec3, 2>();
 };
 
 NearSideExtent near_side_extent(const BandNearSide& n, const Vec2& dir) {

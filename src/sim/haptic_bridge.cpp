@@ -41,10 +41,6 @@ HapticForces::HapticForces(physics::CouplingParams coupling, double servo_rate_h
   const double rc = 1.0 / (2.0 * units::kPi * velocity_cutoff_hz);
   alpha_ = dt_ / (rc + dt_);
   for (auto& p : ports_) p = physics::PassivityPort(passivity_control);
-  // `v_{}` does not zero it: Eigen's vectors have a default constructor that leaves them as they
-  // are. The first fingertip velocities were heap garbage, filtered on from there: valgrind found
-  // it; force spikes of 12–18 N in the scenario test in a build whose heap layout differed.
-  v_.fill(Vec3::Zero());
 }
 
 void HapticForces::forces(const device::FingertipSample& in, device::ForceFrame& out) noexcept {

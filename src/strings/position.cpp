@@ -14,7 +14,7 @@ namespace {
 /// Distances and unit directions from each fulcrum to p, and the cost Σ (‖P − A_i‖ − l_i)².
 struct Linearisation {
   std::array<double, kMaxStrings> r{};  ///< residuals ‖P − A_i‖ − l_i [m]
-  std::array<Vec3, kMaxStrings> j{};    ///< unit directions (P − A_i)/‖P − A_i‖
+  std::array<Vec3, kMaxStrings> j = zeros<Vec3, kMaxStrings>();  ///< unit directions (P − A_i)/‖P − A_i‖
   double cost = 0.0;
 };
 

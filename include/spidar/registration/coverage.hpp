@@ -39,8 +39,8 @@ struct ProjectedHand {
   /// The palm box's corners in right-hand H coordinates [m] (hand_shape.hpp) and their projections
   /// [px]; `hull` lists corner indices of the projected convex hull, counter-clockwise in the
   /// image's (x right, y down) coordinates.
-  std::array<Vec3, 8> palm_H{};
-  std::array<Vec2, 8> palm_px{};
+  std::array<Vec3, 8> palm_H = zeros<Vec3, 8>();
+  std::array<Vec2, 8> palm_px = zeros<Vec2, 8>();
   std::array<int, 8> hull{};
   int hull_count = 0;  ///< 0 = the palm is not drawn (a corner behind the camera)
   ImageCapsule forearm;

@@ -47,7 +47,7 @@ struct OwnedPixel;  // coverage.hpp
 
 /// What is measured of one hand in one frame.
 struct HandObservation {
-  std::array<Vec3, hand::kFingertipCount> p_W_fingertip{};  ///< from the strings, world [m]
+  std::array<Vec3, hand::kFingertipCount> p_W_fingertip = zeros<Vec3, hand::kFingertipCount>();  ///< from the strings, world [m]
   std::array<bool, hand::kFingertipCount> fingertip_valid{};
   std::optional<Vec2> wrist_px;  ///< projected wrist from the bracelet [px]
   double wrist_confidence = 1.0; ///< 0..1, multiplies the wrist term's weight

@@ -35,7 +35,7 @@ struct FrameTruthMetrics {
   std::array<double, 2> wrist_px{};
   /// How each fitted palm is turned against the true one [deg]: registration::palm_rotation_error_rad
   /// (x pitched, y rolled, z turned in the palm's plane, in the hand's own axes).
-  std::array<Vec3, 2> palm_rotation_deg{};
+  std::array<Vec3, 2> palm_rotation_deg = zeros<Vec3, 2>();
   /// The paper's model's joint error floor per hand [px]: its skeleton with the user's true sizes
   /// at the true pose, with the little finger following the ring finger's (the paper's model has
   /// no parameters of their own for it; registration's little_free fits them, and can go below

@@ -71,7 +71,7 @@ class HapticForces final : public device::ForceSource {
   double alpha_;  ///< velocity low-pass coefficient
   bool have_prev_ = false;
   device::FingertipSample prev_;
-  std::array<Vec3, kMaxFingers> v_;  ///< filtered fingertip velocities [m/s], world (zeroed by the constructor)
+  std::array<Vec3, kMaxFingers> v_ = zeros<Vec3, kMaxFingers>();  ///< filtered fingertip velocities [m/s], world
   std::array<physics::PassivityPort, kMaxFingers> ports_;
   HapticStats stats_;
   core::Latest<TargetFrame> targets_;

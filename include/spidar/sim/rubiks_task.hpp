@@ -282,7 +282,7 @@ class RubiksTask final : public device::FingertipSource {
   core::Latest<Plan> published_plan_;       ///< for the other threads
   double prev_s_ = 0;                       ///< script time at the previous goals() call
   double prev_goal_t_ = -1;                 ///< run time of the previous goals() call (−1: none)
-  std::array<Vec3, 8> prev_goal_{};         ///< the goals it gave
+  std::array<Vec3, 8> prev_goal_ = zeros<Vec3, 8>();        ///< the goals it gave
   double drop_since_ = -1;                  ///< run time the cube was first seen dropped (−1: not)
   double turn_start_lift_ = -1;             ///< the held cube's lift when the current turn began [m] (−1: no turn)
   int turns_at_check_ = 0;                  ///< turns seen at the previous turn check

@@ -28,7 +28,7 @@ struct ClosedFormTriple {
 /// Geometry of one point's strings in the world frame.
 struct PointGeometry {
   int n = 0;                                ///< number of strings, 3..kMaxStrings
-  std::array<Vec3, kMaxStrings> p_WA{};     ///< fulcrum of string i [m], world
+  std::array<Vec3, kMaxStrings> p_WA = zeros<Vec3, kMaxStrings>();  ///< fulcrum of string i [m], world
   Vec3 p_W_inner = Vec3::Zero();            ///< a point on the frame's inner side (its centre)
   ClosedFormTriple triple;                  ///< best-conditioned triple for the closed form
 };

@@ -18,7 +18,7 @@ namespace spidar::strings {
 
 struct TensionSolution {
   StringVec t;              ///< tension of each string [N]
-  Vec3 f_displayed;         ///< Σ t_i u_i [N], world
+  Vec3 f_displayed = Vec3::Zero();  ///< Σ t_i u_i [N], world
   bool reachable = false;   ///< ‖f_displayed − f_desired‖ ≤ 1e-9 (1 + ‖f_desired‖)
   int iterations = 0;       ///< active-set iterations
 };
