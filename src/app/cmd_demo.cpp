@@ -58,14 +58,25 @@ Action add_demo(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--fixed-hand-size", o->fixed_hand_size,
                 "keep the model hand's sizes (default: estimate each hand's length and width online)");
-  cmd->add_flag("--ring-on-side", o->ring_on_side,
-                "the simulated user's left ring finger presses on the cube's left face instead of its "
-                "back: each finger on a face its strings can push it back from, so the layer turns with "
-                "the cube moved or turned (users 10 % longer then miss the caps by up to 2 mm)");
+  // Two flags that contradict each other are refused (CLI11 would take the last one given), here
+  // and below.
+  CLI::Option* ring_side = cmd->add_flag("--ring-on-side", o->ring_on_side,
+                                         "the simulated user's left ring finger presses on the cube's left face: "
+                                         "each finger on a face its strings can push it back from, so the layer "
+                                         "turns with the cube moved or turned (the default)");
+  cmd->add_flag("!--ring-on-back", o->ring_on_side,
+                "the simulated user's left ring finger presses on the cube's back face, with the index and "
+                "middle finger (the grasp before 2026-11-29: the layer's second turn fails with the cube "
+                "turned or moved)")
+      ->excludes(ring_side);
+  cmd->add_option("--fit-margin", o->fit_margin_rad,
+                  "how far inside their finger joints' ranges the simulated user's script is fitted to "
+                  "their hands [rad]: room for the fingers to follow caps pressed by the strings")
+      ->check(range_check(0.0, 0.3, "rad"))
+      ->capture_default_str();
   cmd->add_flag("--shaped-fingers", o->shaped_fingers,
                 "the simulated user's fingertips yield only where their fingers can move (stiffness "
                 "ellipsoids from their hands): their hands then reach the device's caps");
-  // Two flags that contradict each other are refused (CLI11 would take the last one given).
   CLI::Option* bending = cmd->add_flag("--bending-wrists", o->bending_wrists,
                                        "the simulated user's forearms point at elbows that stay where they were at "
                                        "the script's start, and their wrists bend (up to 60 deg) when the hands turn "

@@ -29,7 +29,8 @@ struct DemoOptions {
   bool fixed_hand_size = false;    ///< no online hand-size personalisation (on in the demo)
   bool bending_wrists = true;      ///< the user's wrists bend: forearms point at fixed elbows
   bool shaped_fingers = false;     ///< the user's fingertips held with their fingers' stiffness
-  bool ring_on_side = false;       ///< the user's left ring finger on the cube's left face
+  bool ring_on_side = true;        ///< the user's left ring finger on the cube's left face
+  double fit_margin_rad = 0.1;     ///< session::ScriptedUserOptions::fit_limit_margin_rad
   bool video = true;
 };
 

@@ -92,7 +92,7 @@ int run_mr_demo(const DemoOptions& o) {
   auto mode = render::parse_composite_mode(o.compositor);
   if (!mode) throw UsageError("--compositor: " + mode.error().message);
   // The scripted user plays until its task is done (retries included), by --seconds at most.
-  auto scene_r = session::Scene::load(scene_path, truth_models, {o.seconds, o.shaped_fingers, o.ring_on_side});
+  auto scene_r = session::Scene::load(scene_path, truth_models, {o.seconds, o.shaped_fingers, o.ring_on_side, o.fit_margin_rad});
   if (!scene_r) throw UsageError("--scene: " + scene_r.error().message);
   session::Scene& scene = *scene_r.value();
   const auto& cube = scene.cube;
@@ -246,6 +246,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.personalised = !o.fixed_hand_size;
   summary.shaped_fingers = o.shaped_fingers;
   summary.ring_on_side = o.ring_on_side;
+  summary.fit_margin_rad = o.fit_margin_rad;
   summary.bending_wrists = o.bending_wrists;
   summary.compositor = o.compositor;
   summary.width = o.width;

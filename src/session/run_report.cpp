@@ -452,6 +452,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
       {"user_hand_profile", s.user_profile},
       {"shaped_fingers", s.shaped_fingers},
       {"ring_on_side", s.ring_on_side},
+      {"fit_margin_rad", s.fit_margin_rad},
       {"bending_wrists", s.bending_wrists},
       {"haptic", [&] {
          nlohmann::json h = servo_timing_json(s.servo);

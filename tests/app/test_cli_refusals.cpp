@@ -93,9 +93,15 @@ TEST(CliRefusals, FlagsThatContradictEachOtherAreRefused) {
   for (const std::string args : {"demo --bending-wrists --in-line-forearms --seconds 1",
                                  "demo --in-line-forearms --bending-wrists --seconds 1"})
     expect_refused(args, "--bending-wrists excludes --in-line-forearms");
+  for (const std::string args : {"demo --ring-on-side --ring-on-back --seconds 1", "demo --ring-on-back --ring-on-side --seconds 1"})
+    expect_refused(args, "--ring-on-side excludes --ring-on-back");
   // Each alone still works as before (parsed; the demo itself is not run here).
   expect_refused("demo --in-line-forearms --seconds -1", "--seconds");
   expect_refused("demo --bending-wrists --seconds -1", "--seconds");
+  expect_refused("demo --ring-on-back --seconds -1", "--seconds");
+  // The fit's margin is an angle within the joints' ranges.
+  expect_refused("demo --fit-margin 0.5 --seconds 1", "--fit-margin");
+  expect_refused("demo --fit-margin nan --seconds 1", "--fit-margin");
 }
 
 TEST(CliRefusals, ASubnormalCoordinateOrForceIsRefused) {
