@@ -9,7 +9,11 @@
 //                      [--silhouette] [--no-balls] [--no-wrist] [--personalise]
 //                      [--t0 S] [--t1 S] [--fps F] [--verbose [--q-from S --q-to S]] [--ceiling-scan]
 //                      [--dump DIR [--dump-below IOU]] [--bending-wrists [--oracle-forearm]]
-//                      [--set KEY=VALUE]... [--cube X,Y,YAW]
+//                      [--set KEY=VALUE]... [--cube X,Y,YAW] [--ring-on-side] [--fit-margin RAD]
+//
+// --ring-on-side --fit-margin 0.1: the scripted user's grasp as the session plays it (its
+// defaults since 2026-11-29: the left ring finger on the cube's left face, the script fitted
+// 0.1 rad inside the joint ranges); without them, RubiksTaskParams' defaults.
 //
 // --cube: the cube elsewhere on the table, centre (X, Y) [m] and turned YAW [rad] about the
 // vertical; the scripted user grasps it where it lies (RubiksTask::track), as in the demo with a
@@ -91,6 +95,8 @@ struct Args {
   bool oracle_forearm = false;  ///< --oracle-forearm: the registration is told where the true forearms point
   double shape_w = 0, shape_dq = 0;
   bool shape_silhouette = false;  ///< --shape-silhouette: the size estimator also fits the keyframes' spill
+  bool ring_on_side = false;  ///< --ring-on-side: sim::RubiksTaskParams::ring_on_side (the session's grasp)
+  double fit_margin = 0;      ///< --fit-margin RAD: fit_to_hands' limit margin (the session's: 0.1)
 };
 
 double mean(const std::vector<double>& v) {
@@ -158,6 +164,8 @@ int main(int argc, char** argv) {
       }
     }
     else if (k == "--set") a.sets.push_back(next());
+    else if (k == "--ring-on-side") a.ring_on_side = true;
+    else if (k == "--fit-margin") a.fit_margin = std::atof(next().c_str());
     else {
       std::fprintf(stderr, "registration_study: unknown argument %s\n", k.c_str());
       return 2;
@@ -324,8 +332,9 @@ int main(int argc, char** argv) {
     sample.q_WC = {X_W_cube.R.w(), X_W_cube.R.x(), X_W_cube.R.y(), X_W_cube.R.z()};
     cube_pose.publish(sample);
   }
+  task_params.ring_on_side = a.ring_on_side;
   sim::RubiksTask task(task_params);
-  task.fit_to_hands(truth_models);
+  task.fit_to_hands(truth_models, 0.01, a.fit_margin);
   if (a.cube) task.track(&cube_pose);
   sim::SyntheticCameraParams film_params;
   if (a.bending_wrists) film_params.elbows_W = sim::user_elbows(task);
@@ -370,6 +379,8 @@ int main(int argc, char** argv) {
   std::array<double, 6> joint_part_sum{}, joint_floor_sum{}, joint_part_n{};  // wrist, thumb … little
   int brace_n = 0;
   std::vector<double> brace_axis, brace_surf, obs, caps, iou, tip, joint, ceil_iou, contested, contested_paper;
+  std::array<double, 2> iterations{};  // linear solves, summed over the frames
+  int kept_restarts = 0, kept_switches = 0, kept_reaches = 0;
   std::vector<double> frame_t;  // each scored frame's time on the script [s]
   std::array<std::vector<double>, 2> wrist_depth_mm;  // fit − truth along the camera's axis, per hand
   // The angle between the forearm direction the fit used and the simulated forearm's [°], per hand.
@@ -737,6 +748,8 @@ int main(int argc, char** argv) {
         }
       }
     }
+    for (int h = 0; h < 2; ++h) iterations[h] += r.fits[static_cast<std::size_t>(h)].iterations;
+    kept_restarts += r.restarts, kept_switches += r.depth_switches, kept_reaches += r.reaches;
     obs.push_back(1e3 * obs_res);
     caps.push_back(1e3 * cap_res);
     iou.push_back(m.iou);
@@ -771,6 +784,12 @@ int main(int argc, char** argv) {
       "%.2f px  contested %.2f %% (paper %.2f %%)\n",
       iou.size(), mean(iou), quantile(iou, 0.05), mean(ceil_iou), quantile(ceil_iou, 0.05),
       mean(tip), quantile(tip, 0.95), mean(joint), mean(contested), mean(contested_paper));
+  // What the fit costs, without a clock: its linear solves per frame, per hand, and how often a
+  // second start was kept (a restart, the wrist's other depth, a digit re-posed to its string).
+  std::printf("iterations per frame: left %.1f right %.1f; kept restarts %d, other depths %d, reaches %d\n",
+              iou.empty() ? 0.0 : iterations[0] / static_cast<double>(iou.size()),
+              iou.empty() ? 0.0 : iterations[1] / static_cast<double>(iou.size()), kept_restarts, kept_switches,
+              kept_reaches);
   // The same figures second by second of the script: where in the run the fit loses (the approach,
   // the sizes' convergence, the release), each against its ceiling.
   {
