@@ -70,8 +70,8 @@ Action add_demo(CLI::App& app) {
                 "turned or moved)")
       ->excludes(ring_side);
   cmd->add_option("--fit-margin", o->fit_margin_rad,
-                  "how far inside their finger joints' ranges the simulated user's script is fitted to "
-                  "their hands [rad]: room for the fingers to follow caps pressed by the strings")
+                  "how far inside its finger joints' ranges the simulated user's script is fitted to "
+                  "their holding (left) hand [rad]: room for its fingers to follow caps pressed by the strings")
       ->check(range_check(0.0, 0.3, "rad"))
       ->capture_default_str();
   cmd->add_flag("--shaped-fingers", o->shaped_fingers,

@@ -30,7 +30,7 @@ struct DemoOptions {
   bool bending_wrists = true;      ///< the user's wrists bend: forearms point at fixed elbows
   bool shaped_fingers = false;     ///< the user's fingertips held with their fingers' stiffness
   bool ring_on_side = true;        ///< the user's left ring finger on the cube's left face
-  double fit_margin_rad = 0.1;     ///< session::ScriptedUserOptions::fit_limit_margin_rad
+  double fit_margin_rad = 0.1;     ///< session::ScriptedUserOptions::fit_limit_margin_rad (holding hand)
   bool video = true;
 };
 

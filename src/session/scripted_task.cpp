@@ -77,7 +77,7 @@ Result<std::shared_ptr<sim::RubiksTask>> make_scripted_task(const physics::World
     X_cube0->p = tp.p_W_cube;
   }
   auto task = std::make_shared<sim::RubiksTask>(tp);
-  task->fit_to_hands(user, 0.01, options.fit_limit_margin_rad);
+  task->fit_to_hands(user, 0.01, std::array<double, 2>{options.fit_limit_margin_rad, 0.0});
   return std::shared_ptr<sim::RubiksTask>(std::move(task));
 }
 

@@ -62,7 +62,7 @@ Vec3 onto_face(const Vec3& fitted, const Vec3& n, double closed, const RubiksTas
 }  // namespace
 
 void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, double dt_s,
-                              double limit_margin_rad) {
+                              const std::array<double, 2>& limit_margin_rad) {
   fit_dt_ = std::clamp(dt_s, 1e-3, 0.1);
   // A little past the end, so that the last interval interpolates between fitted samples.
   const auto n = static_cast<std::size_t>(std::ceil((p_.duration + 0.5) / fit_dt_)) + 2;
@@ -77,7 +77,7 @@ void RubiksTask::fit_to_hands(const std::array<hand::HandModel, 2>& hands, doubl
     // Fitted inside the joint ranges by the margin: the device's caps lie past the touching
     // positions (pressed into the faces, pulled by the strings) and the user's fingers must be
     // able to follow them there, not already be at a limit.
-    const double margin = std::max(0.0, limit_margin_rad);
+    const double margin = std::isfinite(limit_margin_rad[h]) ? std::max(0.0, limit_margin_rad[h]) : 0.0;
     const hand::HandModel model = with_inset_limits(hands[h], margin);
     // Shaped fingers: two more passes toward the faces (and the hand's own layers).
     const int passes = p_.shaped_fingers ? 3 : (margin > 0 ? 2 : 1);

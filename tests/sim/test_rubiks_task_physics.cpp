@@ -183,7 +183,8 @@ TEST(RubiksTask, LockstepPhysicsThroughTheDeviceTurnsTwice) {
 class PlacedCubeThroughTheDevice : public ::testing::TestWithParam<CubePlacement> {};
 
 /// U's quarter turns at the end of the session's scripted task (the ring on the left face, the
-/// script fitted 0.1 rad inside the joint ranges: session::ScriptedUserOptions' defaults) for the
+/// script fitted 0.1 rad inside the holding hand's joint ranges: session::ScriptedUserOptions'
+/// defaults) for the
 /// user of `hands_file` (its profile `user`, else its first) with the cube at `c`, through the
 /// simulated device.
 int session_task_through_the_device(const std::string& hands_file, const CubePlacement& c) {
@@ -191,7 +192,7 @@ int session_task_through_the_device(const std::string& hands_file, const CubePla
   const hand::HandProfile& profile = profiles.find("user") ? *profiles.find("user") : profiles.profiles.at(0);
   const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
   int quarter_turns = 0;
-  run_lockstep_device([&](RubiksTask& task) { task.fit_to_hands(hands, 0.01, /*limit_margin_rad=*/0.1); },
+  run_lockstep_device([&](RubiksTask& task) { task.fit_to_hands(hands, 0.01, std::array<double, 2>{0.1, 0.0}); },
                       [&](double, std::span<const Vec3>, const physics::RubiksCube& cube) {
                         quarter_turns = u_quarter_turns(cube);
                       },

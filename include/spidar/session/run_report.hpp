@@ -44,7 +44,7 @@ struct MrSummary {
   bool bending_wrists = false;  ///< the simulated user's forearms point at fixed elbows
   bool shaped_fingers = false;  ///< the simulated user's fingertips held by their own fingers' stiffness
   bool ring_on_side = false;    ///< the simulated user's left ring finger on the cube's left face
-  double fit_margin_rad = 0.0;  ///< the script fitted this far inside the user's joint ranges [rad]
+  double fit_margin_rad = 0.0;  ///< the script fitted this far inside the holding hand's joint ranges [rad]
   int width = 0, height = 0;
   /// Each trace frame's part of the task (sim::RubiksTask::phase_kind), in trace order: the report
   /// gives the registration and the contested pixels per part (registration.by_phase) and

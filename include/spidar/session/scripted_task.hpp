@@ -38,11 +38,12 @@ struct ScriptedUserOptions {
   /// sim::RubiksTaskParams::ring_on_side: the holding hand's ring finger on the cube's left face,
   /// where its strings can push it back (the library's RubiksTaskParams keeps the back face).
   bool ring_on_side = true;
-  /// The script is fitted to the user's hands this far inside their finger joints' ranges [rad]
-  /// (sim::RubiksTask::fit_to_hands' limit_margin_rad), so that the fingers can follow their caps
-  /// where the displayed forces press them. With the ring on the side and 0, users 10 % longer
-  /// miss their caps by 1.4–2.0 mm (the left index pressed past its passive abduction range);
-  /// with 0.1, every user ±10 % within 0.8 mm (docs/measurements.md, session 46).
+  /// The script is fitted to the user's holding (left) hand this far inside its finger joints'
+  /// ranges [rad] (sim::RubiksTask::fit_to_hands' limit_margin_rad; the turning hand's is 0), so
+  /// that its fingers can follow their caps where the displayed forces press them. With the ring
+  /// on the side and 0, users 10 % longer miss their caps by 1.4–2.0 mm (the left index pressed
+  /// past its passive abduction range); with 0.1, every user ±10 % within 0.8 mm
+  /// (docs/measurements.md, session 46).
   double fit_limit_margin_rad = 0.1;
 };
 
