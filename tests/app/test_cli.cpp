@@ -275,9 +275,12 @@ TEST(Cli, DemoFilmsThroughACalibratedLens) {
   ASSERT_NE(g, nullptr);
   fputs(cam.c_str(), g);
   fclose(g);
-  auto r = run("demo --seconds 2 --no-video --width 320 --height 240 --camera " + cam_path + " --out " + dir);
+  // With the old grasp (the ring on the back face: no fit margin unless one is given).
+  auto r = run("demo --seconds 2 --no-video --ring-on-back --width 320 --height 240 --camera " + cam_path + " --out " + dir);
   const auto j = read_json(dir + "/report.json");
   ASSERT_TRUE(j.is_object()) << "no report.json; exit " << r.code << "\n" << r.err;
+  EXPECT_FALSE(j["ring_on_side"].get<bool>());
+  EXPECT_EQ(j["fit_margin_rad"].get<double>(), 0.0);
   EXPECT_EQ(r.code, j["haptic"]["faults"] == "none" ? 0 : 1) << r.err;
   EXPECT_GE(j["frames"].get<int>(), 4);
   // As MixedRealityDemoRunsEndToEnd's bounds (the fit's quality under load is not this test's).
@@ -298,6 +301,9 @@ TEST(Cli, MixedRealityDemoRunsEndToEnd) {
   // late physics step or servo cycle can latch a timing fault, nothing else may.
   const std::string faults = j["haptic"]["faults"];
   EXPECT_EQ(r.code, faults == "none" ? 0 : 1) << r.err;
+  // The scripted user's grasp by default: the ring on the cube's side, the holding hand's margin.
+  EXPECT_TRUE(j["ring_on_side"].get<bool>());
+  EXPECT_EQ(j["fit_margin_rad"].get<double>(), 0.1);
   if (faults != "none") {
     EXPECT_NE(r.err.find("the servo loop latched"), std::string::npos) << r.err;
     for (const char* f : {"workspace", "inconsistent", "encoder_glitch", "over_current", "protocol"})

@@ -13,7 +13,7 @@
 //
 // --ring-on-side --fit-margin 0.1: the scripted user's grasp as the session plays it (its
 // defaults since 2026-11-29: the left ring finger on the cube's left face, the script fitted
-// 0.1 rad inside the joint ranges); without them, RubiksTaskParams' defaults.
+// 0.1 rad inside the holding hand's joint ranges); without them, RubiksTaskParams' defaults.
 //
 // --cube: the cube elsewhere on the table, centre (X, Y) [m] and turned YAW [rad] about the
 // vertical; the scripted user grasps it where it lies (RubiksTask::track), as in the demo with a
@@ -96,7 +96,7 @@ struct Args {
   double shape_w = 0, shape_dq = 0;
   bool shape_silhouette = false;  ///< --shape-silhouette: the size estimator also fits the keyframes' spill
   bool ring_on_side = false;  ///< --ring-on-side: sim::RubiksTaskParams::ring_on_side (the session's grasp)
-  double fit_margin = 0;      ///< --fit-margin RAD: fit_to_hands' limit margin (the session's: 0.1)
+  double fit_margin = 0;      ///< --fit-margin RAD: fit_to_hands' limit margin, holding hand (the session's: 0.1)
 };
 
 double mean(const std::vector<double>& v) {
@@ -334,7 +334,7 @@ int main(int argc, char** argv) {
   }
   task_params.ring_on_side = a.ring_on_side;
   sim::RubiksTask task(task_params);
-  task.fit_to_hands(truth_models, 0.01, a.fit_margin);
+  task.fit_to_hands(truth_models, 0.01, std::array<double, 2>{a.fit_margin, 0.0});
   if (a.cube) task.track(&cube_pose);
   sim::SyntheticCameraParams film_params;
   if (a.bending_wrists) film_params.elbows_W = sim::user_elbows(task);
