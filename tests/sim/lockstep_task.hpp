@@ -5,6 +5,8 @@
 // the fingertips end up (the cube's turns, the user's hands on the caps) is checked without the
 // timing of a busy machine.
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -16,10 +18,12 @@
 #include "spidar/device/fingertip_impedance.hpp"
 #include "spidar/device/servo_cycle.hpp"
 #include "spidar/device/simulated_spidar.hpp"
+#include "spidar/hand/hand_config.hpp"
 #include "spidar/physics/rubiks_cube.hpp"
 #include "spidar/physics/world.hpp"
 #include "spidar/sim/haptic_bridge.hpp"
 #include "spidar/sim/rubiks_task.hpp"
+#include "spidar/sim/user_hands.hpp"
 #include "spidar/strings/device_config.hpp"
 
 namespace spidar::sim {
@@ -44,6 +48,41 @@ inline LockstepScene load_lockstep_scene(const std::string& scene) {
   tp.p_W_cube = cube.core_pose().p;
   return {std::move(world), std::move(cube), tp};
 }
+
+/// The top layer's angle in quarter turns, rounded.
+inline int u_quarter_turns(const physics::RubiksCube& cube) {
+  return static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
+}
+
+/// The hands (left, right) of the user in hands YAML `hands_file` (a path in the source tree): its
+/// profile `user`, else its first.
+inline std::array<hand::HandModel, 2> profile_hands(const std::string& hands_file) {
+  const auto profiles = hand::load_hand_profiles(spidar::test::source(hands_file));
+  const hand::HandProfile& profile = profiles.find("user") ? *profiles.find("user") : profiles.profiles.at(0);
+  return {profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
+}
+
+/// The simulated user's hands posed on the device's caps at the camera's rate (30 frames per
+/// second), as the demo's camera thread poses them, from a lockstep run's observer.
+class CameraRateUser {
+ public:
+  explicit CameraRateUser(const std::array<hand::HandModel, 2>& hands) : hands_(hands) {}
+  /// Makes the hands for `task` (after it is fitted; it must outlive them).
+  void start(const RubiksTask& task) { user_ = std::make_unique<UserHands>(hands_, task); }
+  /// Poses the hands on `p_W_caps` at run time t [s] when a frame is due; returns whether it did.
+  bool pose(double t_s, std::span<const Vec3> p_W_caps) {
+    if (t_s + 1e-9 < next_frame_s_) return false;
+    next_frame_s_ += 1.0 / 30;
+    user_->update(t_s, p_W_caps);
+    return true;
+  }
+  const UserHands& hands() const { return *user_; }
+
+ private:
+  std::array<hand::HandModel, 2> hands_;
+  std::unique_ptr<UserHands> user_;
+  double next_frame_s_ = 0;
+};
 
 /// Publishes the cube's present pose for the task to track.
 inline void publish_cube_pose(const physics::RubiksCube& cube, core::Latest<CubePoseSample>& pose) {

@@ -29,11 +29,6 @@ struct TaskRun {
   bool solved = true;
 };
 
-/// The top layer's angle in quarter turns, rounded.
-int u_quarter_turns(const physics::RubiksCube& cube) {
-  return static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
-}
-
 /// `fit`: the user's hands the script is fitted to (RubiksTask::fit_to_hands), or nullptr.
 TaskRun run_task(const std::array<hand::HandModel, 2>* fit = nullptr, const std::string& scene = {}) {
   TaskRun r;
@@ -188,9 +183,7 @@ class PlacedCubeThroughTheDevice : public ::testing::TestWithParam<CubePlacement
 /// user of `hands_file` (its profile `user`, else its first) with the cube at `c`, through the
 /// simulated device.
 int session_task_through_the_device(const std::string& hands_file, const CubePlacement& c) {
-  const auto profiles = hand::load_hand_profiles(spidar::test::source(hands_file));
-  const hand::HandProfile& profile = profiles.find("user") ? *profiles.find("user") : profiles.profiles.at(0);
-  const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
+  const std::array<hand::HandModel, 2> hands = profile_hands(hands_file);
   int quarter_turns = 0;
   run_lockstep_device([&](RubiksTask& task) { task.fit_to_hands(hands, 0.01, std::array<double, 2>{0.1, 0.0}); },
                       [&](double, std::span<const Vec3>, const physics::RubiksCube& cube) {

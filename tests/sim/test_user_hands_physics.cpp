@@ -38,30 +38,28 @@ struct PressedRun {
 /// lockstep physics; the user's hands posed on the device's caps at 30 frames per second, as the
 /// camera thread does.
 PressedRun pressed_run(const std::array<hand::HandModel, 2>& hands, double limit_margin_rad, bool shaped_fingers) {
-  std::unique_ptr<UserHands> user;
+  CameraRateUser camera_user(hands);
   std::vector<double> per_frame;
   PressedRun r;
-  double next_frame = 0;
   run_lockstep(
       [&](RubiksTask& task) {
         task.fit_to_hands(hands, 0.01, limit_margin_rad);
-        user = std::make_unique<UserHands>(hands, task);
+        camera_user.start(task);
       },
       [&](double t, std::span<const Vec3> caps, const physics::RubiksCube& cube) {
-        r.quarter_turns_u = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
-        if (t + 1e-9 < next_frame) return;
-        next_frame += 1.0 / 30;
-        user->update(t, caps);
+        r.quarter_turns_u = u_quarter_turns(cube);
+        if (!camera_user.pose(t, caps)) return;
+        const UserHands& user = camera_user.hands();
         double e_max = 0;
         for (std::size_t h = 0; h < 2; ++h) {
-          const double e = user->cap_residual_m()[h];
+          const double e = user.cap_residual_m()[h];
           if (e > r.worst) r.worst = e, r.worst_t = t, r.worst_h = static_cast<int>(h);
           e_max = std::max(e_max, e);
           r.within_limits = r.within_limits &&
-                            hand::within_limits(user->params()[h], user->reach_limits(static_cast<int>(h)), 1e-9);
+                            hand::within_limits(user.params()[h], user.reach_limits(static_cast<int>(h)), 1e-9);
           if (t < 1.2)
             r.active_before_contact = r.active_before_contact &&
-                                      hand::within_limits(user->params()[h], user->models()[h].limits, 1e-9);
+                                      hand::within_limits(user.params()[h], user.models()[h].limits, 1e-9);
         }
         per_frame.push_back(e_max);
       },
@@ -157,29 +155,23 @@ INSTANTIATE_TEST_SUITE_P(
 class PressedCapsThroughTheDevice : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(PressedCapsThroughTheDevice, EveryFingerReachesItsCapAndTheLayerTurnsTwice) {
-  const auto profiles = hand::load_hand_profiles(spidar::test::source(GetParam()));
-  ASSERT_FALSE(profiles.profiles.empty());
-  const hand::HandProfile& profile = profiles.find("user") ? *profiles.find("user") : profiles.profiles.front();
-  const std::array<hand::HandModel, 2> hands{profile.model(hand::Side::kLeft), profile.model(hand::Side::kRight)};
+  const std::array<hand::HandModel, 2> hands = profile_hands(GetParam());
   // [rad] left, right: session::ScriptedUserOptions::fit_limit_margin_rad, for the holding hand
   constexpr std::array<double, 2> kFitMargin{0.1, 0.0};
-  std::unique_ptr<UserHands> user;
+  CameraRateUser camera_user(hands);
   std::array<double, 8> worst{};  // per finger, left thumb … right ring [m]
   std::array<double, 8> worst_t{};
   int quarter_turns = 0;
-  double next_frame = 0;
   run_lockstep_device(
       [&](RubiksTask& task) {
         task.fit_to_hands(hands, 0.01, kFitMargin);
-        user = std::make_unique<UserHands>(hands, task);
+        camera_user.start(task);
       },
       [&](double t, std::span<const Vec3> caps, const physics::RubiksCube& cube) {
-        quarter_turns = static_cast<int>(std::lround(cube.face_angle('U') / (units::kPi / 2)));
-        if (t + 1e-9 < next_frame) return;
-        next_frame += 1.0 / 30;  // the camera's rate, at which the demo poses the user's hands
-        user->update(t, caps);
+        quarter_turns = u_quarter_turns(cube);
+        if (!camera_user.pose(t, caps)) return;
         for (int h = 0; h < 2; ++h) {
-          const hand::HandPoints pts = hand::forward_kinematics(hands[h], user->params()[h]);
+          const hand::HandPoints pts = hand::forward_kinematics(hands[h], camera_user.hands().params()[h]);
           for (int f = 0; f < hand::kFingertipCount; ++f) {
             const auto i = static_cast<std::size_t>(4 * h + f);
             const double e = (pts.p_W_fingertip[f] - caps[i]).norm();
@@ -188,8 +180,7 @@ TEST_P(PressedCapsThroughTheDevice, EveryFingerReachesItsCapAndTheLayerTurnsTwic
         }
       },
       {}, /*ring_on_side=*/true);
-  std::printf("%s (%s): U %d quarter turns; worst cap residual per finger [mm]:", GetParam().c_str(),
-              profile.name.c_str(), quarter_turns);
+  std::printf("%s: U %d quarter turns; worst cap residual per finger [mm]:", GetParam().c_str(), quarter_turns);
   for (double e : worst) std::printf(" %.2f", 1e3 * e);
   std::printf("\n");
   for (std::size_t i = 0; i < worst.size(); ++i)
