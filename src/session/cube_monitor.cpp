@@ -58,6 +58,7 @@ void CubeMonitor::before_step(physics::World& w) {
     const Pose X = cube.core_pose();
     turns_.update(cube);
     pose_.publish({{X.p.x(), X.p.y(), X.p.z()}, {X.R.w(), X.R.x(), X.R.y(), X.R.z()}, turns_.turns_of('U')});
+    s.present = true;
     s.lift = X.p.z() - X_cube0_.p.z();
     s.u_angle = cube.face_angle('U');
     s.d_angle = cube.face_angle('D');

@@ -61,6 +61,7 @@ device::ServoStats run_haptic_scenario(const ScenarioOptions& o, std::ostream& o
   haptic.set_before_step([&](physics::World& w) {
     CubeStatus s;
     s.t_s = w.time();
+    s.present = true;
     s.lift = cube.core_pose().p.z() - X_cube0.p.z();
     s.u_angle = cube.face_angle('U');
     s.u_misalign = cube.face_misalignment('U');

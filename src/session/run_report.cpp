@@ -348,6 +348,21 @@ std::string silhouette_loss_line(const nlohmann::json& j) {
   return o.str();
 }
 
+/// Without a cube: how the object the scripted user reaches for was held (its lift, TruthFrame::
+/// lift_mm), over the run and over the frames of the "twist" phase, where the script holds it
+/// lifted (RubiksTaskParams::lift): a grip that lost it shows there.
+nlohmann::json object_json(const MrTrace& t, const std::vector<std::string>& phases) {
+  std::vector<double> all, twist;
+  for (std::size_t i = 0; i < t.frames.size(); ++i) {
+    all.push_back(t.frames[i].lift_mm);
+    if (i < phases.size() && phases[i] == "twist") twist.push_back(t.frames[i].lift_mm);
+  }
+  return {{"lift_mm_max", quantile(all, 1.0)},
+          {"lift_mm_twist_median", quantile(twist, 0.5)},
+          {"lift_mm_twist_p5", quantile(twist, 0.05)},
+          {"twist_frames", twist.size()}};
+}
+
 }  // namespace
 
 int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s, std::ostream& os) {
@@ -532,6 +547,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                         {"joint_px_floor", mean(joint_floor)},
                         {"hand_shape", {{"length_m", s.user_length_m}, {"width_m", s.user_width_m}}}}},
       {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
+  if (!s.has_cube) report["object"] = object_json(t, s.phases);
   nlohmann::json forces = nlohmann::json::array();
   int touching = 0;
   for (int f = 0; f < 8; ++f) {

@@ -27,7 +27,7 @@ double pinch_half_extent(const Shape& s) {
   return 0.0;
 }
 
-Status reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
+const Shape* nearest_object(const SceneSnapshot& scene) {
   double best = std::numeric_limits<double>::infinity();
   const Shape* target = nullptr;
   for (const Shape& s : scene.shapes) {
@@ -38,6 +38,11 @@ Status reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
       target = &s;
     }
   }
+  return target;
+}
+
+Status reach_target(const SceneSnapshot& scene, sim::RubiksTaskParams* tp) {
+  const Shape* target = nearest_object(scene);
   auto mm = [](double m) { return std::to_string(static_cast<long>(std::lround(1e3 * m))); };
   if (target == nullptr)
     return Error{"no object for the scripted user to reach for: the scene has no body of its own "

@@ -5,6 +5,7 @@
 
 #include "spidar/core/clock.hpp"
 #include "spidar/core/units.hpp"
+#include "spidar/session/scripted_task.hpp"
 
 namespace spidar::session {
 
@@ -81,11 +82,20 @@ void TruthScorer::on_frame(const FrameEvent& e) {
     m.shape[h] = result.shapes[h];
     m.truth_cap_residual_mm[h] = filmed.cap_residual_m[h] * 1e3;
   }
-  if (const auto& s = e.cube) {
+  if (const auto& s = e.cube; s && s->present) {
     m.lift_mm = s->lift * 1e3;
     m.u_angle_deg = s->u_angle * 180 / units::kPi;
     m.d_angle_deg = s->d_angle * 180 / units::kPi;
     m.turns = s->top_turns;
+  } else if (e.scene != nullptr) {
+    const std::vector<Shape>& shapes = e.scene->shapes;
+    if (object_shape_ < 0)
+      if (const Shape* o = nearest_object(*e.scene)) {
+        object_shape_ = o - shapes.data();
+        object_z0_m_ = o->X_WS.p.z();
+      }
+    if (object_shape_ >= 0 && static_cast<std::size_t>(object_shape_) < shapes.size())
+      m.lift_mm = (shapes[static_cast<std::size_t>(object_shape_)].X_WS.p.z() - object_z0_m_) * 1e3;
   }
   for (int f = 0; f < 8; ++f) {
     const auto& F = e.measured->f_W[f];

@@ -40,8 +40,7 @@ MrFrame frame(double t, double iou, double joints_px, long real_px, long fitted_
 /// Writes the report of `t` into a fresh directory named for `tag`, and returns its report.json
 /// (null if none was written) and the summary printed (into `*printed`).
 nlohmann::json report_of(const MrTrace& t, double seconds, const std::string& tag, std::string* printed,
-                         std::string* frames_csv = nullptr) {
-  MrSummary s;
+                         std::string* frames_csv = nullptr, MrSummary s = {}) {
   s.seconds = s.wall_s = seconds;
   const fs::path dir = fs::temp_directory_path() / ("spidar_run_report_" + tag + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
@@ -72,6 +71,33 @@ TEST(JsonText, BytesThatAreNotUtf8BecomeTheReplacementCharacter) {
   EXPECT_EQ(text, "{\"device\":\"SPIDAR-8 \xC3\xA9\",\"out\":\"/tmp/run\xEF\xBF\xBD\xEF\xBF\xBD\"}");
   EXPECT_EQ(nlohmann::json::parse(text)["device"], "SPIDAR-8 \xC3\xA9");
   EXPECT_EQ(session::json_text(nlohmann::json{{"a", 1}}, 2), "{\n  \"a\": 1\n}");
+}
+
+// Without a cube the report says how the reached-for object was held: its lift over the run and
+// over the twist's frames (where the script holds it up), which a lost grip pulls down. With a
+// cube there is no such section (the cube's own figures say it).
+TEST(RunReport, WithoutACubeTheHeldObjectsLiftIsReportedOverTheTwist) {
+  MrTrace t;
+  MrSummary s;
+  const std::pair<const char*, double> frames[] = {{"reach", 0.0}, {"lift", 6.0},  {"twist", 12.0}, {"twist", 11.0},
+                                                   {"twist", 2.0},  {"twist", 10.0}, {"release", 14.0}, {"withdraw", 0.5}};
+  for (const auto& [phase, lift] : frames) {
+    MrFrame m = frame(0.1 * static_cast<double>(t.frames.size()), 0.8, 4.0, 900, 800, false, 0);
+    m.lift_mm = lift;
+    t.frames.push_back(m);
+    s.phases.emplace_back(phase);
+  }
+  std::string printed, csv;
+  s.has_cube = false;
+  const auto j = report_of(t, 0.8, "object", &printed, &csv, s);
+  ASSERT_TRUE(j.contains("object")) << j.dump();
+  EXPECT_DOUBLE_EQ(j["object"]["lift_mm_max"].get<double>(), 14.0);
+  EXPECT_DOUBLE_EQ(j["object"]["lift_mm_twist_median"].get<double>(), 10.5);  // of 2, 10, 11, 12
+  EXPECT_EQ(j["object"]["twist_frames"].get<int>(), 4);
+  EXPECT_LT(j["object"]["lift_mm_twist_p5"].get<double>(), 4.0);  // the frame where it slipped
+  EXPECT_NE(csv.find(",12,"), std::string::npos) << csv;          // frames.csv's lift_mm column
+  s.has_cube = true;
+  EXPECT_FALSE(report_of(t, 0.8, "cube", &printed, nullptr, s).contains("object"));
 }
 
 TEST(RunReport, FramesWithoutAHandInViewAreLeftOutOfTheImagesFigures) {

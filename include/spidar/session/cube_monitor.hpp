@@ -22,6 +22,7 @@ struct CubeStatus {
   double u_misalign = 0;           ///< top layer's angle from its nearest click [rad]
   int turns = 0;      ///< completed quarter turns of every face
   int top_turns = 0;  ///< of them, the top layer's (U): the layer the scripted user turns
+  bool present = false;  ///< the scene has a Rubik's cube (the fields above and below are its)
   bool solved = false;  ///< a cube is present and solved (false in a scene without one)
   int contacts = 0;
 };

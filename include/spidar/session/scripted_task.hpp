@@ -25,6 +25,11 @@ inline constexpr double kMaxPinchAcrossM = 0.10;
 /// axis turned by its pose plus its radius. 0 for a plane.
 double pinch_half_extent(const Shape& shape);
 
+/// The object the scripted user reaches for in a scene without a cube: the shape of a body of its
+/// own (not the world's, not a hand's proxy, not a plane) whose centre is nearest the frame
+/// centre; nullptr when there is none. Points into `scene`.
+const Shape* nearest_object(const SceneSnapshot& scene);
+
 /// Where the scripted user reaches in a scene without a cube: the non-static object nearest the
 /// frame centre (its centre, and pinch_half_extent as the half size). Fails, naming the object's
 /// place and size, when the scene has no such object, or when it is too small or too large for the

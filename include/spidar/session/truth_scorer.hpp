@@ -4,6 +4,7 @@
 /// on compared frames, the cube, forces and servo timing — the per-frame trace the demo's report
 /// is made of.
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -44,6 +45,8 @@ struct TruthFrame {
   /// The registration's size estimates after this frame (left, right).
   std::array<registration::ShapeEstimate, 2> shape{};
   std::array<double, 2> truth_cap_residual_mm{};
+  /// The cube's lift [mm] (CubeStatus::lift); in a scene without a cube, the height of the object
+  /// the scripted user reaches for (session::nearest_object) over where it was at the first frame.
   double lift_mm = 0, u_angle_deg = 0, d_angle_deg = 0;
   int turns = 0;  ///< completed quarter turns of the top layer (CubeStatus::top_turns)
   std::array<double, 8> force_n{};
@@ -82,6 +85,10 @@ class TruthScorer final : public FrameSink {
   sim::FrameTruthWorkspace ws_;
   TruthTrace trace_;
   std::int64_t last_camera_index_ = -1;
+  /// Without a cube: the reached-for object's shape (its index in the scene's shapes, −1 not yet
+  /// found) and its height at the first frame [m].
+  std::ptrdiff_t object_shape_ = -1;
+  double object_z0_m_ = 0;
 };
 
 }  // namespace spidar::session
