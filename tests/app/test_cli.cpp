@@ -703,7 +703,10 @@ TEST(Cli, DemoWithoutACubeFollowsTheLiftOfTheObjectItHolds) {
   // The script lifts it 20 mm from 2 to 3 s; held in the pinch it rises (10–14 mm in the demo's
   // full runs). A loaded machine or a sanitizer build may leave the physics late, not still.
   EXPECT_GT(j["object"]["lift_mm_max"].get<double>(), 3.0) << j["object"];
-  EXPECT_GE(j["object"]["twist_frames"].get<int>(), 0);
+  // The twist begins at 3.0 s: a run that got past it scored frames of it.
+  if (j["seconds"].get<double>() > 3.1) {
+    EXPECT_GE(j["object"]["twist_frames"].get<int>(), 1) << j["object"];
+  }
   std::filesystem::remove_all(dir);
 }
 

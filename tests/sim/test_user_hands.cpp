@@ -74,7 +74,8 @@ TEST(RubiksTask, WithoutACubeTheFittedTouchPointsAreWhereTheHandReaches) {
   for (double t = 1.5; t <= 9.5; t += 0.25) {  // closed on the object: grasp … release
     task.touch_points(t, touch);
     for (int h = 0; h < 2; ++h) {
-      const hand::HandPoints pts = hand::forward_kinematics(hands[h], task.nominal(t, h == 0 ? hand::Side::kLeft : hand::Side::kRight));
+      const auto side = h == 0 ? hand::Side::kLeft : hand::Side::kRight;
+      const hand::HandPoints pts = hand::forward_kinematics(hands[h], task.nominal(t, side));
       for (int f = 0; f < 4; ++f) worst = std::max(worst, (pts.p_W_fingertip[f] - touch[4 * h + f]).norm());
     }
   }
