@@ -39,7 +39,8 @@ using session::write_mr_report;
 
 namespace {
 
-/// The progress line: script phase, IoU, fingertip error, occlusion, the cube's top layer.
+/// The progress line: script phase, IoU, fingertip error, occlusion, the cube's top layer (in a
+/// scene without a cube, the held object's lift).
 std::string status_line(const MrFrame& m, const sim::RubiksTask& task) {
   std::ostringstream st;
   st << std::fixed << std::setprecision(1) << "t " << m.t_s << " s  "
@@ -51,7 +52,9 @@ std::string status_line(const MrFrame& m, const sim::RubiksTask& task) {
   st << std::setprecision(1)
      << "  tip " << 0.5 * (m.truth[0].fingertip_mm[0] + m.truth[0].fingertip_mm[1])
      << " mm  occlusion " << m.truth[0].occlusion_pct << " % (paper "
-     << m.truth[0].occlusion_pct_paper << " %)  layer " << m.u_angle_deg << " deg";
+     << m.truth[0].occlusion_pct_paper << " %)";
+  if (task.params().has_cube) st << "  layer " << m.u_angle_deg << " deg";
+  else st << "  lift " << m.lift_mm << " mm";
   return st.str();
 }
 

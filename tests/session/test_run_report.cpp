@@ -96,6 +96,8 @@ TEST(RunReport, WithoutACubeTheHeldObjectsLiftIsReportedOverTheTwist) {
   EXPECT_EQ(j["object"]["twist_frames"].get<int>(), 4);
   EXPECT_LT(j["object"]["lift_mm_twist_p5"].get<double>(), 4.0);  // the frame where it slipped
   EXPECT_NE(csv.find(",12,"), std::string::npos) << csv;          // frames.csv's lift_mm column
+  EXPECT_NE(printed.find("object         lifted 14.0 mm at most; over the twist (4 frames) 10.5 mm"),
+            std::string::npos) << printed;
   s.has_cube = true;
   EXPECT_FALSE(report_of(t, 0.8, "cube", &printed, nullptr, s).contains("object"));
 }
