@@ -547,7 +547,9 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                         {"joint_px_floor", mean(joint_floor)},
                         {"hand_shape", {{"length_m", s.user_length_m}, {"width_m", s.user_width_m}}}}},
       {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
-  if (!s.has_cube) report["object"] = object_json(t, s.phases);
+  // Without a cube, the object the user reached for instead: how high it was held while twisted.
+  const nlohmann::json object = s.has_cube ? nlohmann::json() : object_json(t, s.phases);
+  if (!s.has_cube) report["object"] = object;
   nlohmann::json forces = nlohmann::json::array();
   int touching = 0;
   for (int f = 0; f < 8; ++f) {
@@ -607,13 +609,11 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
      << " cycles without force, " << s.servo.stale_force_cycles << " on stale physics), faults " << device::fault_names(s.servo.faults)
      << "; physics step median " << std::setprecision(2) << s.physics.step_ms_median << " ms\n"
      << "  contact        " << touching << " of 8 fingertips felt more than 0.5 N\n";
-  if (!s.has_cube) {
-    // The object the user reached for instead: how high it was held while twisted.
-    const nlohmann::json o = object_json(t, s.phases);
-    os << "  object         lifted " << std::setprecision(1) << o["lift_mm_max"].get<double>()
-       << " mm at most; over the twist (" << o["twist_frames"].get<std::size_t>() << " frames) "
-       << o["lift_mm_twist_median"].get<double>() << " mm, p5 " << o["lift_mm_twist_p5"].get<double>() << " mm\n";
-  }
+  if (!s.has_cube)
+    os << "  object         lifted " << std::setprecision(1) << object["lift_mm_max"].get<double>()
+       << " mm at most; over the twist (" << object["twist_frames"].get<std::size_t>() << " frames) "
+       << object["lift_mm_twist_median"].get<double>() << " mm, p5 " << object["lift_mm_twist_p5"].get<double>()
+       << " mm\n";
   os << "  cube           "
      << (s.has_cube ? std::to_string(s.turns) + " of " + std::to_string(s.task.turns_planned) +
                           " layer turns completed (" + std::to_string(s.task.retries_turn) +
