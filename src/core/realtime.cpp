@@ -86,6 +86,21 @@ Status pin_to_cpu(int cpu) {
   return Ok{};
 }
 
+Status avoid_cpu(int cpu) {
+  const auto resolved = online_cpu(cpu);
+  if (!resolved) return resolved.error();
+  const int c = resolved.value();
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) != 0)
+    return Error{std::string("could not read the CPU affinity (") + std::strerror(errno) + ")"};
+  if (!CPU_ISSET(c, &set) || CPU_COUNT(&set) < 2) return Ok{};
+  CPU_CLR(c, &set);
+  if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set); rc != 0)
+    return Error{"could not move off CPU " + std::to_string(c) + " (" + std::strerror(rc) + ")"};
+  return Ok{};
+}
+
 Status release_starved_thread(pthread_t thread) {
   std::string error;
   sched_param sp{};

@@ -183,6 +183,12 @@ void ServoLoop::reset_faults() {
 
 void ServoLoop::monitor(pthread_t servo_thread) {
   core::set_thread_name("spidar-watchdog");
+  // Off the servo's CPU: a task that holds that CPU must not starve the thread that detects it
+  // (on CI the watchdog, woken on the held CPU, first ran after the loop's end and latched nothing).
+  if (servo_.realtime) {
+    if (const Status away = core::avoid_cpu(servo_.cpu); !away.ok())
+      spdlog::warn("servo loop: watchdog: {}", away.error().message);
+  }
   // Detects a servo thread that stopped cycling (stuck in a read, starved): safe state at once.
   const auto window_ns = std::max<std::int64_t>(core::s_to_ns(servo_.stall_limit_s), 1'000'000);
   // The end by the wall clock, whether the servo thread runs or not.
@@ -195,11 +201,17 @@ void ServoLoop::monitor(pthread_t servo_thread) {
   std::int64_t next = last_progress_ns + 4 * window_ns;  // grace for start-up
   while (running_.load(std::memory_order_acquire) && !stop_.load(std::memory_order_acquire)) {
     core::sleep_until_ns(std::min({next, end_ns, core::monotonic_ns() + 1'000'000}));
-    if (core::monotonic_ns() >= end_ns) {
+    const std::int64_t woke = core::monotonic_ns();
+    const bool at_end = woke >= end_ns;
+    // At the end, the stall is checked whenever a window has passed since the last progress seen:
+    // a monitor that woke late (its CPU busy), or a run shorter than the start-up grace, must not
+    // end the loop without latching the stall it slept through.
+    const bool due = woke >= next || (at_end && woke - last_progress_ns >= window_ns);
+    if (!due) {
+      if (!at_end) continue;
       stop_.store(true, std::memory_order_release);
       break;
     }
-    if (core::monotonic_ns() < next) continue;
     const std::uint64_t now_cycles = cycle_.load(std::memory_order_acquire);
     if (now_cycles == last && running_.load(std::memory_order_acquire)) {
       device_.request_safe_state();
@@ -213,6 +225,10 @@ void ServoLoop::monitor(pthread_t servo_thread) {
     if (now_cycles != last) last_progress_ns = core::monotonic_ns();
     last = now_cycles;
     next = core::monotonic_ns() + window_ns;
+    if (at_end) {
+      stop_.store(true, std::memory_order_release);
+      break;
+    }
   }
   if (stop_.load(std::memory_order_acquire)) end_servo_thread(servo_thread, window_ns);
 }

@@ -1,6 +1,7 @@
 // Thread scheduling helpers: nice applies to the calling thread only and is range-checked.
 #include <gtest/gtest.h>
 
+#include <sched.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -65,6 +66,47 @@ TEST(Realtime, ThreadCountersCountTheCallingThreadsPageFaults) {
   EXPECT_GE(after.minor_faults + after.major_faults - before.minor_faults - before.major_faults, kPages / 2)
       << "at most one fault per 2 pages (fault-around does not apply to anonymous memory)";
   EXPECT_LT(here_after.minor_faults - here_before.minor_faults, kPages / 4) << "the other thread's faults";
+}
+
+
+TEST(Realtime, AvoidCpuTakesTheCpuOutOfTheCallingThreadsAffinityOnly) {
+  if (sysconf(_SC_NPROCESSORS_ONLN) < 2) GTEST_SKIP() << "needs two CPUs";
+  cpu_set_t before, after, caller_after;
+  CPU_ZERO(&before);
+  CPU_ZERO(&after);
+  ASSERT_EQ(sched_getaffinity(0, sizeof before, &before), 0);
+  if (!CPU_ISSET(0, &before) || CPU_COUNT(&before) < 2) GTEST_SKIP() << "needs CPU 0 and another";
+  Status st = Ok{};
+  std::thread([&] {
+    st = avoid_cpu(0);
+    sched_getaffinity(0, sizeof after, &after);
+  }).join();
+  ASSERT_TRUE(st.ok()) << st.error().message;
+  EXPECT_FALSE(CPU_ISSET(0, &after));
+  EXPECT_EQ(CPU_COUNT(&after), CPU_COUNT(&before) - 1);
+  ASSERT_EQ(sched_getaffinity(0, sizeof caller_after, &caller_after), 0);
+  EXPECT_TRUE(CPU_EQUAL(&caller_after, &before)) << "it moved the calling test thread too";
+}
+
+TEST(Realtime, AvoidCpuLeavesAThreadItsOnlyCpu) {
+  cpu_set_t only, after;
+  CPU_ZERO(&only);
+  CPU_ZERO(&after);
+  CPU_SET(0, &only);
+  Status st = Ok{};
+  std::thread([&] {
+    ASSERT_EQ(pthread_setaffinity_np(pthread_self(), sizeof only, &only), 0);
+    st = avoid_cpu(0);
+    sched_getaffinity(0, sizeof after, &after);
+  }).join();
+  EXPECT_TRUE(st.ok()) << st.error().message;
+  EXPECT_TRUE(CPU_EQUAL(&after, &only));
+}
+
+TEST(Realtime, AvoidCpuNamesACpuThatIsNotOnline) {
+  const Status st = avoid_cpu(static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)) + 3);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("is not online"), std::string::npos) << st.error().message;
 }
 
 }  // namespace

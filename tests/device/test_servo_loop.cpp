@@ -11,6 +11,7 @@
 
 #include "allocation_counter.hpp"
 #include "idle_threads.hpp"
+#include "named_thread.hpp"
 #include "device_test_support.hpp"
 #include "spidar/core/clock.hpp"
 #include "spidar/device/servo_loop.hpp"
@@ -321,6 +322,35 @@ TEST(ServoLoop, MonitorCatchesAServoThreadStuckInARead) {
   EXPECT_NE(loop.fault_message().find("watchdog: monitor: the servo thread completed no cycle"),
             std::string::npos)
       << loop.fault_message();
+}
+
+// The watchdog must not share the CPU the servo pins itself to: a task holding that CPU starves
+// both, and the stall went unlatched (a CI run, ASan, 2026-11-29: the watchdog first ran after the
+// loop's end). Deterministic: it checks where the watchdog may run, not when it ran.
+TEST(ServoLoop, TheWatchdogRunsOffTheServosCpu) {
+  if (sysconf(_SC_NPROCESSORS_ONLN) < 2) GTEST_SKIP() << "needs two CPUs";
+  const int servo_cpu = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)) - 1;
+  cpu_set_t mine;
+  CPU_ZERO(&mine);
+  ASSERT_EQ(sched_getaffinity(0, sizeof mine, &mine), 0);
+  if (!CPU_ISSET(servo_cpu, &mine) || CPU_COUNT(&mine) < 2) GTEST_SKIP() << "needs the last CPU and another";
+  Rig rig;
+  ServoConfig cfg;
+  cfg.realtime = true;  // pins the servo to the last CPU (whether SCHED_FIFO is granted or not)
+  ServoLoop loop(rig.rec, spidar8(), cfg, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  wait_for_cycles(loop, 20);
+  pid_t watchdog = -1;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while ((watchdog = spidar::test::thread_named("spidar-watchdog")) < 0 && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(1ms);
+  ASSERT_GE(watchdog, 0) << "no thread named spidar-watchdog";
+  cpu_set_t where;
+  CPU_ZERO(&where);
+  ASSERT_EQ(sched_getaffinity(watchdog, sizeof where, &where), 0);
+  loop.stop();
+  EXPECT_FALSE(CPU_ISSET(servo_cpu, &where)) << "the watchdog may run on the servo's CPU " << servo_cpu;
+  EXPECT_GE(CPU_COUNT(&where), 1);
 }
 
 TEST(ServoLoop, DisconnectEndsTheLoopCleanlyWithTheFault) {

@@ -57,6 +57,24 @@ TEST(ServoLoopStarved, MaxSecondsEndsTheLoopOnTimeWhenItsCpuIsHeld) {
   EXPECT_TRUE(s.faults & kFaultWatchdog) << fault_names(s.faults);
 }
 
+// The loop's end by the wall clock (max_seconds + kMaxSecondsGrace_s = 0.55 s) comes before the
+// watchdog's first check (4 stall windows = 0.8 s): the end must still latch the stall it saw.
+TEST(ServoLoopStarved, ARunShorterThanTheStartUpGraceStillLatchesTheStall) {
+  SPIDAR_STARVE_SERVO_CPU(hog);
+  SimulatedSpidar sim(spidar8(), {}, testing::hovering(spidar8()));
+  ASSERT_TRUE(sim.open().ok());
+  ServoConfig cfg;
+  cfg.realtime = true;
+  cfg.max_seconds = 0.05;
+  cfg.stall_limit_s = 0.2;
+  ServoLoop loop(sim, spidar8(), cfg, std::make_shared<ZeroForce>());
+  ASSERT_TRUE(loop.start().ok());
+  loop.wait();
+  const ServoStats s = loop.stats();
+  EXPECT_TRUE(s.released_at_end) << "the servo thread was not starved: the test tested nothing";
+  EXPECT_TRUE(s.faults & kFaultWatchdog) << fault_names(s.faults);
+}
+
 TEST(ServoLoopStarved, StopReturnsOnTimeWhenItsCpuIsHeld) {
   SPIDAR_STARVE_SERVO_CPU(hog);
   SimulatedSpidar sim(spidar8(), {}, testing::hovering(spidar8()));

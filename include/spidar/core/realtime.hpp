@@ -49,6 +49,12 @@ Result<int> online_cpu(int cpu);
 /// Pins the calling thread to `cpu` (0-based; −1 = the last online CPU). Error names the CPU.
 Status pin_to_cpu(int cpu);
 
+/// Takes `cpu` (0-based; −1 = the last online CPU) out of the calling thread's CPU affinity, so
+/// that a thread watching another one pinned there (a watchdog) does not share its fate when a
+/// higher-priority task holds that CPU. Leaves the affinity as it is, without error, where `cpu`
+/// is the only CPU the thread may use. Error names the CPU.
+Status avoid_cpu(int cpu);
+
 /// What the kernel counted for the calling thread (getrusage RUSAGE_THREAD): page faults that had
 /// to wait for I/O (major: a page read back, e.g. code the kernel dropped from memory) or not
 /// (minor), and the times the thread gave up its CPU by waiting (voluntary) or was taken off it
