@@ -227,6 +227,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.camera_skipped = static_cast<int>(end.camera_skipped);
   summary.output_waits = off_path.waits();
   summary.output_wait_ms = off_path.waited_ms();
+  summary.frame_realtime = end.frame_realtime;
   summary.servo = end.servo;
   summary.physics = end.physics;
   if (auto s = scene.monitor->status().read()) {

@@ -36,6 +36,26 @@ Status set_nice(int nice) {
   return Ok{};
 }
 
+ThreadScheduling current_scheduling() {
+  ThreadScheduling s;
+  sched_param sp{};
+  if (pthread_getschedparam(pthread_self(), &s.policy, &sp) == 0) s.priority = sp.sched_priority;
+  errno = 0;
+  const int nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid()));
+  if (errno == 0) s.nice = nice;
+  return s;
+}
+
+Status apply_scheduling(const ThreadScheduling& s) {
+  sched_param sp{};
+  sp.sched_priority = s.priority;
+  if (const int rc = pthread_setschedparam(pthread_self(), s.policy, &sp); rc != 0)
+    return Error{"could not set scheduling policy " + std::to_string(s.policy) + " priority " +
+                 std::to_string(s.priority) + " (" + std::strerror(rc) + ")"};
+  // The nice value counts only under the normal policies, but is kept for a return to them.
+  return set_nice(s.nice);
+}
+
 Result<CpuLatencyRequest> CpuLatencyRequest::open(int max_latency_us) {
   if (max_latency_us < 0) return Error{"CPU latency request: expected >= 0 us, got " + std::to_string(max_latency_us)};
   const int fd = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);

@@ -25,6 +25,7 @@ void SideTask::start_erased(void* task, void (*call)(void*)) {
   if (!thread_.joinable()) thread_ = std::thread([this] { loop(); });
   task_ = task;
   call_ = call;
+  owner_scheduling_ = current_scheduling();
   error_ = nullptr;
   started_ = true;
   {
@@ -69,6 +70,7 @@ void SideTask::wait() {
 
 void SideTask::loop() {
   set_thread_name("spidar-side");
+  ThreadScheduling asked = current_scheduling();  // the scheduling last asked for (made: inherited)
   std::unique_lock lock(mutex_);
   for (;;) {
     wake_.wait(lock, [this] { return quit_ || state_.load(std::memory_order_acquire) == kOffered; });
@@ -76,6 +78,10 @@ void SideTask::loop() {
     int offered = kOffered;
     if (!state_.compare_exchange_strong(offered, kRunning, std::memory_order_acq_rel)) continue;  // the caller took it
     lock.unlock();
+    if (owner_scheduling_ != asked) {  // asked once per change, not per task
+      asked = owner_scheduling_;
+      (void)apply_scheduling(asked);  // best effort: what the owner was granted may be refused here
+    }
     run_task();
     lock.lock();
     state_.store(kDone, std::memory_order_release);  // under mutex_: the caller's sleep sees it

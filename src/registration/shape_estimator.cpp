@@ -525,7 +525,9 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
   polls_since_start_ = 0;
   pending_ = std::async(std::launch::async, [job = std::move(job)]() mutable {
     core::set_thread_name("spidar-shape");
-    (void)core::set_nice(0);  // best effort: an ordinary share, below the frame thread's
+    // An ordinary share below the frame thread's, whose scheduling (SCHED_FIFO in the session) it
+    // inherited: a solve of 10–30 ms must not hold up the frames. Best effort.
+    (void)core::apply_scheduling({SCHED_OTHER, 0, 0});
     return run_solve(std::move(job));
   });
   return false;

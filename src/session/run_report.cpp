@@ -511,6 +511,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
         {"camera_skipped_frames", s.camera_skipped},
         {"output_waits", s.output_waits},
         {"output_wait_ms", s.output_wait_ms},
+        {"frame_thread_fifo", s.frame_realtime},
         {"stage_ms_median",
          {{"chroma_key", quantile(column(t, [](const MrFrame& m) { return m.stages.key_ms; }), 0.5)},
           {"bracelets", quantile(column(t, [](const MrFrame& m) { return m.stages.bracelet_ms; }), 0.5)},

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <thread>
+#include <utility>
+
+#include <spdlog/spdlog.h>
 
 #include "spidar/core/clock.hpp"
 #include "spidar/core/realtime.hpp"
@@ -25,6 +28,11 @@ std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context
                                          const SessionParams& params, device::Device* drive) {
   if (params.warm_results < 1 || params.warm_results > 32)
     throw SpidarError("session: warm_results must be in 1..32, got " + std::to_string(params.warm_results));
+  if (params.frame_fifo_priority < 0 || params.frame_fifo_priority > 99)
+    throw SpidarError("session: frame_fifo_priority must be in 0..99 (0: none), got " +
+                      std::to_string(params.frame_fifo_priority));
+  if (params.frame_nice < -20 || params.frame_nice > 19)
+    throw SpidarError("session: frame_nice must be in -20..19, got " + std::to_string(params.frame_nice));
   std::unique_ptr<Session> s(new Session(rig, scene, context, params));
   auto lens = vision::LensUndistortion::of(camera.intrinsics());
   if (!lens) throw SpidarError("camera: " + lens.error().message);
@@ -247,8 +255,27 @@ Session::Step Session::step() {
 
 SessionSummary Session::run(const std::function<std::optional<std::string>()>& interrupted) {
   start();
-  // After start(): the threads it made keep their own niceness, not this one's.
+  // After start(): the threads it made keep their own scheduling, not this one's. The caller's
+  // is given back when run() returns (or throws).
+  struct RestoreScheduling {
+    core::ThreadScheduling was = core::current_scheduling();
+    bool done = false;
+    void now() {
+      if (!std::exchange(done, true)) (void)core::apply_scheduling(was);
+    }
+    ~RestoreScheduling() { now(); }
+  } restore;
   if (params_.frame_nice != 0) (void)core::set_nice(params_.frame_nice);  // best effort
+  if (params_.frame_fifo_priority > 0) {
+    const Status rt = core::set_fifo_priority(params_.frame_fifo_priority);
+    frame_realtime_ = rt.ok();
+    if (!rt.ok()) {
+      spdlog::warn("session: the frame thread runs at nice {} instead of SCHED_FIFO {} ({}); on a busy "
+                   "machine expect more latency and dropped frames. Allow real-time priority: rtprio "
+                   "in /etc/security/limits.conf, or CAP_SYS_NICE",
+                   params_.frame_nice, params_.frame_fifo_priority, rt.error().message);
+    }
+  }
   std::string ended_by = "completed";
   while (servo_running()) {
     if (interrupted) {
@@ -268,6 +295,7 @@ SessionSummary Session::run(const std::function<std::optional<std::string>()>& i
       wait_for_frame(core::monotonic_ns() + kFrameWaitNs);
     }
   }
+  restore.now();  // the sinks' on_end (reports, plots) at the caller's scheduling
   return stop(ended_by);
 }
 
@@ -296,6 +324,7 @@ SessionSummary Session::stop(const std::string& ended_by) {
     s.physics = haptic_->physics().stats();
   }
   s.camera_error = rig_.camera().error();
+  s.frame_realtime = frame_realtime_;
   summary_ = s;
   for (FrameSink* k : sinks_) k->on_end(s);
   return s;

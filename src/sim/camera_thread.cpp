@@ -46,6 +46,10 @@ Result<std::unique_ptr<CameraThread>> CameraThread::prepare(
       return Error{std::string("camera thread: ") + name + " must be in [0, 1e9] ns, got " + std::to_string(ns)};
   if (params.truth_poll_ns < 1000 || params.truth_poll_ns > 1'000'000'000)
     return Error{"camera thread: truth_poll_ns must be in [1e3, 1e9] ns, got " + std::to_string(params.truth_poll_ns)};
+  if (params.fifo_priority < 0 || params.fifo_priority > 99)
+    return Error{"camera thread: fifo_priority must be in 0..99 (0: none), got " + std::to_string(params.fifo_priority)};
+  if (params.nice < -20 || params.nice > 19)
+    return Error{"camera thread: nice must be in -20..19, got " + std::to_string(params.nice)};
   if (params.warm_frames < 0 || params.warm_frames > 64)
     return Error{"camera thread: warm_frames must be in 0..64, got " + std::to_string(params.warm_frames)};
   std::unique_ptr<CameraThread> c(new CameraThread());
@@ -112,6 +116,8 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
                        std::function<void(Status)> ready) {
   core::set_thread_name("spidar-camera");
   (void)core::set_nice(params_.nice);  // best effort (see CameraThreadParams::nice)
+  if (params_.fifo_priority > 0)
+    realtime_.store(core::set_fifo_priority(params_.fifo_priority).ok(), std::memory_order_release);
   // However the thread ends, a frame thread waiting for a frame is woken.
   struct WakeWaitersAtEnd {
     CameraThread& c;

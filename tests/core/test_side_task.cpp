@@ -150,6 +150,38 @@ TEST(SideTask, TheHelperRunsAtTheNiceValueOfTheThreadThatFirstStartedIt) {
   EXPECT_EQ(helper_nice, target);
 }
 
+// The session lowers the frame thread's nice value after its warm-up frame, which made the helper:
+// the helper must follow (it had stayed at nice 0, level with any other program on a busy machine).
+TEST(SideTask, TheHelperFollowsItsOwnersNiceValueChangedAfterItWasMade) {
+  const int before = getpriority(PRIO_PROCESS, 0);
+  const int after = std::min(before + 4, 19);
+  if (after == before) GTEST_SKIP() << "already at nice 19";
+  std::vector<int> helper_nice;
+  std::thread owner([&] {
+    SideTask side;
+    auto on_helper = [&] {
+      std::atomic<bool> read{false};
+      auto read_nice = [&] {
+        helper_nice.push_back(getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())));
+        read = true;
+      };
+      side.start(read_nice);
+      while (!read.load()) std::this_thread::yield();  // run by the helper, not taken back
+      side.wait();
+    };
+    on_helper();  // makes the helper at the owner's nice value
+    ASSERT_EQ(setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), after), 0);
+    on_helper();
+    on_helper();
+    EXPECT_EQ(side.tasks_run_by_caller(), 0u);
+  });
+  owner.join();
+  ASSERT_EQ(helper_nice.size(), 3u);
+  EXPECT_EQ(helper_nice[0], before);
+  EXPECT_EQ(helper_nice[1], after);
+  EXPECT_EQ(helper_nice[2], after);
+}
+
 TEST(SideTask, DestroyingItWithATaskStartedRunsTheTaskFirst) {
   std::atomic<bool> finished{false};
   {

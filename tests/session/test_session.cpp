@@ -2,6 +2,8 @@
 // history, the warm-up, and a sink that throws.
 #include <gtest/gtest.h>
 
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -15,9 +17,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "named_thread.hpp"
+#include "spidar/core/realtime.hpp"
 #include "spidar/session/async_sinks.hpp"
 #include "spidar/session/frame_stats.hpp"
 #include "spidar/session/session.hpp"
+#include "spidar/sim/camera_thread.hpp"
 #include "after_frames.hpp"
 #include "simulated_setup.hpp"
 
@@ -121,6 +126,57 @@ TEST(Session, ItsThreadsAreNamedForTheirRoles) {
   ASSERT_GT(frames, 0u) << "no frame processed";
   for (const std::string& role : roles)
     EXPECT_NE(std::find(seen.begin(), seen.end(), role), seen.end()) << role;
+}
+
+/// Whether this process may give a thread SCHED_FIFO (root, CAP_SYS_NICE or an rtprio limit).
+bool fifo_permitted() {
+  bool ok = false;
+  std::thread([&ok] { ok = core::set_fifo_priority(1).ok(); }).join();
+  return ok;
+}
+
+// On a busy machine the frame thread and the simulated camera lost their CPU to any other
+// program at nice 0 (latency p95 51–62 ms, one core busy); at SCHED_FIFO 20 and 30 they do not
+// (25–32 ms). The caller's own scheduling comes back when run() returns.
+TEST(Session, TheFrameThreadAndTheCameraRunAtTheirRealTimePrioritiesAndTheCallersComesBack) {
+  if (!fifo_permitted()) GTEST_SKIP() << "SCHED_FIFO not permitted here";
+  SimulatedSetup s(kBackstopS);
+  const core::ThreadScheduling before = core::current_scheduling();
+  std::vector<core::ThreadScheduling> frame_thread;
+  int camera_policy = -1, camera_priority = -1;
+  FunctionSink look([&](const FrameEvent&) {
+    frame_thread.push_back(core::current_scheduling());
+    if (const pid_t camera = spidar::test::thread_named("spidar-camera"); camera > 0) {
+      sched_param sp{};
+      camera_policy = sched_getscheduler(camera);
+      if (sched_getparam(camera, &sp) == 0) camera_priority = sp.sched_priority;
+    }
+  });
+  s.session->add_sink(look);
+  const SessionSummary end = s.session->run([&]() -> std::optional<std::string> {
+    if (frame_thread.size() >= 5) return std::string("looked");
+    return std::nullopt;
+  });
+  ASSERT_FALSE(frame_thread.empty()) << "no frame processed";
+  for (const core::ThreadScheduling& f : frame_thread) {
+    EXPECT_EQ(f.policy, SCHED_FIFO);
+    EXPECT_EQ(f.priority, SessionParams{}.frame_fifo_priority);
+  }
+  EXPECT_TRUE(end.frame_realtime);
+  EXPECT_EQ(camera_policy, SCHED_FIFO);
+  EXPECT_EQ(camera_priority, sim::CameraThreadParams{}.fifo_priority);
+  EXPECT_EQ(core::current_scheduling(), before) << "run() left the caller's thread at the frame thread's scheduling";
+}
+
+TEST(Session, AFramePriorityOutsideItsRangeIsRefusedByName) {
+  for (int bad : {-1, 100}) {
+    try {
+      SimulatedSetup s(1.0, true, [bad](SessionParams& p) { p.frame_fifo_priority = bad; });
+      ADD_FAILURE() << "frame_fifo_priority " << bad << " was accepted";
+    } catch (const SpidarError& e) {
+      EXPECT_NE(std::string(e.what()).find("frame_fifo_priority must be in 0..99"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Session, WarmUpHappensOnceAndTheFirstRealFrameIsAColdStart) {

@@ -55,6 +55,19 @@ Status pin_to_cpu(int cpu);
 /// is the only CPU the thread may use. Error names the CPU.
 Status avoid_cpu(int cpu);
 
+/// The calling thread's scheduling: its policy (SCHED_OTHER, SCHED_FIFO, ...), its real-time
+/// priority (0 for the normal policies) and its nice value (Linux: per thread).
+struct ThreadScheduling {
+  int policy = 0;
+  int priority = 0;
+  int nice = 0;
+  bool operator==(const ThreadScheduling&) const = default;
+};
+ThreadScheduling current_scheduling();
+/// Gives the calling thread `s` (policy and priority, then nice). Error names what the kernel
+/// refused (raising a priority needs CAP_SYS_NICE or an rtprio / nice limit).
+Status apply_scheduling(const ThreadScheduling& s);
+
 /// What the kernel counted for the calling thread (getrusage RUSAGE_THREAD): page faults that had
 /// to wait for I/O (major: a page read back, e.g. code the kernel dropped from memory) or not
 /// (minor), and the times the thread gave up its CPU by waiting (voluntary) or was taken off it

@@ -8,10 +8,12 @@
 /// busy machine may not schedule the helper at all), the caller takes the task back and runs it
 /// itself. A task runs exactly once, on one of the two threads.
 ///
-/// The helper thread is made at the first start(), by the thread that calls it, so that it
-/// inherits that thread's scheduling (on Linux a thread's nice value and policy are inherited at
-/// creation): the frame thread's helper runs at the frame thread's priority. It sleeps on a
-/// condition variable between tasks.
+/// The helper runs each task at its owner's scheduling as it was at that task's start() (policy,
+/// priority and nice value; best effort): the frame thread's helper runs at the frame thread's
+/// priority even when the owner changed it after the helper was made (the session lowers the
+/// frame thread's nice value after its warm-up frame, which made the helper; the helper had
+/// stayed at nice 0, level with any other program). The helper is made at the first start() and
+/// sleeps on a condition variable between tasks.
 ///
 /// Not copyable or movable (the helper refers to it). One owner thread calls start() and wait();
 /// the task must not call either. The task object must live until wait() returns.
@@ -21,6 +23,8 @@
 #include <mutex>
 #include <thread>
 #include <utility>
+
+#include "spidar/core/realtime.hpp"
 
 namespace spidar::core {
 
@@ -58,6 +62,7 @@ class SideTask {
   std::condition_variable wake_, done_;
   std::atomic<int> state_{kIdle};
   void* task_ = nullptr;               // written before state_ becomes kOffered
+  ThreadScheduling owner_scheduling_;  // likewise: the owner's, at start()
   void (*call_)(void*) = nullptr;
   std::exception_ptr error_;           // written by the runner before state_ becomes kDone
   bool quit_ = false;                  // guarded by mutex_

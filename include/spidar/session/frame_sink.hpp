@@ -85,6 +85,8 @@ struct SessionSummary {
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;
   std::string camera_error;            ///< why the camera stopped, if it failed
+  /// The frame thread ran at SCHED_FIFO (SessionParams::frame_fifo_priority was granted).
+  bool frame_realtime = false;
   /// CPU time by thread name just before the session's threads stopped (core::thread_cpu_by_name:
   /// the frame thread under the program's name, spidar-servo, spidar-physics, spidar-camera, ...).
   std::vector<core::ThreadCpu> thread_cpu;

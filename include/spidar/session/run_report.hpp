@@ -29,6 +29,7 @@ struct MrSummary {
   /// (AsyncSinks::waits), and for how long in all [ms].
   std::uint64_t output_waits = 0;
   double output_wait_ms = 0;
+  bool frame_realtime = false;  ///< the frame thread ran at SCHED_FIFO (SessionSummary::frame_realtime)
   device::ServoStats servo;
   sim::PhysicsThreadStats physics;
   int turns = 0;        ///< completed quarter turns of the top layer, the one the user turns

@@ -58,6 +58,13 @@ struct SessionParams {
   /// against 0 gave latency median 26.2 against 29.0 ms, p95 50 against 58 ms, dropped 1.9 against
   /// 2.9 %. 0: leave it.
   int frame_nice = -5;
+  /// The frame thread's SCHED_FIFO priority while run() runs (0: its niceness only), below the
+  /// physics (60) and the servo loop (80), with the simulated camera's 30 above it. Its side
+  /// helper follows it (core::SideTask). Where SCHED_FIFO is not permitted the session says so
+  /// once and the thread keeps frame_nice. Demo, seeds 1–4 interleaved (docs/measurements.md,
+  /// session 48), against frame_nice alone: quiet, latency median 18.2–20.2 against 21.2–24.8 ms;
+  /// one core busy, 18.9–24.4 against 27.2–28.7 ms, p95 25–32 against 51–62 ms. 1..99 or 0.
+  int frame_fifo_priority = 20;
 };
 
 class Session {
@@ -178,6 +185,7 @@ class Session {
   core::RecyclingPool<pipeline::FrameResult> results_;
   /// The camera's delivered count before the frame past the end (Step::kPastEnd), once one came.
   std::optional<std::uint64_t> delivered_before_end_;
+  bool frame_realtime_ = false;  ///< SessionParams::frame_fifo_priority granted in run()
   std::shared_ptr<pipeline::FrameResult> result_;
   pipeline::FrameResult alt_result_;
 };

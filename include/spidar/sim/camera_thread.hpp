@@ -88,6 +88,11 @@ struct CameraThreadParams {
   /// films at its rate whatever the host does, so it goes before the frame thread and the outputs
   /// that share the CPU with it. Needs CAP_SYS_NICE below 0; without it, a normal share.
   int nice = -10;
+  /// The thread's SCHED_FIFO priority (0: its niceness only; best effort, the niceness where it is
+  /// refused): above the frame thread's 20 and below the physics' 60 and the servo's 80, so that a
+  /// busy machine does not delay the exposures' films (session::SessionParams::frame_fifo_priority
+  /// for the figures). 0..99.
+  int fifo_priority = 30;
   /// Frames filmed into the pool before the clock starts (prepare), all held at once and then
   /// let go: the frames the session holds at a time (the frame thread's and the output thread's,
   /// 6 in the demo) have their images allocated and touched before the first exposure instead of
@@ -138,6 +143,9 @@ class CameraThread {
   std::uint64_t skipped() const { return skipped_.load(std::memory_order_acquire); }
   /// The error that stopped the thread, if any (read after stop()).
   const std::string& error() const { return error_; }
+  /// The thread runs at SCHED_FIFO (CameraThreadParams::fifo_priority granted); known once
+  /// prepare() has returned.
+  bool realtime() const { return realtime_.load(std::memory_order_acquire); }
   void stop();
 
  private:
@@ -160,6 +168,7 @@ class CameraThread {
   std::atomic<std::uint64_t> filmed_{0};
   std::atomic<std::uint64_t> skipped_{0};
   std::atomic<bool> stop_{false};
+  std::atomic<bool> realtime_{false};
   /// The exposures' start (begin()), or a stop, releases the prepared thread.
   std::mutex gate_mutex_;
   std::condition_variable gate_;
