@@ -60,6 +60,7 @@ nlohmann::json replay_recording(const std::string& dir, const std::string& out, 
 
   session::SessionParams sp;
   sp.warm_up = false;  // the recorded fits started cold from the recording's start rotations
+  sp.frame_fifo_priority = 0;  // offline, as fast as it goes: no real-time priority to hold a core with
   sp.pipeline = session::live_pipeline_params(cfg, r0);
   auto session = session::Session::create(rig, **scene_r, *context, camera, models, sp);
   session::ReplayScorer scorer(rig);

@@ -22,17 +22,25 @@ constexpr std::int64_t kFrameWaitNs = 5'000'000;
 Session::Session(Rig& rig, Scene& scene, render::Context& context, const SessionParams& params)
     : rig_(rig), scene_(scene), context_(context), params_(params) {}
 
+Status validate(const SessionParams& params) {
+  if (params.warm_results < 1 || params.warm_results > 32)
+    return Error{"session: warm_results must be in 1..32, got " + std::to_string(params.warm_results)};
+  if (params.frame_fifo_priority < 0 || params.frame_fifo_priority > 99)
+    return Error{"session: frame_fifo_priority must be in 0..99 (0: none), got " +
+                 std::to_string(params.frame_fifo_priority)};
+  if (params.physics_priority < 0 || params.physics_priority > 99)
+    return Error{"session: physics_priority must be in 0..99 (0: normal scheduling), got " +
+                 std::to_string(params.physics_priority)};
+  if (params.frame_nice < -20 || params.frame_nice > 19)
+    return Error{"session: frame_nice must be in -20..19, got " + std::to_string(params.frame_nice)};
+  return Ok{};
+}
+
 std::unique_ptr<Session> Session::create(Rig& rig, Scene& scene, render::Context& context,
                                          const vision::Camera& camera,
                                          const std::array<hand::HandModel, 2>& models,
                                          const SessionParams& params, device::Device* drive) {
-  if (params.warm_results < 1 || params.warm_results > 32)
-    throw SpidarError("session: warm_results must be in 1..32, got " + std::to_string(params.warm_results));
-  if (params.frame_fifo_priority < 0 || params.frame_fifo_priority > 99)
-    throw SpidarError("session: frame_fifo_priority must be in 0..99 (0: none), got " +
-                      std::to_string(params.frame_fifo_priority));
-  if (params.frame_nice < -20 || params.frame_nice > 19)
-    throw SpidarError("session: frame_nice must be in -20..19, got " + std::to_string(params.frame_nice));
+  if (auto st = validate(params); !st) throw SpidarError(st.error().message);
   std::unique_ptr<Session> s(new Session(rig, scene, context, params));
   auto lens = vision::LensUndistortion::of(camera.intrinsics());
   if (!lens) throw SpidarError("camera: " + lens.error().message);

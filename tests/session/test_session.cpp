@@ -168,13 +168,19 @@ TEST(Session, TheFrameThreadAndTheCameraRunAtTheirRealTimePrioritiesAndTheCaller
   EXPECT_EQ(core::current_scheduling(), before) << "run() left the caller's thread at the frame thread's scheduling";
 }
 
-TEST(Session, AFramePriorityOutsideItsRangeIsRefusedByName) {
-  for (int bad : {-1, 100}) {
-    try {
-      SimulatedSetup s(1.0, true, [bad](SessionParams& p) { p.frame_fifo_priority = bad; });
-      ADD_FAILURE() << "frame_fifo_priority " << bad << " was accepted";
-    } catch (const SpidarError& e) {
-      EXPECT_NE(std::string(e.what()).find("frame_fifo_priority must be in 0..99"), std::string::npos) << e.what();
+TEST(Session, APriorityOutsideItsRangeIsRefusedByName) {
+  using Tweak = std::function<void(SessionParams&, int)>;
+  const std::vector<std::pair<std::string, Tweak>> fields{
+      {"frame_fifo_priority must be in 0..99", [](SessionParams& p, int v) { p.frame_fifo_priority = v; }},
+      {"physics_priority must be in 0..99", [](SessionParams& p, int v) { p.physics_priority = v; }}};
+  for (const auto& [message, set] : fields) {
+    for (int bad : {-1, 100}) {
+      SessionParams p;
+      ASSERT_TRUE(validate(p).ok());
+      set(p, bad);
+      const Status st = validate(p);
+      ASSERT_FALSE(st.ok()) << message << ": " << bad << " was accepted";
+      EXPECT_NE(st.error().message.find(message), std::string::npos) << st.error().message;
     }
   }
 }

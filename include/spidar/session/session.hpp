@@ -51,7 +51,13 @@ struct SessionParams {
   double seconds = 0;
   /// The run also ends once the scene's scripted user is done (sim::RubiksTask::finished).
   bool end_with_script = false;
-  int physics_priority = 60;  ///< SCHED_FIFO: above the rendering threads, below the servo loop
+  /// The physics thread's SCHED_FIFO priority: above the frame thread (20), below the servo loop
+  /// (80) and the simulated camera (30), which a real rig's camera, a device, never waits for.
+  /// At 60, above the camera, the physics' 1 kHz steps preempted the camera's film on its CPU:
+  /// quiet demo, seeds 1–8 interleaved (docs/measurements.md, session 48), film 8.4–12.0 ms and
+  /// latency median 17.9–25.2 against 8.2–8.7 and 17.7–19.4 at 25; the physics' late steps, the
+  /// stale force cycles and the servo's jitter stayed within their bounds. 1..99.
+  int physics_priority = 25;
   /// The frame thread's niceness while run() runs (core::set_nice, best effort: below 0 needs
   /// CAP_SYS_NICE, else a normal share): after the simulated camera (−10, hardware), before the
   /// output thread (10) and other programs (0). Demo, one core busy, seeds 4–7 interleaved: −5
@@ -59,13 +65,16 @@ struct SessionParams {
   /// 2.9 %. 0: leave it.
   int frame_nice = -5;
   /// The frame thread's SCHED_FIFO priority while run() runs (0: its niceness only), below the
-  /// physics (60) and the servo loop (80), with the simulated camera's 30 above it. Its side
+  /// physics (25) and the servo loop (80), with the simulated camera's 30 above it. Its side
   /// helper follows it (core::SideTask). Where SCHED_FIFO is not permitted the session says so
   /// once and the thread keeps frame_nice. Demo, seeds 1–4 interleaved (docs/measurements.md,
   /// session 48), against frame_nice alone: quiet, latency median 18.2–20.2 against 21.2–24.8 ms;
   /// one core busy, 18.9–24.4 against 27.2–28.7 ms, p95 25–32 against 51–62 ms. 1..99 or 0.
   int frame_fifo_priority = 20;
 };
+
+/// Error naming the first SessionParams field out of its range (Session::create throws it).
+Status validate(const SessionParams& params);
 
 class Session {
  public:

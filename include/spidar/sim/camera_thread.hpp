@@ -89,7 +89,7 @@ struct CameraThreadParams {
   /// that share the CPU with it. Needs CAP_SYS_NICE below 0; without it, a normal share.
   int nice = -10;
   /// The thread's SCHED_FIFO priority (0: its niceness only; best effort, the niceness where it is
-  /// refused): above the frame thread's 20 and below the physics' 60 and the servo's 80, so that a
+  /// refused): above the frame thread's 20 and the physics' 25, below the servo's 80, so that a
   /// busy machine does not delay the exposures' films (session::SessionParams::frame_fifo_priority
   /// for the figures). 0..99.
   int fifo_priority = 30;
