@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <thread>
 
 #include "spidar/core/realtime.hpp"
@@ -107,6 +108,32 @@ TEST(Realtime, AvoidCpuNamesACpuThatIsNotOnline) {
   const Status st = avoid_cpu(static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)) + 3);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().message.find("is not online"), std::string::npos) << st.error().message;
+}
+
+
+TEST(Realtime, ASchedulingReadBackIsWhatWasAppliedToTheCallingThreadOnly) {
+  const ThreadScheduling mine = current_scheduling();
+  ThreadScheduling seen, after;
+  Status st = Ok{};
+  std::thread([&] {
+    ThreadScheduling want = current_scheduling();
+    EXPECT_EQ(want, mine) << "a new thread inherits its creator's scheduling";
+    want.nice = std::min(want.nice + 2, 19);  // raising nice needs no privilege
+    st = apply_scheduling(want);
+    seen = current_scheduling();
+    after = want;
+  }).join();
+  ASSERT_TRUE(st.ok()) << st.error().message;
+  EXPECT_EQ(seen, after);
+  EXPECT_EQ(seen.policy, mine.policy);
+  EXPECT_EQ(current_scheduling(), mine) << "it changed the calling test thread too";
+}
+
+TEST(Realtime, ApplySchedulingNamesAPolicyTheKernelRefuses) {
+  Status st = Ok{};
+  std::thread([&] { st = apply_scheduling({12345, 0, 0}); }).join();
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("policy 12345"), std::string::npos) << st.error().message;
 }
 
 }  // namespace
