@@ -278,10 +278,10 @@ SessionSummary Session::run(const std::function<std::optional<std::string>()>& i
     const Status rt = core::set_fifo_priority(params_.frame_fifo_priority);
     frame_realtime_ = rt.ok();
     if (!rt.ok()) {
+      // The nice value it has (frame_nice may have been refused too).
       spdlog::warn("session: the frame thread runs at nice {} instead of SCHED_FIFO {} ({}); on a busy "
-                   "machine expect more latency and dropped frames. Allow real-time priority: rtprio "
-                   "in /etc/security/limits.conf, or CAP_SYS_NICE",
-                   params_.frame_nice, params_.frame_fifo_priority, rt.error().message);
+                   "machine expect more latency and dropped frames",
+                   core::current_scheduling().nice, params_.frame_fifo_priority, rt.error().message);
     }
   }
   std::string ended_by = "completed";
