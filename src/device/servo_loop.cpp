@@ -207,24 +207,21 @@ void ServoLoop::monitor(pthread_t servo_thread) {
     // a monitor that woke late (its CPU busy), or a run shorter than the start-up grace, must not
     // end the loop without latching the stall it slept through.
     const bool due = woke >= next || (at_end && woke - last_progress_ns >= window_ns);
-    if (!due) {
-      if (!at_end) continue;
-      stop_.store(true, std::memory_order_release);
-      break;
+    if (due) {
+      const std::uint64_t now_cycles = cycle_.load(std::memory_order_acquire);
+      if (now_cycles == last && running_.load(std::memory_order_acquire)) {
+        device_.request_safe_state();
+        latch(kFaultWatchdog,
+              "monitor: the servo thread completed no cycle for %.3f ms (bound stall_limit_s "
+              "%.3f ms, at least 1 ms; 4 times that before the first cycle); stuck in cycle %llu "
+              "(a read, the force source or the scheduler)",
+              static_cast<double>(core::monotonic_ns() - last_progress_ns) * 1e-6,
+              static_cast<double>(window_ns) * 1e-6, static_cast<unsigned long long>(now_cycles));
+      }
+      if (now_cycles != last) last_progress_ns = core::monotonic_ns();
+      last = now_cycles;
+      next = core::monotonic_ns() + window_ns;
     }
-    const std::uint64_t now_cycles = cycle_.load(std::memory_order_acquire);
-    if (now_cycles == last && running_.load(std::memory_order_acquire)) {
-      device_.request_safe_state();
-      latch(kFaultWatchdog,
-            "monitor: the servo thread completed no cycle for %.3f ms (bound stall_limit_s "
-            "%.3f ms, at least 1 ms; 4 times that before the first cycle); stuck in cycle %llu "
-            "(a read, the force source or the scheduler)",
-            static_cast<double>(core::monotonic_ns() - last_progress_ns) * 1e-6,
-            static_cast<double>(window_ns) * 1e-6, static_cast<unsigned long long>(now_cycles));
-    }
-    if (now_cycles != last) last_progress_ns = core::monotonic_ns();
-    last = now_cycles;
-    next = core::monotonic_ns() + window_ns;
     if (at_end) {
       stop_.store(true, std::memory_order_release);
       break;

@@ -116,8 +116,7 @@ void CameraThread::run(const vision::Camera& camera, const std::array<hand::Hand
                        std::function<void(Status)> ready) {
   core::set_thread_name("spidar-camera");
   (void)core::set_nice(params_.nice);  // best effort (see CameraThreadParams::nice)
-  if (params_.fifo_priority > 0)
-    realtime_.store(core::set_fifo_priority(params_.fifo_priority).ok(), std::memory_order_release);
+  if (params_.fifo_priority > 0) (void)core::set_fifo_priority(params_.fifo_priority);  // best effort: nice where refused
   // However the thread ends, a frame thread waiting for a frame is woken.
   struct WakeWaitersAtEnd {
     CameraThread& c;

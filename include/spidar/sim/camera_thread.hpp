@@ -143,9 +143,6 @@ class CameraThread {
   std::uint64_t skipped() const { return skipped_.load(std::memory_order_acquire); }
   /// The error that stopped the thread, if any (read after stop()).
   const std::string& error() const { return error_; }
-  /// The thread runs at SCHED_FIFO (CameraThreadParams::fifo_priority granted); known once
-  /// prepare() has returned.
-  bool realtime() const { return realtime_.load(std::memory_order_acquire); }
   void stop();
 
  private:
@@ -168,7 +165,6 @@ class CameraThread {
   std::atomic<std::uint64_t> filmed_{0};
   std::atomic<std::uint64_t> skipped_{0};
   std::atomic<bool> stop_{false};
-  std::atomic<bool> realtime_{false};
   /// The exposures' start (begin()), or a stop, releases the prepared thread.
   std::mutex gate_mutex_;
   std::condition_variable gate_;
