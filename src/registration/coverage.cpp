@@ -160,6 +160,17 @@ double part_distance(const ProjectedHand& hand, int part, const Vec2& px) {
   return palm_distance(hand, px);
 }
 
+double section_clearance_px(const ProjectedHand& hand, const DigitAxisPoint& section) {
+  double clear = kInf;
+  for (const double side : {-1.0, 1.0}) {
+    // The section's edges: its midpoint ± half its width across the bone.
+    const Vec2 edge = section.target_px + side * 0.5 * section.width_px * section.across_px;
+    for (int part = -1; part < kSilhouetteBoneCount; ++part)
+      if (part != section.bone) clear = std::min(clear, part_distance(hand, part, edge));
+  }
+  return clear;
+}
+
 void coverage_evidence(const cv::Mat& silhouette, const std::array<const ProjectedHand*, 2>& hands,
                        const RegistrationParams& params, std::array<std::vector<OwnedPixel>, 2>* owned) {
   for (auto& o : *owned) o.clear();

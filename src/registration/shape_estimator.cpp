@@ -10,6 +10,7 @@
 
 #include "spidar/core/realtime.hpp"
 #include "spidar/core/result.hpp"
+#include "spidar/registration/coverage.hpp"
 #include "spidar/registration/fingertip_reach.hpp"
 #include "spidar/registration/palm_breadth.hpp"
 #include "spidar/registration/residuals.hpp"
@@ -25,6 +26,10 @@ constexpr int kSilhouetteMarginPx = 40;
 constexpr double kSectionMaxRatio = 1.35;
 /// The digits' sections pooled (ShapeEstimatorParams::digit_section_sigma): the oldest go first.
 constexpr std::size_t kMaxSectionSizes = 400;
+/// A section's edges lie at least this far outside every other part of the hand's outline [px]
+/// (ShapeEstimatorParams::digit_section_clear_edges): an edge found on another part's own boundary,
+/// the far side of a neighbour the digit merges with in the matte, lies within a pixel or so of it.
+constexpr double kSectionClearancePx = 2.0;
 }  // namespace
 
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled) {
@@ -35,12 +40,14 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "max_relative_change", "reach_min_miss_m", "apply_after_frames", "silhouette",
                     "max_fingertip_cost", "max_keyframe_speed_m_s", "shared_hands", "keyframe_prior_scale",
                     "keyframe_prior", "joint_balls", "palm_breadth_sigma_px", "palm_breadth_at",
-                    "palm_breadth_min_facing", "digit_axes", "digit_section_sigma", "keyframe_window"});
+                    "palm_breadth_min_facing", "digit_axes", "digit_section_sigma", "digit_section_clear_edges",
+                    "keyframe_window"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
   if (auto b = node.find("joint_balls")) p.joint_balls = b->as_bool();
   if (auto b = node.find("digit_axes")) p.digit_axes = b->as_bool();
+  if (auto b = node.find("digit_section_clear_edges")) p.digit_section_clear_edges = b->as_bool();
   if (auto b = node.find("keyframe_prior")) {
     const std::string v = b->as_string();
     if (v == "taken") p.keyframe_prior = KeyframePrior::kTaken;
@@ -541,11 +548,18 @@ void ShapeEstimator::add_sections(int hand, const hand::HandParams& q, const vis
   // The measured radius scale in β's units (hand 0's sizes): the model's width × thickness times
   // the section's real / model diameter, over the hand's width ratio to hand 0's.
   const double to_beta = starts_[0].y() / start.y();
+  ProjectedHand outline;  // the hand's outline at q, for the sections' edges (digit_section_clear_edges)
+  bool projected = false;
   for (const DigitAxisPoint& sec : digit_sections(model, q, camera, alpha, threshold)) {
     const BoneRef bone = silhouette_bone(sec.bone);
     if (bone.finger == hand::kThumb || bone.segment != 2) continue;  // the fingers' middle phalanges
     const double ratio = sec.width_px / sec.model_width_px;
     if (!(ratio > 1.0 / kSectionMaxRatio && ratio < kSectionMaxRatio)) continue;
+    if (p_.digit_section_clear_edges) {
+      if (!projected) project_hand(model, q, camera, 0.0, &outline);
+      projected = true;
+      if (!(section_clearance_px(outline, sec) >= kSectionClearancePx)) continue;
+    }
     if (section_sizes_.size() >= kMaxSectionSizes) section_sizes_.erase(section_sizes_.begin());
     section_sizes_.push_back(d.width * d.thickness * ratio * to_beta);
   }

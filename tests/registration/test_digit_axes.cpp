@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "registration_test_util.hpp"
+#include "spidar/registration/coverage.hpp"
 #include "spidar/registration/residuals.hpp"
 #include "spidar/registration/shape_estimator.hpp"
 
@@ -168,6 +169,75 @@ TEST(DigitSections, ReadEachDigitAsThickAsItsCapsule) {
   q[hand::kThumbCmcFlexion] = std::nan("");
   cv::Mat full(480, 640, CV_8UC1, cv::Scalar(255));
   EXPECT_TRUE(digit_sections(m, q, camera, full, 0.5).empty());
+}
+
+// A section whose edge lies inside another part of the hand's outline (section_clearance_px < 0)
+// may read that part's edge, and an edge on another part's own boundary (the far side of a
+// neighbour the digit merges with in the matte) lies within a pixel or so of it. Hands drawn from
+// their own capsules with the index and ring fingers turned toward the middle one (past their
+// limits, as a finger seen partly behind its neighbour is), read at the true pose: every section
+// that reads more than 8 % wide has an edge less than 2 px clear of another part, and every
+// section whose edges are 2 px clear reads its capsule within 8 % (nearly straight
+// digits read 0-6 % wide: DigitSections.ReadEachDigitAsThickAsItsCapsule). The size estimate keeps
+// only the clear ones (ShapeEstimatorParams::digit_section_clear_edges).
+TEST(DigitSections, OnlyThoseWithAnEdgeInsideAnotherPartReadWide) {
+  const vision::Camera camera = vision::default_rig_camera();
+  int wide = 0, clear = 0;
+  for (const double W : {0.085, 0.0935, 0.0765}) {
+    const hand::HandModel m = resized(hand::default_hand_model(hand::Side::kRight), 0.19, W).value();
+    for (const double toward : {0.0, 0.15, 0.25, 0.35}) {
+      hand::HandParams q = test::reaching_hands(0)[1];
+      for (int i = hand::kThumbCmcFlexion; i < hand::kParamCount; ++i) q[i] *= 0.2;
+      for (const double sign : {1.0, -1.0}) {
+        hand::HandParams crossed = q;
+        crossed[hand::kIndexMcpAbduction] += sign * toward;
+        crossed[hand::kRingMcpAbduction] -= sign * toward;
+        cv::Mat mask;
+        test::draw_capsule_mask(m, crossed, camera, &mask, true, true);
+        ProjectedHand outline;
+        project_hand(m, crossed, camera, 0.0, &outline);
+        for (const auto& s : digit_sections(m, crossed, camera, mask, 0.5)) {
+          const double ratio = s.width_px / s.model_width_px;
+          if (ratio > 1.35) continue;  // two fingers side by side (the size estimate leaves them out)
+          const double c = section_clearance_px(outline, s);
+          if (ratio > 1.08) {
+            ++wide;
+            EXPECT_LT(c, 2.0) << W << " toward " << sign * toward << " bone " << s.bone << " ratio " << ratio;
+          }
+          if (c >= 2.0) {
+            ++clear;
+            EXPECT_GT(ratio, 0.96) << W << " toward " << sign * toward << " bone " << s.bone;
+            EXPECT_LT(ratio, 1.08) << W << " toward " << sign * toward << " bone " << s.bone;
+          }
+        }
+      }
+    }
+  }
+  std::printf("sections read wide: %d; with clear edges: %d\n", wide, clear);
+  EXPECT_GT(wide, 5);    // the crossed fingers do read some digits wide
+  EXPECT_GT(clear, 20);  // and the others stay measurable
+}
+
+// section_clearance_px: two capsules side by side, a section across one of them. Its edge is
+// clear of the other by the gap between them, and inside it once they overlap; a lone capsule is
+// clear everywhere (+∞).
+TEST(DigitSections, ClearanceIsTheEdgesDistanceFromTheOtherParts) {
+  ProjectedHand hand;
+  ImageCapsule& a = hand.bones[5];
+  ImageCapsule& b = hand.bones[8];
+  a = {Vec2(100, 100), Vec2(100, 200), 10, 10, true};
+  DigitAxisPoint s;
+  s.bone = 5;
+  s.target_px = Vec2(100, 150);
+  s.across_px = Vec2(1, 0);
+  s.width_px = 20;  // edges at x = 90 and 110
+  EXPECT_TRUE(std::isinf(section_clearance_px(hand, s)));
+  for (const double x : {135.0, 125.0, 118.0}) {
+    b = {Vec2(x, 100), Vec2(x, 200), 10, 10, true};
+    EXPECT_NEAR(section_clearance_px(hand, s), x - 10 - 110, 1e-9) << x;
+  }
+  b.valid = false;  // a part not drawn is no neighbour
+  EXPECT_TRUE(std::isinf(section_clearance_px(hand, s)));
 }
 
 }  // namespace

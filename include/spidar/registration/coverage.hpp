@@ -70,6 +70,14 @@ OutlineNearest nearest_part(const ProjectedHand& hand, const Vec2& px);
 /// +∞ if that part is not drawn.
 double part_distance(const ProjectedHand& hand, int part, const Vec2& px);
 
+/// How far the two edges of a digit's section (digit_sections, residuals.hpp) lie outside every
+/// other part of the hand's outline [px]: the smaller of the edges' distances to the nearest part
+/// other than the section's own bone (the palm included). Below 0 an edge lies inside another
+/// part, whose outline in the image may be the silhouette's edge there (a neighbouring finger seen
+/// partly behind this one, the next phalanx's rounded end at a bent joint): the section is then no
+/// measurement of this digit alone. +∞ when no other part is drawn.
+double section_clearance_px(const ProjectedHand& hand, const DigitAxisPoint& section);
+
 /// A silhouette pixel a hand owns, with the part of the hand nearest to it when its owner was
 /// decided (a hint: a pose a little later most likely still covers the pixel with that part).
 struct OwnedPixel {

@@ -202,6 +202,14 @@ struct ShapeEstimatorParams {
   /// on the worse hand 7.3 → 4.8 % (max 18.3 → 9.5 %), IoU 0.829 → 0.837, joints 7.5 → 7.1 px,
   /// the contested pixels 2.4 → 2.1 % wrong (max 5.3 → 3.6 %).
   double digit_section_sigma = 0.3;
+  /// A section is kept only where both its edges lie at least 2 px outside every other part of the
+  /// hand's model outline at the frame's fitted pose (section_clearance_px, coverage.hpp): an edge
+  /// inside another part, or on its boundary, may be that part's (a neighbouring finger partly
+  /// behind this one, merged with it in the matte), and reads the digit wide. Measured (demo, 2026-11-29,
+  /// session 49): without it every section of the default user's left hand came from its middle
+  /// finger, each edge 1–6 px inside a neighbour's outline, reading it 1.08–1.33 times the model's
+  /// width, and the left width ended 9–15 % wide; with it −0.3…+1.9 % (docs/measurements.md).
+  bool digit_section_clear_edges = true;
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
