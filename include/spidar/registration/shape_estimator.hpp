@@ -208,7 +208,8 @@ struct ShapeEstimatorParams {
   /// behind this one, merged with it in the matte), and reads the digit wide. Measured (demo, 2026-11-29,
   /// session 49): without it every section of the default user's left hand came from its middle
   /// finger, each edge 1–6 px inside a neighbour's outline, reading it 1.08–1.33 times the model's
-  /// width, and the left width ended 9–15 % wide; with it −0.3…+1.9 % (docs/measurements.md).
+  /// width, and the left width ended 8–15 % wide; with it −0.4…+2.9 % (seeds 1–6), −2.0…+3.7 %
+  /// over seeds 1–20, at 0.007 less IoU (docs/measurements.md).
   bool digit_section_clear_edges = true;
 };
 
@@ -332,8 +333,9 @@ class ShapeEstimator {
 /// solve_every, min_keyframes, iterations, freeze_sigma_length_m, freeze_sigma_width_m,
 /// freeze_sigma_thickness, max_relative_change,
 /// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, max_keyframe_speed_m_s, shared_hands,
-/// keyframe_prior_scale, keyframe_prior (taken or last), palm_breadth_sigma_px, palm_breadth_at,
-/// palm_breadth_min_facing.
+/// keyframe_prior_scale, keyframe_prior (taken or last), keyframe_window (newest or session),
+/// joint_balls, palm_breadth_sigma_px, palm_breadth_at, palm_breadth_min_facing, digit_axes,
+/// digit_section_sigma, digit_section_clear_edges.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
