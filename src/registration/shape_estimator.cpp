@@ -549,17 +549,13 @@ void ShapeEstimator::add_sections(int hand, const hand::HandParams& q, const vis
   // the section's real / model diameter, over the hand's width ratio to hand 0's.
   const double to_beta = starts_[0].y() / start.y();
   ProjectedHand outline;  // the hand's outline at q, for the sections' edges (digit_section_clear_edges)
-  bool projected = false;
+  if (p_.digit_section_clear_edges) project_hand(model, q, camera, 0.0, &outline);
   for (const DigitAxisPoint& sec : digit_sections(model, q, camera, alpha, threshold)) {
     const BoneRef bone = silhouette_bone(sec.bone);
     if (bone.finger == hand::kThumb || bone.segment != 2) continue;  // the fingers' middle phalanges
     const double ratio = sec.width_px / sec.model_width_px;
     if (!(ratio > 1.0 / kSectionMaxRatio && ratio < kSectionMaxRatio)) continue;
-    if (p_.digit_section_clear_edges) {
-      if (!projected) project_hand(model, q, camera, 0.0, &outline);
-      projected = true;
-      if (!(section_clearance_px(outline, sec) >= kSectionClearancePx)) continue;
-    }
+    if (p_.digit_section_clear_edges && !(section_clearance_px(outline, sec) >= kSectionClearancePx)) continue;
     if (section_sizes_.size() >= kMaxSectionSizes) section_sizes_.erase(section_sizes_.begin());
     section_sizes_.push_back(d.width * d.thickness * ratio * to_beta);
   }

@@ -229,6 +229,23 @@ TEST(ShapeEstimator, ThePalmsBreadthWidensANarrowModel) {
   EXPECT_LT(std::abs(chords.width_m - W), 0.04 * W);
 }
 
+/// The reaching right hand with its fingers nearly straight, so that most frames show their middle
+/// phalanges across (the reaching pose's are mostly seen end-on).
+hand::HandParams nearly_straight_hand() {
+  hand::HandParams base = test::reaching_hands(0)[1];
+  for (int i = hand::kThumbCmcFlexion; i < hand::kParamCount; ++i) base[i] *= 0.2;
+  return base;
+}
+
+/// The estimate from the default right model, the strings and the digits' sections of `truth`
+/// about `base` (feed(), exact digits, 240 frames; no joint-balls): `sp` as given otherwise.
+ShapeEstimate estimate_with_sections(const hand::HandModel& truth, const hand::HandParams& base,
+                                     ShapeEstimatorParams sp) {
+  sp.joint_balls = false;
+  ShapeEstimator est(hand::default_hand_model(hand::Side::kRight), sp);
+  return feed(est, 0, truth, base, 240, 13, ShapeSilhouette::kNone, true, true, true).estimate;
+}
+
 // The digits' sections (digit_section_sigma): the fingers' middle phalanges seen across, whose
 // width against the model's outline measures the capsules' radius (width × thickness; both are
 // estimated then). Hands of the model's length and width with thicker and thinner digits (±20 %),
@@ -240,16 +257,11 @@ TEST(ShapeEstimator, TheDigitsSectionsSeeTheDigitsThickness) {
   for (const double T : {1.2, 0.8}) {
     hand::HandDimensions d = hand::default_hand_model(hand::Side::kRight).shape.dimensions;
     const hand::HandModel truth = resized(hand::default_hand_model(hand::Side::kRight), d.length, d.width, T).value();
-    // The fingers nearly straight, so that most frames show their middle phalanges across (the
-    // reaching pose's are mostly seen end-on).
-    hand::HandParams base = test::reaching_hands(0)[1];
-    for (int i = hand::kThumbCmcFlexion; i < hand::kParamCount; ++i) base[i] *= 0.2;
+    const hand::HandParams base = nearly_straight_hand();
     auto estimate = [&](double sigma) {
       ShapeEstimatorParams sp;
-      sp.joint_balls = false;
       sp.digit_section_sigma = sigma;
-      ShapeEstimator est(hand::default_hand_model(hand::Side::kRight), sp);
-      return feed(est, 0, truth, base, 240, 13, ShapeSilhouette::kNone, true, true, true).estimate;
+      return estimate_with_sections(truth, base, sp);
     };
     const ShapeEstimate strings = estimate(0.0), sections = estimate(0.3);
     const double r_true = d.width * T, r_sections = sections.width_m * sections.thickness;
@@ -276,26 +288,24 @@ TEST(ShapeEstimator, SectionsWithAnEdgeOnANeighbourAreLeftOut) {
       truth.limits.lower[i] = -1.0;
       truth.limits.upper[i] = 1.0;
     }
-    hand::HandParams base = test::reaching_hands(0)[1];
-    for (int i = hand::kThumbCmcFlexion; i < hand::kParamCount; ++i) base[i] *= 0.2;
+    hand::HandParams base = nearly_straight_hand();
     base[hand::kIndexMcpAbduction] += sign * 0.3;
     base[hand::kRingMcpAbduction] -= sign * 0.3;
-    auto estimate = [&](bool clear) {
-      ShapeEstimatorParams sp;
-      sp.joint_balls = false;
-      sp.digit_section_clear_edges = clear;
-      ShapeEstimator est(hand::default_hand_model(hand::Side::kRight), sp);
-      return feed(est, 0, truth, base, 240, 13, ShapeSilhouette::kNone, true, true, true).estimate;
-    };
-    const ShapeEstimate all = estimate(false), clear = estimate(true);
+    // The capsules' radius scale (width × thickness) relative to the truth's, less 1.
     const double r_true = truth.shape.dimensions.width * truth.shape.dimensions.thickness;
-    std::printf("sign %+.0f: all sections W %.4f x %.3f (%+.1f %%), clear edges W %.4f x %.3f (%+.1f %%)\n", sign,
-                all.width_m, all.thickness, 100 * (all.width_m * all.thickness / r_true - 1), clear.width_m,
-                clear.thickness, 100 * (clear.width_m * clear.thickness / r_true - 1));
+    auto radius_error = [&](bool clear) {
+      ShapeEstimatorParams sp;
+      sp.digit_section_clear_edges = clear;
+      const ShapeEstimate e = estimate_with_sections(truth, base, sp);
+      return e.width_m * e.thickness / r_true - 1;
+    };
+    const double all = radius_error(false), clear = radius_error(true);
+    std::printf("sign %+.0f: width × thickness %+.1f %% off with every section, %+.1f %% with the clear ones\n", sign,
+                100 * all, 100 * clear);
     // Measured: +8.6 / +6.2 % with every section, +4.1 / +3.6 % with the clear ones (the rest is
     // the strings': the fit cannot lean its fingers past their limits).
-    const double e_all = std::abs(all.width_m * all.thickness / r_true - 1);
-    const double e_clear = std::abs(clear.width_m * clear.thickness / r_true - 1);
+    const double e_all = std::abs(all);
+    const double e_clear = std::abs(clear);
     EXPECT_LT(e_clear, 0.7 * e_all) << sign;
     EXPECT_LT(e_clear, 0.05) << sign;
   }
