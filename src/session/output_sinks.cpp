@@ -28,8 +28,11 @@ void KeyframeSink::on_frame(const FrameEvent& e) {
   if (next_ >= times_.size() || e.t_s < times_[next_]) return;
   char name[64];
   std::snprintf(name, sizeof name, "keyframe_%d_t%04.1fs.png", static_cast<int>(next_) + 1, e.t_s);
+  // With the simulated camera's ground truth, the fit against the real hands as well.
+  const cv::Mat* real_hand_id = e.filmed != nullptr ? &e.filmed->wait_for_truth_images().hand_id : nullptr;
   keyframes_.emplace_back((std::filesystem::path(dir_) / name).string(),
-                          sim::keyframe_montage(*e.bgr, *e.result, mode_, e.result->models, camera_, caption_(e)));
+                          sim::keyframe_montage(*e.bgr, *e.result, mode_, e.result->models, camera_, caption_(e),
+                                                real_hand_id));
   ++next_;
 }
 

@@ -1,6 +1,9 @@
 #include "spidar/sim/frame_truth.hpp"
 
+#include <cstdio>
 #include <limits>
+#include <string>
+#include <tuple>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -97,12 +100,61 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
   return m;
 }
 
+namespace {
+
+/// The legend of silhouette_loss_image's colours with `loss`'s counts per hand, on `tile`.
+void draw_loss_legend(const SilhouetteLoss& loss, cv::Mat* tile) {
+  const SilhouetteLossColours c;
+  const auto put = [&](const std::string& text, int row, const cv::Scalar& colour) {
+    cv::putText(*tile, text, cv::Point(16, 56 + 26 * row), cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv::LINE_AA);
+  };
+  const auto swatch = [&](const cv::Vec3b& v, int row) {
+    cv::rectangle(*tile, cv::Rect(16, 56 + 26 * row - 12, 14, 14), cv::Scalar(v[0], v[1], v[2]), cv::FILLED);
+  };
+  const cv::Scalar white(230, 230, 230);
+  char line[128];
+  std::snprintf(line, sizeof line, "IoU %.3f  (px: left / right hand)", loss.iou());
+  put(line, 0, white);
+  const std::array<std::tuple<const char*, cv::Vec3b, long, long>, 5> rows{{
+      {"real and model", c.both, loss.both, -1},
+      {"palm missed", c.missed_palm, loss.missed_palm[0], loss.missed_palm[1]},
+      {"digits missed", c.missed_digits, loss.missed_digits[0], loss.missed_digits[1]},
+      {"palm spilled", c.spill_palm, loss.spill_palm[0], loss.spill_palm[1]},
+      {"digits spilled", c.spill_digits, loss.spill_digits[0], loss.spill_digits[1]}}};
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& [name, colour, left, right] = rows[i];
+    const int row = static_cast<int>(i) + 1;
+    swatch(colour, row);
+    if (right < 0) std::snprintf(line, sizeof line, "     %-15s %6ld", name, left);
+    else std::snprintf(line, sizeof line, "     %-15s %6ld / %ld", name, left, right);
+    put(line, row, white);
+  }
+  put("the fit drawn as scored (skin, no forearm)", 7, cv::Scalar(170, 170, 170));
+  put("against the filmed hands' palms and digits", 8, cv::Scalar(170, 170, 170));
+}
+
+}  // namespace
+
 cv::Mat keyframe_montage(const cv::Mat& camera_bgr, const pipeline::FrameResult& result,
                          render::CompositeMode main_mode,
                          const std::array<hand::HandModel, 2>& models,
-                         const vision::Camera& camera, const std::string& caption) {
+                         const vision::Camera& camera, const std::string& caption,
+                         const cv::Mat* real_hand_id) {
   const int w = camera_bgr.cols, h = camera_bgr.rows;
-  cv::Mat out(2 * h + 28, 2 * w, CV_8UC3, cv::Scalar(30, 30, 30));
+  // The third column only where the fit's drawing and the truth agree in size (else 2×2).
+  cv::Mat loss_img, legend;
+  if (real_hand_id != nullptr && !result.virt.hand_id.empty()) {
+    SilhouetteLoss loss;
+    if (silhouette_loss(result.virt.hand_id, *real_hand_id, &loss).ok() &&
+        silhouette_loss_image(result.virt.hand_id, *real_hand_id, &loss_img).ok() && loss_img.size() == camera_bgr.size()) {
+      legend = cv::Mat(h, w, CV_8UC3, cv::Scalar(30, 30, 30));
+      draw_loss_legend(loss, &legend);
+    } else {
+      loss_img.release();
+    }
+  }
+  const int columns = loss_img.empty() ? 2 : 3;
+  cv::Mat out(2 * h + 28, columns * w, CV_8UC3, cv::Scalar(30, 30, 30));
   cv::Mat matte;
   result.key.alpha.convertTo(matte, CV_8U, 255.0);
   cv::cvtColor(matte, matte, cv::COLOR_GRAY2BGR);
@@ -116,17 +168,20 @@ cv::Mat keyframe_montage(const cv::Mat& camera_bgr, const pipeline::FrameResult&
   const bool depth_main = main_mode == render::CompositeMode::kDepth;
   const cv::Mat& depth_img = depth_main ? result.composite : result.other;
   const cv::Mat& paper_img = depth_main ? result.other : result.composite;
-  const std::array<std::pair<const cv::Mat*, const char*>, 4> tiles{{
-      {&camera_bgr, "camera (synthetic)"},
-      {&matte, "matte + fitted hands"},
-      {&depth_img, "composite: depth"},
-      {&paper_img, "composite: paper"}}};
-  for (int i = 0; i < 4; ++i) {
-    if (tiles[i].first->empty()) continue;
-    const cv::Rect at((i % 2) * w, (i / 2) * h, w, h);
-    tiles[i].first->copyTo(out(at));
-    cv::putText(out, tiles[i].second, cv::Point(at.x + 8, at.y + 20), cv::FONT_HERSHEY_SIMPLEX,
-                0.55, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  // Row by row: camera, matte [, fit against the real hands]; depth, paper [, legend].
+  const std::array<std::tuple<const cv::Mat*, const char*, int, int>, 6> tiles{{
+      {&camera_bgr, "camera (synthetic)", 0, 0},
+      {&matte, "matte + fitted hands", 1, 0},
+      {&loss_img, "fit against the real hands", 2, 0},
+      {&depth_img, "composite: depth", 0, 1},
+      {&paper_img, "composite: paper", 1, 1},
+      {&legend, "", 2, 1}}};
+  for (const auto& [img, label, col, row] : tiles) {
+    if (img->empty() || col >= columns) continue;
+    const cv::Rect at(col * w, row * h, w, h);
+    img->copyTo(out(at));
+    cv::putText(out, label, cv::Point(at.x + 8, at.y + 20), cv::FONT_HERSHEY_SIMPLEX, 0.55,
+                cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }
   cv::putText(out, caption, cv::Point(8, 2 * h + 20), cv::FONT_HERSHEY_SIMPLEX, 0.5,
               cv::Scalar(230, 230, 230), 1, cv::LINE_AA);

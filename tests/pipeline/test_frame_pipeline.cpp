@@ -168,6 +168,44 @@ TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) 
 // against the paper's joint-balls alone (its forearm in line), on the same frames of the simulated
 // user's hands, their wrists bending as the demo's do: the approach (hands coming in from the
 // sides, the worst frames of the paper's fit) through the grasp, the lift and the first turn.
+// The report's keyframe: 2×2 without the ground truth (real hardware), and with the real hands'
+// ids a third column whose top tile is the fit against the real hands (silhouette_loss_image).
+TEST_F(FramePipelineTest, AKeyframeShowsTheFitAgainstTheRealHandsWhenTheTruthIsKnown) {
+  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
+  FramePipelineParams p;
+  p.chroma_key = vc.chroma_key;
+  p.bracelet = vc.bracelet;
+  sim::RubiksTask task({});
+  for (int h = 0; h < 2; ++h)
+    p.initial_r_W_hand[h] = task.nominal(2.0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  auto pipe = FramePipeline::create(*context_, camera_, models_, p).value();
+  sim::UserHands user(truth_models_, task);
+  sim::SyntheticFrame frame;
+  FrameResult r;
+  const auto sample = pose_user(user, task, 2.0);
+  const auto& truth = user.params();
+  ASSERT_TRUE(film_->film({&truth[0], &truth[1]}, &frame).ok());
+  ASSERT_TRUE(pipe->process(frame.bgr, sample, scene_, &r).ok());
+  const int w = frame.bgr.cols, h = frame.bgr.rows;
+  const cv::Mat plain = sim::keyframe_montage(frame.bgr, r, p.compositor.mode, r.models, camera_, "caption");
+  EXPECT_EQ(plain.cols, 2 * w);
+  EXPECT_EQ(plain.rows, 2 * h + 28);
+  const cv::Mat with = sim::keyframe_montage(frame.bgr, r, p.compositor.mode, r.models, camera_, "caption", &frame.hand_id);
+  ASSERT_EQ(with.cols, 3 * w);
+  EXPECT_EQ(with.rows, 2 * h + 28);
+  cv::Mat loss;
+  ASSERT_TRUE(sim::silhouette_loss_image(r.virt.hand_id, frame.hand_id, &loss).ok());
+  ASSERT_GT(cv::countNonZero(loss.reshape(1)), 1000);  // the hands are in view
+  // Below the tile's label, the tile is the loss picture.
+  const cv::Rect below(0, 32, w, h - 32);
+  cv::Mat diff;
+  cv::absdiff(with(cv::Rect(2 * w, 0, w, h))(below), loss(below), diff);
+  EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0);
+  // A truth of another size is left out rather than drawn wrong.
+  const cv::Mat small(h / 2, w / 2, CV_8UC1, cv::Scalar(0));
+  EXPECT_EQ(sim::keyframe_montage(frame.bgr, r, p.compositor.mode, r.models, camera_, "caption", &small).cols, 2 * w);
+}
+
 TEST_F(FramePipelineTest, TheSilhouetteTermBeatsJointBallsOnTheSameFrames) {
   const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
   sim::RubiksTask task({});

@@ -91,6 +91,46 @@ TEST(SilhouetteLoss, ItsIouIsMaskIousOnRandomHands) {
   }
 }
 
+/// Pixels of `bgr` of colour `c`.
+long count_colour(const cv::Mat& bgr, const cv::Vec3b& c) {
+  long n = 0;
+  for (int i = 0; i < bgr.rows; ++i)
+    for (int j = 0; j < bgr.cols; ++j) n += bgr.at<cv::Vec3b>(i, j) == c ? 1 : 0;
+  return n;
+}
+
+// The picture of the loss (for the keyframes): each class in its colour, so its colours' counts are
+// the loss's (both hands together), on the hand-drawn pair above and on random hands; the rest black.
+TEST(SilhouetteLoss, ItsPictureShowsEachPixelsClassInItsColour) {
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> x(0, 159), y(0, 119), r(3, 25), part(-1, 6), hand(0, 1);
+  const SilhouetteLossColours c;
+  for (int trial = 0; trial < 10; ++trial) {
+    cv::Mat model(120, 160, CV_8UC1, cv::Scalar(0)), real(120, 160, CV_8UC1, cv::Scalar(0));
+    for (int k = 0; k < 6; ++k)
+      for (cv::Mat* m : {&real, &model})
+        cv::circle(*m, cv::Point(x(rng), y(rng)), r(rng), cv::Scalar(encode_hand_id(hand(rng), part(rng))), cv::FILLED);
+    SilhouetteLoss l;
+    cv::Mat picture;
+    ASSERT_TRUE(silhouette_loss(model, real, &l).ok());
+    ASSERT_TRUE(silhouette_loss_image(model, real, &picture).ok());
+    ASSERT_EQ(picture.type(), CV_8UC3);
+    ASSERT_EQ(picture.size(), model.size());
+    EXPECT_EQ(count_colour(picture, c.both), l.both) << "trial " << trial;
+    EXPECT_EQ(count_colour(picture, c.missed_palm), l.missed_palm[0] + l.missed_palm[1]) << "trial " << trial;
+    EXPECT_EQ(count_colour(picture, c.missed_digits), l.missed_digits[0] + l.missed_digits[1]) << "trial " << trial;
+    EXPECT_EQ(count_colour(picture, c.spill_palm), l.spill_palm[0] + l.spill_palm[1]) << "trial " << trial;
+    EXPECT_EQ(count_colour(picture, c.spill_digits), l.spill_digits[0] + l.spill_digits[1]) << "trial " << trial;
+    cv::Mat either;
+    cv::bitwise_or(hand_mask(model), hand_mask(real), either);
+    EXPECT_EQ(count_colour(picture, cv::Vec3b(0, 0, 0)), picture.total() - cv::countNonZero(either)) << "trial " << trial;
+  }
+  const auto wrong = silhouette_loss_image(cv::Mat(10, 10, CV_8UC1), cv::Mat(9, 10, CV_8UC1), nullptr);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().message.find("silhouette_loss_image: real_hand_id is 10x9"), std::string::npos)
+      << wrong.error().message;
+}
+
 TEST(SilhouetteLoss, RejectsImagesOfAnotherTypeOrSizeNamingThem) {
   const cv::Mat id(10, 10, CV_8UC1, cv::Scalar(0));
   SilhouetteLoss l;

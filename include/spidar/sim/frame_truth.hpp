@@ -74,11 +74,16 @@ Result<FrameTruthMetrics> measure_frame(const SyntheticFrame& frame,
                                         const std::array<hand::HandParams, 2>& truth,
                                         const vision::Camera& camera, FrameTruthWorkspace* ws);
 
-/// A 2×2 keyframe for the report: the camera frame | the matte with the fitted hands' wireframe
-/// and bracelet wrists, the depth composite | the paper composite, each labelled, with `caption`.
+/// A keyframe for the report: the camera frame | the matte with the fitted hands' wireframe
+/// and bracelet wrists, the depth composite | the paper composite, each labelled, with `caption`
+/// (2×2). With the real hands' ids (`real_hand_id`, SyntheticFrame::hand_id; the simulated
+/// camera's ground truth) a third column: the drawn fit against the real hands
+/// (silhouette_loss_image, the IoU's pixels: what the fit misses and where it spills, palm and
+/// digits apart) over a legend with the frame's counts per hand (3×2).
 cv::Mat keyframe_montage(const cv::Mat& camera_bgr, const pipeline::FrameResult& result,
                          render::CompositeMode main_mode,
                          const std::array<hand::HandModel, 2>& models,
-                         const vision::Camera& camera, const std::string& caption);
+                         const vision::Camera& camera, const std::string& caption,
+                         const cv::Mat* real_hand_id = nullptr);
 
 }  // namespace spidar::sim

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
+#include <opencv2/core/matx.hpp>
 
 #include "spidar/core/result.hpp"
 
@@ -35,5 +36,21 @@ struct SilhouetteLoss {
 /// only palms and digits are the hand (is_hand_pixel). Error naming the image if a type or size
 /// differs.
 Status silhouette_loss(const cv::Mat& model_hand_id, const cv::Mat& real_hand_id, SilhouetteLoss* out);
+
+/// Colours of silhouette_loss_image (BGR).
+struct SilhouetteLossColours {
+  cv::Vec3b both{150, 150, 150};          ///< real and model hand alike
+  cv::Vec3b missed_palm{40, 40, 190};     ///< a real palm no model hand covers
+  cv::Vec3b missed_digits{60, 150, 255};  ///< real digits no model hand covers
+  cv::Vec3b spill_palm{190, 70, 20};      ///< a model palm off the real hands
+  cv::Vec3b spill_digits{240, 220, 60};   ///< model digits off the real hands
+};
+
+/// The same comparison as a picture (CV_8UC3, the images' size; black where neither holds a hand
+/// pixel): where the fit leaves the real hands uncovered and where it spills, by part, so that a
+/// keyframe shows which part of the fit is off. Counting its colours gives silhouette_loss's
+/// counts (both hands together). Same errors as silhouette_loss.
+Status silhouette_loss_image(const cv::Mat& model_hand_id, const cv::Mat& real_hand_id, cv::Mat* bgr,
+                             const SilhouetteLossColours& colours = {});
 
 }  // namespace spidar::sim
