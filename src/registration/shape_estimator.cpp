@@ -41,13 +41,14 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "max_fingertip_cost", "max_keyframe_speed_m_s", "shared_hands", "keyframe_prior_scale",
                     "keyframe_prior", "joint_balls", "palm_breadth_sigma_px", "palm_breadth_at",
                     "palm_breadth_min_facing", "digit_axes", "digit_section_sigma", "digit_section_clear_edges",
-                    "keyframe_window"});
+                    "keyframe_window", "accumulate"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
   if (auto b = node.find("joint_balls")) p.joint_balls = b->as_bool();
   if (auto b = node.find("digit_axes")) p.digit_axes = b->as_bool();
   if (auto b = node.find("digit_section_clear_edges")) p.digit_section_clear_edges = b->as_bool();
+  if (auto b = node.find("accumulate")) p.accumulate = b->as_bool();
   if (auto b = node.find("keyframe_prior")) {
     const std::string v = b->as_string();
     if (v == "taken") p.keyframe_prior = KeyframePrior::kTaken;
@@ -186,6 +187,9 @@ ShapeEstimator::ShapeEstimator(const hand::HandModel& start, const ShapeEstimato
   estimate_.sigma_length_m = p_.prior_sigma_length_m;
   estimate_.sigma_width_m = p_.prior_sigma_width_m;
   estimate_.sigma_thickness = p_.prior_sigma_thickness;
+  const Eigen::Vector3d sigma0(p_.prior_sigma_length_m, p_.prior_sigma_width_m, p_.prior_sigma_thickness);
+  prior_H_ = sigma0.cwiseProduct(sigma0).cwiseInverse().asDiagonal();
+  prior_h_ = prior_H_ * starts_[0];
 }
 
 ShapeEstimator::ShapeEstimator(const std::array<hand::HandModel, 2>& starts,
@@ -252,7 +256,11 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   const int nb = any_silhouette || (p.digit_section_sigma > 0 && !job.section_sizes.empty()) ? 3 : 2;
   const Eigen::Vector3d beta0 = starts[0];
   const Eigen::Vector3d sigma0(p.prior_sigma_length_m, p.prior_sigma_width_m, p.prior_sigma_thickness);
-  const Eigen::Matrix3d H0 = sigma0.cwiseProduct(sigma0).cwiseInverse().asDiagonal();
+  // The prior, βᵀ H0 β − 2 h0ᵀ β: the starting profile's, and what left the window (accumulate).
+  // Its mean (H0⁻¹ h0) makes its cost (β − mean)ᵀ H0 (β − mean) ≥ 0.
+  const Eigen::Matrix3d H0 = job.prior_H;
+  const Eigen::Vector3d prior_mean = H0.ldlt().solve(job.prior_h);
+  (void)sigma0;
   const Eigen::Vector3d step_h(p.difference_step_m, p.difference_step_m,
                                p.difference_step_m / std::max(starts[0].y(), 1e-3));
   const double k = p.max_relative_change;
@@ -286,11 +294,13 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     Eigen::Vector3d beta;
     Eigen::Matrix3d H;
     std::vector<hand::HandParams> poses;  ///< the keyframes' re-fitted poses at beta
+    std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> info;  ///< their S_k, g_k at beta
   } best;
   for (int it = 0; it <= p.iterations; ++it) {
     Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    double cost = (beta - beta0).dot(H0 * (beta - beta0));
+    double cost = (beta - prior_mean).dot(H0 * (beta - prior_mean));
+    std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> info(job.keyframes.size());  // S_k, g_k
     for (std::size_t i = 0; i < job.keyframes.size(); ++i) {
       Keyframe& kf = job.keyframes[i];
       const auto hk = static_cast<std::size_t>(kf.hand);
@@ -359,8 +369,11 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       const Eigen::LDLT<MatX> A_ldlt(A);
       const MatX JtJb = J.transpose() * Jb;
       const MatX JbtJ = JtJb.transpose();
-      S += Jb.transpose() * Jb - JbtJ * A_ldlt.solve(JtJb);
-      g -= Jb.transpose() * r - JbtJ * A_ldlt.solve(J.transpose() * r);
+      const Eigen::Matrix3d S_k = Jb.transpose() * Jb - JbtJ * A_ldlt.solve(JtJb);
+      const Eigen::Vector3d g_k = -(Jb.transpose() * r - JbtJ * A_ldlt.solve(J.transpose() * r));
+      S += S_k;
+      g += g_k;
+      info[i] = {S_k, g_k};
       cost += r.squaredNorm();
       // The chord's row: the pose is the keyframe's fit (its other evidence), held here.
       if (chord && std::isfinite(r_chord) && J_chord.allFinite()) {
@@ -388,6 +401,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       best.H = S + H0;
       best.poses.clear();
       for (const Keyframe& kf : job.keyframes) best.poses.push_back(kf.q);
+      best.info = info;
     }
     if (it == p.iterations) break;  // the last step evaluated, not stepped from
     if (!better) {
@@ -397,7 +411,7 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
       continue;
     }
     const Eigen::Matrix3d& H = best.H;
-    const Eigen::Vector3d rhs = g + H0 * (beta0 - beta);
+    const Eigen::Vector3d rhs = g + H0 * (prior_mean - beta);
     // Solve over the sizes still free (frozen ones and, without silhouettes, the thickness stay).
     const std::array<bool, 3> free{!estimate.length_frozen, !estimate.width_frozen,
                                    nb == 3 && !estimate.thickness_frozen};
@@ -431,6 +445,13 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   // The best sizes visited, with their models and the keyframes' poses fitted at them.
   if (best.beta != beta) (void)set_models_at(best.beta);  // valid: visited
   for (std::size_t i = 0; i < job.keyframes.size() && i < best.poses.size(); ++i) job.keyframes[i].q = best.poses[i];
+  for (std::size_t i = 0; i < job.keyframes.size() && i < best.info.size(); ++i) {
+    Keyframe& kf = job.keyframes[i];
+    kf.S = best.info[i].first;
+    kf.g = best.info[i].second;
+    kf.beta_lin = best.beta;
+    kf.has_information = kf.S.allFinite() && kf.g.allFinite() && kf.S.trace() > 0;
+  }
   beta = best.beta;
   estimate.objective = best.cost;
   const bool changed = (beta - beta_start).cwiseAbs().maxCoeff() > 1e-7;
@@ -519,10 +540,12 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
   }
   if (p_.digit_section_sigma > 0 && image.camera != nullptr && !image.alpha.empty())
     add_sections(hand, q, *image.camera, image.alpha, fit_params.matte_threshold);
-  if (slot == keyframes_.size())
+  if (slot == keyframes_.size()) {
     keyframes_.push_back(std::move(kf));
-  else
+  } else {
+    if (p_.accumulate) absorb(keyframes_[slot]);
     keyframes_[slot] = std::move(kf);
+  }
   estimate_.keyframes = static_cast<int>(keyframes_.size());
   if (++new_since_solve_ < p_.solve_every || estimate_.keyframes < p_.min_keyframes) return false;
   if (pending_.valid()) return false;  // one re-estimate at a time: the next frame's offer starts it
@@ -561,6 +584,13 @@ void ShapeEstimator::add_sections(int hand, const hand::HandParams& q, const vis
   }
 }
 
+void ShapeEstimator::absorb(const Keyframe& k) {
+  if (!k.has_information) return;  // never in a re-estimate: nothing known to keep
+  // Frozen sizes and those not estimated keep their rows and columns out (their S and g are 0).
+  prior_H_ += k.S;
+  prior_h_ += k.S * k.beta_lin + k.g;
+}
+
 bool ShapeEstimator::poll() {
   if (!pending_.valid()) return false;
   if (++polls_since_start_ < p_.apply_after_frames) return false;
@@ -577,6 +607,8 @@ ShapeEstimator::Solve ShapeEstimator::make_solve(const vision::Camera* camera,
   job.starts = starts_;
   job.keyframes = keyframes_;
   job.section_sizes = section_sizes_;
+  job.prior_H = prior_H_;
+  job.prior_h = prior_h_;
   job.estimate = estimate_;
   return job;
 }
@@ -590,11 +622,15 @@ bool ShapeEstimator::apply(Solve&& done) {
   // started (new_since_solve_ counts them from its start).
   if (new_since_solve_ == 0) {
     keyframes_ = std::move(done.keyframes);
-  } else {  // the distance transforms it made stay with the keyframes still held
+  } else {  // the distance transforms it made, and their information, stay with the keyframes still held
     for (Keyframe& k : keyframes_)
       for (const Keyframe& d : done.keyframes)
         if (d.serial == k.serial) {
           if (!k.distance) k.distance = d.distance;
+          k.S = d.S;
+          k.g = d.g;
+          k.beta_lin = d.beta_lin;
+          k.has_information = d.has_information;
         }
   }
   return done.changed;

@@ -211,6 +211,20 @@ struct ShapeEstimatorParams {
   /// width, and the left width ended 8–15 % wide; with it −0.4…+2.9 % (seeds 1–6), −2.0…+3.7 %
   /// over seeds 1–20, at 0.007 less IoU (docs/measurements.md).
   bool digit_section_clear_edges = true;
+  /// Evidence accumulated over the whole session (honline's cumulative prior, Tkach et al. 2017):
+  /// a keyframe leaving the window hands its information on the sizes to the prior — the quadratic
+  /// its rows gave at the last re-estimate, S_k and g_k (Schur complement, file comment) at the
+  /// sizes then, β*: H_p += S_k, h_p += S_k β* + g_k, from H_p = Σ₀⁻¹, h_p = Σ₀⁻¹ β₀ — so a
+  /// re-estimate weighs every pose seen, not only the `keyframes` held, and σ is the session's.
+  /// false: the prior stays the starting profile's, and the estimate follows the window, which
+  /// the task's phases bias in turn (the default user's right length swung 182–196 mm, its width
+  /// 80–86 mm, and ended 3–4 % wide after the release's keyframes). Measured (demo, 14 pairs
+  /// interleaved: the default user seeds 1–4, the other users and the blocks scene seeds 1–2,
+  /// docs/measurements.md, session 50): IoU higher in 12 of 14 (mean 0.846 → 0.851; short-wide
+  /// +0.017), joints lower in 10 of 14 (6.58 → 6.48 px); the default user's right width
+  /// +3.2…+3.8 → −1.9…+1.5 %; the widths that got worse: the small user's left (+2…+6 → +9 %), the
+  /// long-narrow user's (to ±5 %) and the large user's right (−8 → −11 %).
+  bool accumulate = true;
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
@@ -289,6 +303,12 @@ class ShapeEstimator {
     /// from then on, so copies on a re-estimate's thread share it).
     std::shared_ptr<const vision::SilhouetteDistance> distance;
     std::optional<PalmChord> chord;  ///< the palm's breadth (palm_breadth_sigma_px > 0)
+    /// Its information on β at the last re-estimate that held it (ShapeEstimatorParams::accumulate):
+    /// the quadratic c(β) ≈ c* − 2 gᵀ(β − β*) + (β − β*)ᵀ S (β − β*). has_information: set.
+    Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    Eigen::Vector3d beta_lin = Eigen::Vector3d::Zero();
+    bool has_information = false;
   };
   /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its
   /// own thread shares nothing with the estimator).
@@ -300,6 +320,8 @@ class ShapeEstimator {
     std::vector<Eigen::Vector3d> starts;  ///< per hand: starting (length [m], width [m], thickness)
     std::vector<Keyframe> keyframes;
     std::vector<double> section_sizes;  ///< ShapeEstimator::section_sizes_
+    Eigen::Matrix3d prior_H;  ///< ShapeEstimator::prior_H_
+    Eigen::Vector3d prior_h;  ///< ShapeEstimator::prior_h_
     ShapeEstimate estimate;  ///< in hand 0's sizes (β)
     bool changed = false;
   };
@@ -320,6 +342,12 @@ class ShapeEstimator {
   /// across keyframes, kept when they are replaced: the fingers are seen across in some parts of a
   /// session only (the holding hand's hardly ever), and what they showed stays true.
   std::vector<double> section_sizes_;
+  /// The sizes' prior in information form, βᵀ H β − 2 hᵀ β: the starting profile's (Σ₀⁻¹, Σ₀⁻¹ β₀),
+  /// plus, with ShapeEstimatorParams::accumulate, what the keyframes that left the window knew.
+  Eigen::Matrix3d prior_H_ = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d prior_h_ = Eigen::Vector3d::Zero();
+  /// Adds keyframe `k`'s information to the prior (accumulate) before it leaves the window.
+  void absorb(const Keyframe& k);
   std::uint64_t next_serial_ = 0;
   std::vector<std::uint64_t> candidates_;  ///< per hand: new poses offered (KeyframeWindow::kSession)
   int new_since_solve_ = 0;
@@ -335,7 +363,7 @@ class ShapeEstimator {
 /// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, max_keyframe_speed_m_s, shared_hands,
 /// keyframe_prior_scale, keyframe_prior (taken or last), keyframe_window (newest or session),
 /// joint_balls, palm_breadth_sigma_px, palm_breadth_at, palm_breadth_min_facing, digit_axes,
-/// digit_section_sigma, digit_section_clear_edges.
+/// digit_section_sigma, digit_section_clear_edges, accumulate.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 
