@@ -221,9 +221,10 @@ struct ShapeEstimatorParams {
   /// 80–86 mm, and ended 3–4 % wide after the release's keyframes). Measured (demo, 14 pairs
   /// interleaved: the default user seeds 1–4, the other users and the blocks scene seeds 1–2,
   /// docs/measurements.md, session 50): IoU higher in 12 of 14 (mean 0.846 → 0.851; short-wide
-  /// +0.017), joints lower in 10 of 14 (6.58 → 6.48 px); the default user's right width
-  /// +3.2…+3.8 → −1.9…+1.5 %; the widths that got worse: the small user's left (+2…+6 → +9 %), the
-  /// long-narrow user's (to ±5 %) and the large user's right (−8 → −11 %).
+  /// +0.017), joints lower in 10 of 14 (6.58 → 6.43 px); the default user's right width
+  /// +3.2…+3.8 → −1.9…+1.5 % and the short-wide user's left −8 → ±2 %, but the worse hand's
+  /// width 5.7 → 6.6 % off on average: the small user's left (+2…+6 → +9 %), the long-narrow
+  /// user's (to ±5 %), the large user's right (−8 → −11 %), the blocks scene's right (−4 → −11 %).
   bool accumulate = true;
 };
 
