@@ -255,12 +255,10 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
   // The digits' sections measure the capsules' radius (width × thickness): the thickness too.
   const int nb = any_silhouette || (p.digit_section_sigma > 0 && !job.section_sizes.empty()) ? 3 : 2;
   const Eigen::Vector3d beta0 = starts[0];
-  const Eigen::Vector3d sigma0(p.prior_sigma_length_m, p.prior_sigma_width_m, p.prior_sigma_thickness);
   // The prior, βᵀ H0 β − 2 h0ᵀ β: the starting profile's, and what left the window (accumulate).
   // Its mean (H0⁻¹ h0) makes its cost (β − mean)ᵀ H0 (β − mean) ≥ 0.
   const Eigen::Matrix3d H0 = job.prior_H;
   const Eigen::Vector3d prior_mean = H0.ldlt().solve(job.prior_h);
-  (void)sigma0;
   const Eigen::Vector3d step_h(p.difference_step_m, p.difference_step_m,
                                p.difference_step_m / std::max(starts[0].y(), 1e-3));
   const double k = p.max_relative_change;

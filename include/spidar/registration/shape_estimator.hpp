@@ -18,6 +18,10 @@
 /// A step that raises the objective (J_β is a linearisation) is halved back, never followed.
 /// σ = √diag((Σ S_k + Σ₀⁻¹)⁻¹) is the estimate's uncertainty; a size whose σ falls below its
 /// freeze threshold is frozen (Monado's hand-size schedule likewise stops adapting once sure).
+/// With ShapeEstimatorParams::accumulate (the default) the prior also holds what the keyframes
+/// that left the window knew (their S_k and g_k at their last re-estimate): Σ₀⁻¹ and β₀ become
+/// the session's information H_p and its mean H_p⁻¹ h_p, so the estimate and its σ are the whole
+/// session's, not the window's.
 ///
 /// Without the silhouette (ShapeEstimatorParams::silhouette kNone) the evidence is the strings and
 /// the bracelet, which measure points of the skeleton: a model longer than the hand then bends
