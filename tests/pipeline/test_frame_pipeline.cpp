@@ -66,13 +66,27 @@ class FramePipelineTest : public ::testing::Test {
     return s;
   }
 
-  // The shipped keyer and bracelet detector, estimating the hands' sizes from keyframes of a short
-  // stretch of the script.
-  static FramePipelineParams personalising_params() {
+  // The shipped keyer and bracelet detector; the rest the library's defaults.
+  static FramePipelineParams shipped_keyer_params() {
     const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
     FramePipelineParams p;
     p.chroma_key = vc.chroma_key;
     p.bracelet = vc.bracelet;
+    return p;
+  }
+
+  // The same, the fits starting from the hands' rotations in `task`'s script at `t` [s].
+  static FramePipelineParams scripted_params(const sim::RubiksTask& task, double t) {
+    FramePipelineParams p = shipped_keyer_params();
+    for (int h = 0; h < 2; ++h)
+      p.initial_r_W_hand[h] = task.nominal(t, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+    return p;
+  }
+
+  // The shipped keyer and bracelet detector, estimating the hands' sizes from keyframes of a short
+  // stretch of the script.
+  static FramePipelineParams personalising_params() {
+    FramePipelineParams p = shipped_keyer_params();
     p.personalise_shape = true;
     p.shape_estimator.min_pose_change = 0.02;
     return p;
@@ -83,10 +97,7 @@ class FramePipelineTest : public ::testing::Test {
 
   // The shipped keyer and bracelet detector, with the silhouette term.
   static FramePipelineParams keyed_params() {
-    const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
-    FramePipelineParams p;
-    p.chroma_key = vc.chroma_key;
-    p.bracelet = vc.bracelet;
+    FramePipelineParams p = shipped_keyer_params();
     p.registration.silhouette_term = true;
     return p;
   }
@@ -99,13 +110,8 @@ class FramePipelineTest : public ::testing::Test {
 };
 
 TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) {
-  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
-  FramePipelineParams p;
-  p.chroma_key = vc.chroma_key;
-  p.bracelet = vc.bracelet;
   sim::RubiksTask task({});
-  for (int h = 0; h < 2; ++h)
-    p.initial_r_W_hand[h] = task.nominal(1.5, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  const FramePipelineParams p = scripted_params(task, 1.5);
   auto pipe = FramePipeline::create(*context_, camera_, models_, p).value();
   sim::UserHands user(truth_models_, task);
   sim::SyntheticFrame frame;
@@ -164,20 +170,11 @@ TEST_F(FramePipelineTest, TracksTheUsersHandsAndCompositesWithCorrectOcclusion) 
   EXPECT_NEAR(moved.wrist_depth_mm[1], 0.0, 1e-6);
 }
 
-// The hand-aware silhouette term (with the forearms' directions from their bands, the default)
-// against the paper's joint-balls alone (its forearm in line), on the same frames of the simulated
-// user's hands, their wrists bending as the demo's do: the approach (hands coming in from the
-// sides, the worst frames of the paper's fit) through the grasp, the lift and the first turn.
 // The report's keyframe: 2×2 without the ground truth (real hardware), and with the real hands'
 // ids a third column whose top tile is the fit against the real hands (silhouette_loss_image).
 TEST_F(FramePipelineTest, AKeyframeShowsTheFitAgainstTheRealHandsWhenTheTruthIsKnown) {
-  const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
-  FramePipelineParams p;
-  p.chroma_key = vc.chroma_key;
-  p.bracelet = vc.bracelet;
   sim::RubiksTask task({});
-  for (int h = 0; h < 2; ++h)
-    p.initial_r_W_hand[h] = task.nominal(2.0, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
+  const FramePipelineParams p = scripted_params(task, 2.0);
   auto pipe = FramePipeline::create(*context_, camera_, models_, p).value();
   sim::UserHands user(truth_models_, task);
   sim::SyntheticFrame frame;
@@ -206,6 +203,10 @@ TEST_F(FramePipelineTest, AKeyframeShowsTheFitAgainstTheRealHandsWhenTheTruthIsK
   EXPECT_EQ(sim::keyframe_montage(frame.bgr, r, p.compositor.mode, r.models, camera_, "caption", &small).cols, 2 * w);
 }
 
+// The hand-aware silhouette term (with the forearms' directions from their bands, the default)
+// against the paper's joint-balls alone (its forearm in line), on the same frames of the simulated
+// user's hands, their wrists bending as the demo's do: the approach (hands coming in from the
+// sides, the worst frames of the paper's fit) through the grasp, the lift and the first turn.
 TEST_F(FramePipelineTest, TheSilhouetteTermBeatsJointBallsOnTheSameFrames) {
   const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
   sim::RubiksTask task({});
