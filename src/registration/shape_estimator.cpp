@@ -448,7 +448,6 @@ ShapeEstimator::Solve ShapeEstimator::run_solve(Solve job) {
     kf.S = best.info[i].first;
     kf.g = best.info[i].second;
     kf.beta_lin = best.beta;
-    kf.has_information = kf.S.allFinite() && kf.g.allFinite() && kf.S.trace() > 0;
   }
   beta = best.beta;
   estimate.objective = best.cost;
@@ -583,8 +582,10 @@ void ShapeEstimator::add_sections(int hand, const hand::HandParams& q, const vis
 }
 
 void ShapeEstimator::absorb(const Keyframe& k) {
-  if (!k.has_information) return;  // never in a re-estimate: nothing known to keep
-  // Frozen sizes and those not estimated keep their rows and columns out (their S and g are 0).
+  // Never in a re-estimate (S = 0), or skipped there: nothing known to keep. A size not estimated
+  // (the thickness without sections) has zero rows; a frozen one's information is kept, and no
+  // step moves it.
+  if (!(k.S.allFinite() && k.g.allFinite() && k.beta_lin.allFinite() && k.S.trace() > 0)) return;
   prior_H_ += k.S;
   prior_h_ += k.S * k.beta_lin + k.g;
 }
@@ -628,7 +629,6 @@ bool ShapeEstimator::apply(Solve&& done) {
           k.S = d.S;
           k.g = d.g;
           k.beta_lin = d.beta_lin;
-          k.has_information = d.has_information;
         }
   }
   return done.changed;

@@ -309,11 +309,11 @@ class ShapeEstimator {
     std::shared_ptr<const vision::SilhouetteDistance> distance;
     std::optional<PalmChord> chord;  ///< the palm's breadth (palm_breadth_sigma_px > 0)
     /// Its information on β at the last re-estimate that held it (ShapeEstimatorParams::accumulate):
-    /// the quadratic c(β) ≈ c* − 2 gᵀ(β − β*) + (β − β*)ᵀ S (β − β*). has_information: set.
+    /// the quadratic c(β) ≈ c* − 2 gᵀ(β − β*) + (β − β*)ᵀ S (β − β*), β* = beta_lin; S = 0 until
+    /// a re-estimate has held it.
     Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     Eigen::Vector3d beta_lin = Eigen::Vector3d::Zero();
-    bool has_information = false;
   };
   /// What one re-estimate starts from, and what it ends with (plain copies: a re-estimate on its
   /// own thread shares nothing with the estimator).
