@@ -15,6 +15,7 @@
 #include "spidar/core/atomic_write.hpp"
 #include "spidar/core/units.hpp"
 #include "spidar/device/workspace.hpp"
+#include "spidar/registration/fingertip_end.hpp"
 #include "demo.hpp"
 #include "spidar/session/run_report.hpp"
 #include "progress.hpp"
@@ -260,6 +261,7 @@ int run_mr_demo(const DemoOptions& o) {
   summary.user_profile = user_profile;
   summary.user_length_m = truth_models[0].shape.dimensions.length;
   summary.user_width_m = truth_models[0].shape.dimensions.width;
+  summary.user_cap_reach_m = registration::model_fingertip_reach_m(truth_models[0]);
   summary.ended_by = ended_by;
   summary.mujoco_warning_kinds = scene.world->warning_counts();
   const physics::MujocoWarnings mj = physics::mujoco_warnings();

@@ -4,6 +4,7 @@
 // normal equations, the tests stack the rows. Everything is fixed-size; nothing allocates.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/rotation_vector.hpp"
@@ -19,6 +20,13 @@ static_assert(static_cast<int>(Term::kPrior) == static_cast<int>(ResidualTerm::k
 inline constexpr double kMinImageDepth = 0.01;
 /// A silhouette point counts as outside when farther than this from the silhouette [px].
 inline constexpr double kSilhouetteTolerancePx = 0.5;
+
+/// How far from `from` along `dir` (unit) the matte `alpha` leaves the silhouette (below
+/// `threshold`) [px]: walked a pixel at a time (nearest pixel), the crossing then placed between the
+/// last step on it and the first off it where the bilinear matte crosses the threshold. nullopt if
+/// it does not within `max_px` (residuals.cpp).
+std::optional<double> edge_along(const cv::Mat& alpha, const Vec2& from, const Vec2& dir, double max_px,
+                                 double threshold);
 
 template <int R>
 using Block = Eigen::Matrix<double, R, 1>;

@@ -70,21 +70,6 @@ void freeze_silhouette(const ResidualProblem& pr, const detail::PoseState& s,
   }
 }
 
-/// How far from `from` along `dir` (unit) the matte leaves the silhouette [px]: walked a pixel at
-/// a time (nearest pixel), the crossing then placed between the last step on it and the first off
-/// it where the bilinear matte crosses the threshold. nullopt if it does not within `max_px`.
-std::optional<double> edge_along(const cv::Mat& alpha, const Vec2& from, const Vec2& dir, double max_px,
-                                 double threshold) {
-  for (double s = 1.0; s <= max_px; s += 1.0) {
-    if (vision::sample_nearest(alpha, from + s * dir) >= threshold) continue;
-    const double a0 = vision::sample_bilinear(alpha, from + (s - 1.0) * dir);
-    const double a1 = vision::sample_bilinear(alpha, from + s * dir);
-    const double f = a0 > a1 ? (a0 - threshold) / (a0 - a1) : 0.5;
-    return s - 1.0 + std::clamp(f, 0.0, 1.0);
-  }
-  return std::nullopt;
-}
-
 /// The digits' sections (digit_sections): across each phalanx at t = 1/3 and 2/3, the
 /// silhouette's edges either side of the projected axis, their midpoint and the width between.
 int sections_of(const hand::HandModel& model, const detail::PoseState& s, const vision::Camera& camera,
@@ -109,8 +94,8 @@ int sections_of(const hand::HandModel& model, const detail::PoseState& s, const 
       const Vec2 p = ua + t * d;
       if (!camera.in_image(p) || !vision::on_silhouette(alpha, p, threshold)) continue;
       const double max_px = 2.0 * r_px + 3.0;
-      const auto plus = edge_along(alpha, p, across, max_px, threshold);
-      const auto minus = edge_along(alpha, p, -across, max_px, threshold);
+      const auto plus = detail::edge_along(alpha, p, across, max_px, threshold);
+      const auto minus = detail::edge_along(alpha, p, -across, max_px, threshold);
       if (!plus || !minus) continue;
       const double width = *plus + *minus;
       if (width < 0.5 * 2.0 * r_px || width > 1.8 * 2.0 * r_px) continue;
@@ -498,5 +483,22 @@ std::vector<DigitAxisPoint> digit_sections(const hand::HandModel& model, const h
   const int n = sections_of(model, s, camera, alpha, threshold, buffer);
   return {buffer.begin(), buffer.begin() + n};
 }
+
+namespace detail {
+
+// residual_terms.hpp.
+std::optional<double> edge_along(const cv::Mat& alpha, const Vec2& from, const Vec2& dir, double max_px,
+                                 double threshold) {
+  for (double s = 1.0; s <= max_px; s += 1.0) {
+    if (vision::sample_nearest(alpha, from + s * dir) >= threshold) continue;
+    const double a0 = vision::sample_bilinear(alpha, from + (s - 1.0) * dir);
+    const double a1 = vision::sample_bilinear(alpha, from + s * dir);
+    const double f = a0 > a1 ? (a0 - threshold) / (a0 - a1) : 0.5;
+    return s - 1.0 + std::clamp(f, 0.0, 1.0);
+  }
+  return std::nullopt;
+}
+
+}  // namespace detail
 
 }  // namespace spidar::registration

@@ -26,6 +26,10 @@ constexpr int kSilhouetteMarginPx = 40;
 constexpr double kSectionMaxRatio = 1.35;
 /// The digits' sections pooled (ShapeEstimatorParams::digit_section_sigma): the oldest go first.
 constexpr std::size_t kMaxSectionSizes = 400;
+/// The fingertips' reaches pooled (ShapeEstimatorParams::cap_offset_from_image): the oldest go first.
+constexpr std::size_t kMaxCapReaches = 400;
+/// The models are rebuilt for a new cap offset only when it moved by this much [m].
+constexpr double kCapReachStepM = 1e-4;
 /// A section's edges lie at least this far outside every other part of the hand's outline [px]
 /// (ShapeEstimatorParams::digit_section_clear_edges): an edge found on another part's own boundary,
 /// the far side of a neighbour the digit merges with in the matte, lies within a pixel or so of it.
@@ -41,7 +45,8 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
                     "max_fingertip_cost", "max_keyframe_speed_m_s", "shared_hands", "keyframe_prior_scale",
                     "keyframe_prior", "joint_balls", "palm_breadth_sigma_px", "palm_breadth_at",
                     "palm_breadth_min_facing", "digit_axes", "digit_section_sigma", "digit_section_clear_edges",
-                    "keyframe_window", "accumulate"});
+                    "keyframe_window", "accumulate", "cap_offset_from_image", "cap_offset_min_samples",
+                    "cap_offset_max_change_m"});
   ShapeEstimatorParams p;
   if (auto b = node.find("enabled"); b && enabled) *enabled = b->as_bool();
   if (auto b = node.find("shared_hands")) p.shared_hands = b->as_bool();
@@ -49,6 +54,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
   if (auto b = node.find("digit_axes")) p.digit_axes = b->as_bool();
   if (auto b = node.find("digit_section_clear_edges")) p.digit_section_clear_edges = b->as_bool();
   if (auto b = node.find("accumulate")) p.accumulate = b->as_bool();
+  if (auto b = node.find("cap_offset_from_image")) p.cap_offset_from_image = b->as_bool();
   if (auto b = node.find("keyframe_prior")) {
     const std::string v = b->as_string();
     if (v == "taken") p.keyframe_prior = KeyframePrior::kTaken;
@@ -91,6 +97,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       {"keyframe_prior_scale", &ShapeEstimatorParams::keyframe_prior_scale, 1e-3, 1e3},
       {"palm_breadth_sigma_px", &ShapeEstimatorParams::palm_breadth_sigma_px, 0.01, 1e3, true},
       {"digit_section_sigma", &ShapeEstimatorParams::digit_section_sigma, 1e-3, 2.0, true},
+      {"cap_offset_max_change_m", &ShapeEstimatorParams::cap_offset_max_change_m, 0.0, 0.01, true},
   };
   struct IntField {
     const char* key;
@@ -103,6 +110,7 @@ ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, 
       {"min_keyframes", &ShapeEstimatorParams::min_keyframes, 1, 200},
       {"iterations", &ShapeEstimatorParams::iterations, 1, 50},
       {"apply_after_frames", &ShapeEstimatorParams::apply_after_frames, 0, 100},
+      {"cap_offset_min_samples", &ShapeEstimatorParams::cap_offset_min_samples, 1, 400},
   };
   for (const IntField& f : kInts) {
     const auto child = node.find(f.key);
@@ -190,6 +198,8 @@ ShapeEstimator::ShapeEstimator(const hand::HandModel& start, const ShapeEstimato
   const Eigen::Vector3d sigma0(p_.prior_sigma_length_m, p_.prior_sigma_width_m, p_.prior_sigma_thickness);
   prior_H_ = sigma0.cwiseProduct(sigma0).cwiseInverse().asDiagonal();
   prior_h_ = prior_H_ * starts_[0];
+  start_cap_reach_m_ = model_fingertip_reach_m(start);
+  cap_reach_m_ = start_cap_reach_m_;
 }
 
 ShapeEstimator::ShapeEstimator(const std::array<hand::HandModel, 2>& starts,
@@ -216,6 +226,9 @@ ShapeEstimate ShapeEstimator::estimate(int hand) const {
   e.palm_chords = static_cast<int>(std::count_if(keyframes_.begin(), keyframes_.end(), [&](const Keyframe& k) {
     return k.hand == hand && k.chord.has_value();
   }));
+  e.cap_reach_m = model_fingertip_reach_m(models_[h]);
+  e.sigma_cap_reach_m = sigma_cap_reach_m_;
+  e.cap_reach_samples = static_cast<int>(cap_reaches_.size());
   return e;
 }
 
@@ -512,10 +525,9 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
         if (keyframes_[i].hand == hand && seen++ == j) slot = i;
     }
   }
-  if (slot == kNowhere) {  // not kept; its digits' sections still count
-    if (p_.digit_section_sigma > 0 && image.camera != nullptr && !image.alpha.empty())
-      add_sections(hand, q, *image.camera, image.alpha, fit_params.matte_threshold);
-    return false;
+  if (slot == kNowhere) {  // not kept; its image measures still count
+    add_image_measures(hand, q, observation, image, fit_params);
+    return update_cap_offset();
   }
   Keyframe kf{hand, next_serial_++, q, q, observation, {}, {}, {}, {}};
   // The band's length is left out of the size estimate's refits: with it the default user's width
@@ -535,8 +547,8 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     kf.chord = measure_palm_chord(models_.at(static_cast<std::size_t>(hand)), q, *image.camera, mask,
                                   image.coverage, fit_params.coverage_stride_px, p_.palm_chord);
   }
-  if (p_.digit_section_sigma > 0 && image.camera != nullptr && !image.alpha.empty())
-    add_sections(hand, q, *image.camera, image.alpha, fit_params.matte_threshold);
+  add_image_measures(hand, q, observation, image, fit_params);
+  const bool cap_changed = update_cap_offset();
   if (slot == keyframes_.size()) {
     keyframes_.push_back(std::move(kf));
   } else {
@@ -544,11 +556,11 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     keyframes_[slot] = std::move(kf);
   }
   estimate_.keyframes = static_cast<int>(keyframes_.size());
-  if (++new_since_solve_ < p_.solve_every || estimate_.keyframes < p_.min_keyframes) return false;
-  if (pending_.valid()) return false;  // one re-estimate at a time: the next frame's offer starts it
+  if (++new_since_solve_ < p_.solve_every || estimate_.keyframes < p_.min_keyframes) return cap_changed;
+  if (pending_.valid()) return cap_changed;  // one re-estimate at a time: the next frame's offer starts it
   new_since_solve_ = 0;
   Solve job = make_solve(image.camera, fit_params);
-  if (p_.apply_after_frames <= 0) return apply(run_solve(std::move(job)));
+  if (p_.apply_after_frames <= 0) return apply(run_solve(std::move(job))) || cap_changed;
   polls_since_start_ = 0;
   pending_ = std::async(std::launch::async, [job = std::move(job)]() mutable {
     core::set_thread_name("spidar-shape");
@@ -557,7 +569,7 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     (void)core::apply_scheduling({SCHED_OTHER, 0, 0});
     return run_solve(std::move(job));
   });
-  return false;
+  return cap_changed;
 }
 
 void ShapeEstimator::add_sections(int hand, const hand::HandParams& q, const vision::Camera& camera,
@@ -579,6 +591,67 @@ void ShapeEstimator::add_sections(int hand, const hand::HandParams& q, const vis
     if (section_sizes_.size() >= kMaxSectionSizes) section_sizes_.erase(section_sizes_.begin());
     section_sizes_.push_back(d.width * d.thickness * ratio * to_beta);
   }
+}
+
+void ShapeEstimator::add_fingertip_ends(int hand, const hand::HandParams& q, const HandObservation& observation,
+                                        const vision::Camera& camera, const cv::Mat& alpha, double threshold) {
+  const hand::HandModel& model = models_.at(static_cast<std::size_t>(hand));
+  ProjectedHand outline;  // an end inside another part of the fitted outline may be that part's edge
+  project_hand(model, q, camera, 0.0, &outline);
+  // Only reaches the offset may take count: a longer one has run on into something the outline
+  // does not hold (the other hand).
+  FingertipEndParams fe = p_.fingertip_end;
+  fe.min_reach_m = std::max(fe.min_reach_m, start_cap_reach_m_ - p_.cap_offset_max_change_m);
+  fe.max_reach_m = std::min(fe.max_reach_m, start_cap_reach_m_ + p_.cap_offset_max_change_m);
+  for (const FingertipEnd& e : fingertip_ends(model, q, observation, camera, alpha, threshold, fe, &outline)) {
+    if (cap_reaches_.size() >= kMaxCapReaches) cap_reaches_.erase(cap_reaches_.begin());
+    cap_reaches_.push_back(e.reach_m);
+  }
+}
+
+void ShapeEstimator::add_image_measures(int hand, const hand::HandParams& q, const HandObservation& observation,
+                                        const ImageEvidence& image, const RegistrationParams& fit_params) {
+  if (image.camera == nullptr || image.alpha.empty()) return;
+  if (p_.digit_section_sigma > 0) add_sections(hand, q, *image.camera, image.alpha, fit_params.matte_threshold);
+  if (p_.cap_offset_from_image)
+    add_fingertip_ends(hand, q, observation, *image.camera, image.alpha, fit_params.matte_threshold);
+}
+
+bool ShapeEstimator::set_cap_reach(std::vector<hand::HandModel>* models, double reach_m) {
+  std::vector<hand::HandModel> next;
+  for (const hand::HandModel& m : *models) {
+    hand::HandDimensions d = m.shape.dimensions;
+    d.fingertip_offset.y() = -reach_m;
+    auto shape = hand::make_hand_shape(d);
+    if (!shape) return false;
+    next.push_back(m);
+    next.back().shape = std::move(shape).value();
+  }
+  *models = std::move(next);
+  return true;
+}
+
+bool ShapeEstimator::update_cap_offset() {
+  const auto n = cap_reaches_.size();
+  if (!p_.cap_offset_from_image || n == 0) return false;
+  // The pool's median, and its σ from the median absolute deviation (robust to the ends that
+  // the checks let through on another finger's outline).
+  std::vector<double> v = cap_reaches_;
+  auto median = [](std::vector<double>* x) {
+    const auto mid = x->begin() + static_cast<std::ptrdiff_t>(x->size() / 2);
+    std::nth_element(x->begin(), mid, x->end());
+    return *mid;
+  };
+  const double med = median(&v);
+  for (double& x : v) x = std::abs(x - med);
+  sigma_cap_reach_m_ = 1.2533 * 1.4826 * median(&v) / std::sqrt(static_cast<double>(n));
+  if (static_cast<int>(n) < p_.cap_offset_min_samples) return false;
+  const double k = p_.cap_offset_max_change_m;
+  const double reach = std::clamp(med, start_cap_reach_m_ - k, start_cap_reach_m_ + k);
+  if (std::abs(reach - cap_reach_m_) < kCapReachStepM) return false;
+  if (!set_cap_reach(&models_, reach)) return false;
+  cap_reach_m_ = reach;
+  return true;
 }
 
 void ShapeEstimator::absorb(const Keyframe& k) {
@@ -614,6 +687,10 @@ ShapeEstimator::Solve ShapeEstimator::make_solve(const vision::Camera* camera,
 
 bool ShapeEstimator::apply(Solve&& done) {
   models_ = std::move(done.models);
+  // A cap offset set while the re-estimate ran (its models carry the one it started with).
+  bool cap_changed = false;
+  if (!models_.empty() && std::abs(model_fingertip_reach_m(models_[0]) - cap_reach_m_) > 1e-12)
+    cap_changed = set_cap_reach(&models_, cap_reach_m_);
   const int keyframes = estimate_.keyframes;
   estimate_ = done.estimate;
   estimate_.keyframes = keyframes;
@@ -631,7 +708,7 @@ bool ShapeEstimator::apply(Solve&& done) {
           k.beta_lin = d.beta_lin;
         }
   }
-  return done.changed;
+  return done.changed || cap_changed;
 }
 
 }  // namespace spidar::registration

@@ -444,7 +444,10 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                                           {"keyframes", e.keyframes},
                                           {"solves", e.solves},
                                           {"steps_rejected", e.steps_rejected},
-                                          {"palm_chords", e.palm_chords}};
+                                          {"palm_chords", e.palm_chords},
+                                          {"cap_reach_m", e.cap_reach_m},
+                                          {"sigma_cap_reach_m", e.sigma_cap_reach_m},
+                                          {"cap_reach_samples", e.cap_reach_samples}};
     }
     shape["personalised"] = s.personalised;
     reg["hand_shape"] = shape;
@@ -546,7 +549,7 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                         {"model_ceiling_frames", ceiling.size()},
                         {"model_ceiling_loss", ceiling_loss},
                         {"joint_px_floor", mean(joint_floor)},
-                        {"hand_shape", {{"length_m", s.user_length_m}, {"width_m", s.user_width_m}}}}},
+                        {"hand_shape", {{"length_m", s.user_length_m}, {"width_m", s.user_width_m}, {"cap_reach_m", s.user_cap_reach_m}}}}},
       {"video", {{"path", s.video_path}, {"format", s.video_format}}}};
   // Without a cube, the object the user reached for instead: how high it was held while twisted.
   const nlohmann::json object = s.has_cube ? nlohmann::json() : object_json(t, s.phases);

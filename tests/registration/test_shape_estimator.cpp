@@ -551,6 +551,9 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(p.digit_section_sigma, d.digit_section_sigma);
   EXPECT_EQ(p.digit_section_clear_edges, d.digit_section_clear_edges);
   EXPECT_EQ(p.accumulate, d.accumulate);
+  EXPECT_EQ(p.cap_offset_from_image, d.cap_offset_from_image);
+  EXPECT_EQ(p.cap_offset_min_samples, d.cap_offset_min_samples);
+  EXPECT_EQ(p.cap_offset_max_change_m, d.cap_offset_max_change_m);
   expect_parse_error("personalisation:\n  min_pose_change: -1\n", "bad.yaml", "min_pose_change");
   for (const std::string key :
        {"apply_after_frames", "reach_min_miss_m", "max_fingertip_cost", "keyframe_prior_scale"})
@@ -560,7 +563,8 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
       "personalisation:\n  silhouette: spill\n  reach_min_miss_m: 0\n  prior_sigma_thickness: 0.2\n"
       "  max_fingertip_cost: 25\n  shared_hands: false\n  keyframe_prior_scale: 10\n"
       "  keyframe_prior: taken\n  joint_balls: true\n  keyframe_window: session\n"
-      "  digit_section_clear_edges: false\n  accumulate: true\n", "on.yaml");
+      "  digit_section_clear_edges: false\n  accumulate: true\n  cap_offset_from_image: true\n"
+      "  cap_offset_min_samples: 25\n  cap_offset_max_change_m: 0.002\n", "on.yaml");
   const ShapeEstimatorParams q = parse_shape_estimator_params(on["personalisation"], &enabled);
   EXPECT_EQ(q.silhouette, ShapeSilhouette::kSpill);
   EXPECT_EQ(q.reach_min_miss_m, 0.0);
@@ -571,6 +575,9 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   EXPECT_EQ(q.keyframe_prior, KeyframePrior::kTaken);
   EXPECT_FALSE(q.digit_section_clear_edges);
   EXPECT_TRUE(q.accumulate);
+  EXPECT_TRUE(q.cap_offset_from_image);
+  EXPECT_EQ(q.cap_offset_min_samples, 25);
+  EXPECT_EQ(q.cap_offset_max_change_m, 0.002);
   EXPECT_EQ(q.keyframe_window, KeyframeWindow::kSession);
   EXPECT_TRUE(q.joint_balls);
   EXPECT_EQ(p.silhouette, ShapeSilhouette::kNone);  // the shipped setting
@@ -582,6 +589,9 @@ TEST(ShapeEstimator, ParsesItsSettingsAndNamesBadOnes) {
   expect_parse_error("personalisation:\n  joint_balls: 3\n", "balls.yaml", "joint_balls");
   expect_parse_error("personalisation:\n  digit_axes: often\n", "axes.yaml", "digit_axes");
   expect_parse_error("personalisation:\n  accumulate: always\n", "acc.yaml", "accumulate");
+  expect_parse_error("personalisation:\n  cap_offset_from_image: maybe\n", "cap.yaml", "cap_offset_from_image");
+  expect_parse_error("personalisation:\n  cap_offset_min_samples: 0\n", "cap.yaml", "cap_offset_min_samples");
+  expect_parse_error("personalisation:\n  cap_offset_max_change_m: 0.05\n", "cap.yaml", "cap_offset_max_change_m");
   expect_parse_error("personalisation:\n  palm_breadth_at: 1.5\n", "at.yaml", "palm_breadth_at");
   expect_parse_error("personalisation:\n  palm_breadth_min_facing: -0.1\n", "f.yaml", "palm_breadth_min_facing");
   expect_parse_error("personalisation:\n  palm_breadth_sigma_px: -2\n", "s.yaml", "palm_breadth_sigma_px");

@@ -45,6 +45,7 @@
 #include "spidar/core/config.hpp"
 #include "spidar/hand/hand_model.hpp"
 #include "spidar/registration/coverage.hpp"
+#include "spidar/registration/fingertip_end.hpp"
 #include "spidar/registration/palm_breadth.hpp"
 #include "spidar/registration/successive_adjustment.hpp"
 
@@ -230,6 +231,22 @@ struct ShapeEstimatorParams {
   /// width 5.7 → 6.6 % off on average: the small user's left (+2…+6 → +9 %), the long-narrow
   /// user's (to ±5 %), the large user's right (−8 → −11 %), the blocks scene's right (−4 → −11 %).
   bool accumulate = true;
+  /// The caps' offset along the distal bone (HandDimensions::fingertip_offset's y) from the image:
+  /// where each fingertip's outline ends beyond its string's cap (fingertip_end.hpp), measured
+  /// when a frame is offered past the pose-change gate, pooled over the session (the last 400,
+  /// within cap_offset_max_change_m of the starting profile's reach), and the model's offset set
+  /// to the pool's median once it holds cap_offset_min_samples. The strings alone do not determine
+  /// it (a cap worn further back is reached as well by a longer or more bent finger: session 50's
+  /// offset estimated among the sizes moved 0.3 of 2 mm in a unit test, and the wrong way in the
+  /// demo). Off: on the simulated rig it changed nothing measurable (demo, 8 cases interleaved,
+  /// 2026-11-29: IoU 0.8537 both, joints 6.26 → 6.28 px). The holding (left) hand's fingers gave
+  /// 15–30 samples a run reading 9.1–10.0 mm for caps 9 mm back (the simulated skin reaches 0.5 mm
+  /// beyond the bone); the turning hand's fingertips are seldom seen side on and clear of the
+  /// other hand, and gave none; docs/measurements.md, session 51.
+  bool cap_offset_from_image = false;
+  int cap_offset_min_samples = 15;
+  double cap_offset_max_change_m = 0.004;  ///< [m]
+  FingertipEndParams fingertip_end;  ///< the measurement's checks
 };
 
 /// The estimate of one hand (for an estimator of both hands, the shared estimate in that hand's
@@ -253,6 +270,12 @@ struct ShapeEstimate {
   double objective = 0;
   int steps_rejected = 0;  ///< Gauss-Newton steps that raised the objective (halved back), all re-estimates
   int palm_chords = 0;     ///< keyframes held (of this hand) with a palm chord (palm_breadth_sigma_px)
+  /// The fingertip's reach beyond its cap the model now has (−fingertip_offset.y) [m], the
+  /// image's samples pooled (ShapeEstimatorParams::cap_offset_from_image; of both hands for an
+  /// estimator of both), and the pool median's σ (1.25 × 1.4826 MAD / √n) [m].
+  double cap_reach_m = 0;
+  double sigma_cap_reach_m = 0;
+  int cap_reach_samples = 0;
 };
 
 class ShapeEstimator {
@@ -337,6 +360,18 @@ class ShapeEstimator {
   /// Measures the fingers' middle phalanges' sections of hand `hand` at pose `q` into section_sizes_.
   void add_sections(int hand, const hand::HandParams& q, const vision::Camera& camera, const cv::Mat& alpha,
                     double threshold);
+  /// Measures the fingertips' reach beyond their caps (fingertip_end.hpp) into cap_reaches_.
+  void add_fingertip_ends(int hand, const hand::HandParams& q, const HandObservation& observation,
+                          const vision::Camera& camera, const cv::Mat& alpha, double threshold);
+  /// The image measures of an offered frame (sections, fingertip ends), as the settings ask.
+  void add_image_measures(int hand, const hand::HandParams& q, const HandObservation& observation,
+                          const ImageEvidence& image, const RegistrationParams& fit_params);
+  /// Sets every model's cap offset to the pool's median once it is large enough (cap_offset_*);
+  /// true when the models changed.
+  bool update_cap_offset();
+  /// Every model in `models` with the fingertip's reach `reach_m` beyond the cap; false (models
+  /// unchanged) if a model cannot be built with it.
+  static bool set_cap_reach(std::vector<hand::HandModel>* models, double reach_m);
 
   ShapeEstimatorParams p_;
   std::vector<hand::HandModel> models_;
@@ -347,6 +382,12 @@ class ShapeEstimator {
   /// across keyframes, kept when they are replaced: the fingers are seen across in some parts of a
   /// session only (the holding hand's hardly ever), and what they showed stays true.
   std::vector<double> section_sizes_;
+  /// The fingertips' reach beyond their caps measured in the image (cap_offset_from_image) [m],
+  /// oldest first, the last 400.
+  std::vector<double> cap_reaches_;
+  double start_cap_reach_m_ = 0;  ///< the starting profile's (−fingertip_offset.y) [m]
+  double cap_reach_m_ = 0;        ///< the models' now [m]
+  double sigma_cap_reach_m_ = 0;  ///< [m]
   /// The sizes' prior in information form, βᵀ H β − 2 hᵀ β: the starting profile's (Σ₀⁻¹, Σ₀⁻¹ β₀),
   /// plus, with ShapeEstimatorParams::accumulate, what the keyframes that left the window knew.
   Eigen::Matrix3d prior_H_ = Eigen::Matrix3d::Zero();
@@ -368,7 +409,8 @@ class ShapeEstimator {
 /// reach_min_miss_m, apply_after_frames, silhouette, max_fingertip_cost, max_keyframe_speed_m_s, shared_hands,
 /// keyframe_prior_scale, keyframe_prior (taken or last), keyframe_window (newest or session),
 /// joint_balls, palm_breadth_sigma_px, palm_breadth_at, palm_breadth_min_facing, digit_axes,
-/// digit_section_sigma, digit_section_clear_edges, accumulate.
+/// digit_section_sigma, digit_section_clear_edges, accumulate, cap_offset_from_image,
+/// cap_offset_min_samples, cap_offset_max_change_m.
 /// Throws core::ConfigError naming file:line: key and the expected range.
 ShapeEstimatorParams parse_shape_estimator_params(const core::ConfigNode& node, bool* enabled);
 

@@ -40,6 +40,8 @@ struct MrSummary {
   std::string facelets, video_path, video_format, compositor, scene, user_hand;
   std::string user_profile;  ///< the hands YAML profile the simulated user has (user_hand's)
   double user_length_m = 0, user_width_m = 0;  ///< the simulated user's true hand sizes
+  /// The simulated user's fingertip reach beyond the caps (−fingertip_offset.y) [m]; 0 = unknown.
+  double user_cap_reach_m = 0;
   bool main_silhouette = false;
   bool personalised = false;  ///< the registration estimated the hands' sizes online
   bool bending_wrists = false;  ///< the simulated user's forearms point at fixed elbows
