@@ -229,6 +229,7 @@ ShapeEstimate ShapeEstimator::estimate(int hand) const {
   e.cap_reach_m = model_fingertip_reach_m(models_[h]);
   e.sigma_cap_reach_m = sigma_cap_reach_m_;
   e.cap_reach_samples = static_cast<int>(cap_reaches_.size());
+  e.sections = static_cast<int>(section_sizes_.size());
   return e;
 }
 

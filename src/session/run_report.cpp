@@ -447,7 +447,8 @@ int write_mr_report(const std::string& out, const MrTrace& t, const MrSummary& s
                                           {"palm_chords", e.palm_chords},
                                           {"cap_reach_m", e.cap_reach_m},
                                           {"sigma_cap_reach_m", e.sigma_cap_reach_m},
-                                          {"cap_reach_samples", e.cap_reach_samples}};
+                                          {"cap_reach_samples", e.cap_reach_samples},
+                                          {"sections", e.sections}};
     }
     shape["personalised"] = s.personalised;
     reg["hand_shape"] = shape;

@@ -299,6 +299,8 @@ TEST(ShapeEstimator, TheDigitsSectionsSeeTheDigitsThickness) {
                 d.width, T, strings.width_m, strings.thickness, sections.width_m, sections.thickness,
                 sections.sigma_thickness);
     EXPECT_EQ(strings.thickness, 1.0);  // without sections or silhouettes the thickness stays
+    EXPECT_EQ(strings.sections, 0);
+    EXPECT_GT(sections.sections, 0) << "the sections pooled are counted";
     EXPECT_LT(sections.sigma_thickness, 0.6 * ShapeEstimatorParams{}.prior_sigma_thickness) << T;
     // From 17–25 % off to within 8 % (measured: +6.8 % and +5.9 %, the sections' bias above).
     EXPECT_LT(std::abs(r_sections / r_true - 1), 0.08) << T;

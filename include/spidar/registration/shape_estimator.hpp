@@ -276,6 +276,8 @@ struct ShapeEstimate {
   double cap_reach_m = 0;
   double sigma_cap_reach_m = 0;
   int cap_reach_samples = 0;
+  /// The digits' sections pooled (digit_section_sigma; of both hands for an estimator of both).
+  int sections = 0;
 };
 
 class ShapeEstimator {
