@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "registration_test_util.hpp"
 #include "spidar/hand/hand_shape.hpp"
 #include "spidar/hand/kinematics.hpp"
 #include "spidar/hand/render_geometry.hpp"
@@ -15,21 +16,8 @@
 namespace spidar::registration {
 namespace {
 
-/// A camera without distortion at twice the rig's resolution (a pixel ≈ 0.4 mm at the hand), 0.45 m
-/// from the world origin, looking down at 50°.
-vision::Camera fine_camera() {
-  vision::Camera c = vision::default_rig_camera();
-  vision::Intrinsics k = c.intrinsics();
-  k.distortion = {};
-  k.fx *= 2;
-  k.fy *= 2;
-  k.cx *= 2;
-  k.cy *= 2;
-  k.width *= 2;
-  k.height *= 2;
-  c.set_intrinsics(k);
-  return c;
-}
+/// The rig camera at twice its resolution, without distortion (a pixel ≈ 0.4 mm at the hand).
+vision::Camera fine_camera() { return test::pinhole_camera(2.0); }
 
 /// The default right hand with its caps `reach_m` back from the fingertips along the distal bone.
 hand::HandModel hand_with_reach(double reach_m) {
@@ -129,15 +117,9 @@ cv::Mat ray_cast_matte(const hand::HandModel& truth, const hand::HandParams& q, 
   return alpha;
 }
 
-/// What the strings measure: the caps of `truth` at `q`.
+/// What the strings measure: the caps of `truth` at `q`, exactly.
 HandObservation strings_of(const hand::HandModel& truth, const hand::HandParams& q) {
-  HandObservation obs;
-  const hand::HandPoints pts = hand::forward_kinematics(truth, q);
-  for (int f = 0; f < hand::kFingertipCount; ++f) {
-    obs.p_W_fingertip[f] = pts.p_W_fingertip[f];
-    obs.fingertip_valid[f] = true;
-  }
-  return obs;
+  return test::exact_caps(truth, q);
 }
 
 TEST(FingertipEnd, ReadsTheFingertipsReachBeyondTheCapsNotTheModels) {

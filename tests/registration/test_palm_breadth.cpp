@@ -14,14 +14,7 @@
 namespace spidar::registration {
 namespace {
 
-/// A camera without distortion, 0.45 m from the world origin, looking down at 50°.
-vision::Camera pinhole_camera() {
-  vision::Camera c = vision::default_rig_camera();
-  vision::Intrinsics k = c.intrinsics();
-  k.distortion = {};
-  c.set_intrinsics(k);
-  return c;
-}
+using test::pinhole_camera;
 
 /// The right model hand with its palm's level `at` at the world origin, its back facing the
 /// camera turned by `tilt_rad` about its long axis, the fingers toward the image's right.
