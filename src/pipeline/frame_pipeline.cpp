@@ -397,6 +397,14 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
     int restarts = 0, depth_switches = 0, reaches = 0;
   };
   std::array<HandCounts, 2> counts{};
+  // What each fit offers the size estimate, taken after both fits (an estimator shared by both
+  // hands must not be fed from two threads; ShapeEstimatorParams::shared_hands).
+  struct SizeOffer {
+    bool offered = false;
+    registration::HandObservation obs;
+    registration::ImageEvidence image;
+  };
+  std::array<SizeOffer, 2> offers{};
   auto fit_hand = [&](int h) {
     registration::HandObservation obs;
     obs.forearm_H = s.forearm_H[h];
@@ -554,16 +562,19 @@ Status FramePipeline::process(const cv::Mat& bgr, const device::FingertipSample&
                             speed_gate);
     for (int f = 0; f < hand::kFingertipCount; ++f)
       next_tips_W[h][f] = obs.fingertip_valid[f] ? obs.p_W_fingertip[f] : Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-    if (p.personalise_shape && still && fingertip_cost_per_tip(report, obs) <= p.shape_estimator.max_fingertip_cost) {
-      registration::ShapeEstimator& e = s.estimator_of(h);
-      if (e.add_frame(s.index_in_estimator(h), q, obs, hand_image, p.registration)) s.take_sizes(e);
-    }
-    out->shapes[h] = s.estimator_of(h).estimate(s.index_in_estimator(h));
+    if (p.personalise_shape && still && fingertip_cost_per_tip(report, obs) <= p.shape_estimator.max_fingertip_cost)
+      offers[h] = SizeOffer{true, obs, hand_image};
   };
-  // Side by side only with an estimator per hand: one shared by both takes both hands' frames.
-  const bool own_estimators = s.shape.size() == 2;
-  core::run_side_by_side(p.side_by_side && own_estimators ? &s.side : nullptr, [&] { fit_hand(0); },
-                         [&] { fit_hand(1); });
+  core::run_side_by_side(p.side_by_side ? &s.side : nullptr, [&] { fit_hand(0); }, [&] { fit_hand(1); });
+  // The fits' evidence on the sizes, left hand first; the next frame's fits use the estimate.
+  for (int h = 0; h < 2; ++h) {
+    if (offers[h].offered) {
+      registration::ShapeEstimator& e = s.estimator_of(h);
+      if (e.add_frame(s.index_in_estimator(h), out->hands[h], offers[h].obs, offers[h].image, p.registration))
+        s.take_sizes(e);
+    }
+  }
+  for (int h = 0; h < 2; ++h) out->shapes[h] = s.estimator_of(h).estimate(s.index_in_estimator(h));
   out->restarts = counts[0].restarts + counts[1].restarts;
   out->depth_switches = counts[0].depth_switches + counts[1].depth_switches;
   out->reaches = counts[0].reaches + counts[1].reaches;

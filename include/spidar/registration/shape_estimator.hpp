@@ -147,10 +147,15 @@ struct ShapeEstimatorParams {
   /// fingers hidden behind it, and its length stays unobserved on its own; the other hand's
   /// keyframes measure it too. false: an estimate per hand.
   ///
-  /// Not the default: on the rubiks scene (seeds 1–3, five users) it brought the sizes closer
-  /// for four users at the same IoU, but on scenes/blocks.xml (seeds 1–2, default user) it left
-  /// both hands 9.6 % narrow and the contested pixels 14 % wrong, against 3–4 % per hand.
-  bool shared_hands = false;
+  /// The default since session 51, with keyframe_prior_scale 2 (below): demo, 14 cases
+  /// interleaved (the default user seeds 1–4, the other users and the blocks scene seeds 1–2):
+  /// IoU higher in 13 (mean +0.007), joints lower in 13 (−0.42 px), the worse hand's width 10.7 %
+  /// off at most instead of 12.4 %, the lengths 4.0 % instead of 5.7 %; the default user's
+  /// widths within 1.3 % and lengths 1.7–2.0 % short in all four (docs/measurements.md,
+  /// session 51). Before (with the prior at 1), on scenes/blocks.xml it had left both hands 9.6 %
+  /// narrow and the contested pixels 14 % wrong. The frame pipeline fits both hands side by side
+  /// and offers their frames to the estimate after both fits, left hand first.
+  bool shared_hands = true;
   /// A re-estimate re-fits each keyframe's pose with the fit's temporal prior toward that
   /// keyframe's last pose (fingertips and the wrist pixel alone leave a hand's pose
   /// underdetermined), its σ (RegistrationParams::prior_sigma_*) multiplied by this.
@@ -160,8 +165,14 @@ struct ShapeEstimatorParams {
   /// where the model is exact: started at the true sizes with exact skeleton data
   /// (test_shape_estimator's feed(), 400 frames), the estimate ends 1.8–13.6 % long at 1, 1.2–2.4 %
   /// at 10. But in the registration study (anatomical hands) 10 stops the long-narrow user's
-  /// length from converging (0.1972 m for 0.209) and the small user's worsens: not the default.
-  double keyframe_prior_scale = 1.0;
+  /// length from converging (0.1972 m for 0.209) and the small user's worsens.
+  ///
+  /// 2 since session 51, with shared_hands (above): a keyframe's pose moves with the sizes, so the
+  /// sizes are less held where earlier estimates put them (the large user's widths −10 → −5 %).
+  /// At 3 the IoU rose as much, but the default user's widths ran +6…+12 % wide; with an estimate
+  /// per hand the holding (left) hand's width ran +7…+19 % wide at 3 (docs/measurements.md,
+  /// session 51).
+  double keyframe_prior_scale = 2.0;
   /// The mean of that prior. kLast follows each keyframe's pose from re-estimate to re-estimate,
   /// so the poses and the sizes walk together along the strings' flat side (a longer hand bends
   /// its fingers): started at the true sizes, exact skeleton data (test_shape_estimator's feed(),
