@@ -557,7 +557,9 @@ bool ShapeEstimator::add_frame(int hand, const hand::HandParams& q, const HandOb
     keyframes_[slot] = std::move(kf);
   }
   estimate_.keyframes = static_cast<int>(keyframes_.size());
-  if (++new_since_solve_ < p_.solve_every || estimate_.keyframes < p_.min_keyframes) return cap_changed;
+  // solve_every counts a hand's keyframes: an estimate of both hands re-estimates over twice the
+  // keyframes half as often, at the same cost per frame.
+  if (++new_since_solve_ < p_.solve_every * hands() || estimate_.keyframes < p_.min_keyframes) return cap_changed;
   if (pending_.valid()) return cap_changed;  // one re-estimate at a time: the next frame's offer starts it
   new_since_solve_ = 0;
   Solve job = make_solve(image.camera, fit_params);

@@ -93,7 +93,7 @@ class FramePipelineTest : public ::testing::Test {
   }
 
   // SideBySideStagesGiveTheSerialResults, with or without the sizes estimated online.
-  void side_by_side_matches_serial(bool personalise);
+  void side_by_side_matches_serial(bool personalise, bool shared);
 
   // The shipped keyer and bracelet detector, with the silhouette term.
   static FramePipelineParams keyed_params() {
@@ -348,22 +348,23 @@ TEST_F(FramePipelineTest, PictureOfARegistrationOnlyFitIsTheFullProcessPicture) 
 // The matte and silhouette evidence on a helper thread beside the bracelets on the caller, and
 // the left hand's fit beside the right's (FramePipelineParams::side_by_side), give exactly the
 // serial pipeline's fits, sizes, mattes, bracelets and pictures, frame after frame (each stage
-// and each hand writes only its own outputs), with the sizes estimated online or fixed.
+// and each hand writes only its own outputs; the fits' frames reach the size estimate after both
+// fits), with the sizes fixed, estimated per hand, or one estimate for both hands.
 TEST_F(FramePipelineTest, SideBySideStagesGiveTheSerialResults) {
-  for (bool personalise : {false, true}) {
-    SCOPED_TRACE(personalise ? "sizes estimated online" : "fixed sizes");
-    side_by_side_matches_serial(personalise);
+  for (int personalise : {0, 1, 2}) {
+    SCOPED_TRACE(personalise == 0 ? "fixed sizes" : personalise == 1 ? "sizes estimated per hand" : "one estimate for both");
+    side_by_side_matches_serial(personalise > 0, personalise == 2);
   }
 }
 
-void FramePipelineTest::side_by_side_matches_serial(bool personalise) {
+void FramePipelineTest::side_by_side_matches_serial(bool personalise, bool shared) {
   const auto vc = vision::load_vision_config(source("configs/vision.yaml"));
   FramePipelineParams p = personalise ? personalising_params() : FramePipelineParams{};
   p.chroma_key = vc.chroma_key;
   p.bracelet = vc.bracelet;
   p.registration.silhouette_term = true;  // the evidence stage on the helper does its whole work
   p.registration.silhouette_inward = true;
-  if (personalise) p.shape_estimator.shared_hands = false;  // an estimator per hand
+  p.shape_estimator.shared_hands = shared;
   sim::RubiksTask task({});
   for (int h = 0; h < 2; ++h)
     p.initial_r_W_hand[h] = task.nominal(1.5, h == 0 ? hand::Side::kLeft : hand::Side::kRight).r_W_hand();
@@ -418,6 +419,9 @@ void FramePipelineTest::side_by_side_matches_serial(bool personalise) {
 TEST_F(FramePipelineTest, BrokenFitsAreNoEvidenceOnTheHandsSizes) {
   FramePipelineParams p = personalising_params();
   p.shape_estimator.shared_hands = true;     // one estimate for both hands (checked below)
+  // Fed by one hand only, an estimate of both re-estimates after 2 × solve_every of its keyframes:
+  // half the count, for a re-estimate within this second.
+  p.shape_estimator.solve_every = 5;
   sim::RubiksTask task({});
   task.fit_to_hands(truth_models_);
   const double t0 = 1.8;

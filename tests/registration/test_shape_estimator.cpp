@@ -390,8 +390,12 @@ TEST(ShapeEstimator, BothHandsShareOneEstimateInTheirProfilesRatio) {
   const hand::HandModel right = hand::default_hand_model(hand::Side::kRight);
   const hand::HandModel truth = resized(right, 0.205, 0.088).value();
   const hand::HandParams base = test::reaching_hands(0)[1];
-  // Equal starting profiles: the shared estimate is the right hand's own, bit for bit.
-  ShapeEstimator both(std::array<hand::HandModel, 2>{left, right}, {}), alone(right, {});
+  // Equal starting profiles: the shared estimate is the right hand's own, bit for bit. (solve_every
+  // counts a hand's keyframes, so an estimate of both waits for twice as many; fed by one hand,
+  // it is given half the count to re-estimate when the other does.)
+  ShapeEstimatorParams half;
+  half.solve_every = ShapeEstimatorParams{}.solve_every / 2;
+  ShapeEstimator both(std::array<hand::HandModel, 2>{left, right}, half), alone(right, {});
   ASSERT_EQ(both.hands(), 2);
   const Outcome b = feed(both, 1, truth, base, 200, 5);
   const Outcome a = feed(alone, 0, truth, base, 200, 5);

@@ -44,8 +44,8 @@ struct FramePipelineParams {
   int silhouette_margin_px = 40;        ///< distance-transform margin (inward silhouette only)
   /// Run independent stages side by side on two threads (core/side_task.hpp): the chroma key and
   /// the silhouette evidence built on it on a helper thread beside the bracelets on the calling
-  /// thread; then the left hand's fit on the helper beside the right hand's (with an estimator
-  /// per hand: ShapeEstimatorParams::shared_hands off). The results are the same either way
+  /// thread; then the left hand's fit on the helper beside the right hand's (their frames are
+  /// offered to the size estimate after both fits, left first). The results are the same either way
   /// (test FramePipelineTest.SideBySideStagesGiveTheSerialResults); on two cores it shortens the
   /// frame by the shorter of each pair (FrameTimings then overlap: their sum exceeds total_ms).
   bool side_by_side = true;

@@ -88,7 +88,9 @@ struct ShapeEstimatorParams {
   /// (deterministic: a replay draws the same).
   KeyframeWindow keyframe_window = KeyframeWindow::kNewest;
   double min_pose_change = 0.08;        ///< a keyframe differs from every kept one by this (‖Δθ‖, m/rad)
-  int solve_every = 10;                 ///< re-estimate after this many new keyframes
+  /// Re-estimate after this many new keyframes per hand (an estimate of both hands after twice
+  /// as many of either: its re-estimates refit twice the keyframes, so the cost per frame stays).
+  int solve_every = 10;
   int min_keyframes = 6;                ///< no estimate before this many keyframes
   /// Gauss-Newton steps per re-estimate, each evaluated at the keyframes' re-fitted poses: one
   /// that raises the objective is halved back toward the best sizes visited, which are the ones
