@@ -154,17 +154,24 @@ Result<hand::HandModel> resized(const hand::HandModel& m, double length_m, doubl
   return resized(m, length_m, width_m, m.shape.dimensions.thickness);
 }
 
+namespace {
+/// The model `m` rebuilt with dimensions `d` (same side, coupling and limits).
+Result<hand::HandModel> with_dimensions(const hand::HandModel& m, const hand::HandDimensions& d) {
+  auto shape = hand::make_hand_shape(d);
+  if (!shape) return shape.error();
+  hand::HandModel out = m;
+  out.shape = std::move(shape).value();
+  return out;
+}
+}  // namespace
+
 Result<hand::HandModel> resized(const hand::HandModel& m, double length_m, double width_m,
                                 double thickness) {
   hand::HandDimensions d = m.shape.dimensions;
   d.length = length_m;
   d.width = width_m;
   d.thickness = thickness;
-  auto shape = hand::make_hand_shape(d);
-  if (!shape) return shape.error();
-  hand::HandModel out = m;
-  out.shape = std::move(shape).value();
-  return out;
+  return with_dimensions(m, d);
 }
 
 namespace {
@@ -625,10 +632,9 @@ bool ShapeEstimator::set_cap_reach(std::vector<hand::HandModel>* models, double 
   for (const hand::HandModel& m : *models) {
     hand::HandDimensions d = m.shape.dimensions;
     d.fingertip_offset.y() = -reach_m;
-    auto shape = hand::make_hand_shape(d);
-    if (!shape) return false;
-    next.push_back(m);
-    next.back().shape = std::move(shape).value();
+    auto with = with_dimensions(m, d);
+    if (!with) return false;
+    next.push_back(std::move(with).value());
   }
   *models = std::move(next);
   return true;

@@ -27,7 +27,6 @@
 ///   in a pinch);
 /// - it is the thumb's, unless `thumb` (on the simulated rig the thumbs' read 1.5 mm short of the
 ///   fingers' in the Rubik's grasp, where the fingers' agree within 0.3 mm).
-#include <optional>
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
